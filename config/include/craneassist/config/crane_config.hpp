@@ -1,0 +1,43 @@
+// Loading and validating a crane configuration file (config/cranes/*.yaml, docs/config.md).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "craneassist/config/config_error.hpp"
+#include "craneassist/dynamics/model.hpp"
+
+namespace craneassist::config {
+
+struct ControlSettings {
+  double rate_hz = 100.0;
+  double position_gain_1_s = 0.0;  // P feedback on cylinder position error
+};
+
+struct SimulationSettings {
+  double step_s = 1e-3;
+  dynamics::JointVector q_initial;
+};
+
+struct CraneConfig {
+  dynamics::CraneModel model;
+  ControlSettings control;
+  SimulationSettings simulation;
+  std::string source_name;  // file the config came from, or "<embedded k70m.yaml>"
+  // Number of quantities in the file that do not state where they come from.
+  int unsourced_quantities = 0;
+};
+
+// Both throw ConfigError naming the file, line and field of the first problem found.
+CraneConfig load_crane_config(const std::filesystem::path& path);
+CraneConfig parse_crane_config(std::string_view yaml_text, std::string_view source_name);
+
+// The shipped models, embedded in the binary (config/cranes/k70m.yaml, planar_2r.yaml).
+CraneConfig default_crane_config();
+CraneConfig planar_2r_config();
+
+// Sets the payload body's mass (kg); throws std::invalid_argument outside [0, 100000].
+void set_payload_mass(dynamics::CraneModel& model, double mass_kg);
+
+}  // namespace craneassist::config

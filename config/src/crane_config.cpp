@@ -1,0 +1,435 @@
+#include "craneassist/config/crane_config.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <sstream>
+
+#include "craneassist/config/quantity.hpp"
+#include "craneassist/dynamics/cylinders.hpp"
+#include "embedded_configs.hpp"
+
+namespace craneassist::config {
+namespace {
+
+constexpr const char* kFormat = "craneassist-crane/1";
+
+// Walks the YAML tree, converting and checking values; every failure names file, line, field.
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& field,
+                         const std::string& reason) const {
+    const int line = node.IsDefined() ? node.Mark().line + 1 : 0;
+    throw ConfigError(file_, line, field, reason);
+  }
+
+  // Rejects keys that are not in `allowed` (catches typos such as "bor:").
+  void check_keys(const YAML::Node& map, const std::string& path,
+                  std::initializer_list<const char*> allowed) const {
+    if (!map.IsMap()) fail(map, path, "expected a mapping of fields");
+    for (const auto& kv : map) {
+      const auto key = kv.first.as<std::string>();
+      bool ok = false;
+      std::string list;
+      for (const char* a : allowed) {
+        ok = ok || key == a;
+        list += list.empty() ? a : std::string(", ") + a;
+      }
+      if (!ok) fail(kv.first, join(path, key), "unknown field (expected one of: " + list + ")");
+    }
+  }
+
+  YAML::Node child(const YAML::Node& map, const std::string& key, const std::string& path) const {
+    if (!map.IsMap()) fail(map, path, "expected a mapping of fields");
+    YAML::Node node = map[key];
+    if (!node.IsDefined() || node.IsNull()) fail(map, join(path, key), "missing");
+    return node;
+  }
+
+  std::string text(const YAML::Node& map, const std::string& key, const std::string& path) const {
+    const YAML::Node node = child(map, key, path);
+    if (!node.IsScalar()) fail(node, join(path, key), "expected a single value");
+    return node.Scalar();
+  }
+
+  std::vector<double> values(const YAML::Node& map, const std::string& key,
+                             const std::string& path, Dimension dimension, std::size_t count) {
+    const YAML::Node node = child(map, key, path);
+    const std::string field = join(path, key);
+    if (!node.IsScalar()) fail(node, field, "expected \"VALUE UNIT, SOURCE\"");
+    std::string error;
+    const auto q = parse_quantity(node.Scalar(), dimension, error);
+    if (!q) fail(node, field, error);
+    if (count != 0 && q->si_values.size() != count) {
+      fail(node, field,
+           "expected " + std::to_string(count) + " value(s), got " +
+               std::to_string(q->si_values.size()));
+    }
+    if (q->source == Source::kUnstated) ++unsourced_;
+    return q->si_values;
+  }
+
+  double value(const YAML::Node& map, const std::string& key, const std::string& path,
+               Dimension dimension) {
+    return values(map, key, path, dimension, 1)[0];
+  }
+
+  // A value that must lie in [lo, hi].
+  double value_in(const YAML::Node& map, const std::string& key, const std::string& path,
+                  Dimension dimension, double lo, double hi, const std::string& range_text) {
+    const double v = value(map, key, path, dimension);
+    if (v < lo || v > hi) fail(map[key], join(path, key), "must be " + range_text);
+    return v;
+  }
+
+  bool flag(const YAML::Node& map, const std::string& key, const std::string& path,
+            bool default_value) const {
+    const YAML::Node node = map[key];
+    if (!node.IsDefined()) return default_value;
+    if (node.IsScalar()) {
+      if (node.Scalar() == "true") return true;
+      if (node.Scalar() == "false") return false;
+    }
+    fail(node, join(path, key), "expected true or false");
+  }
+
+  static std::string join(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+  }
+
+  int unsourced() const { return unsourced_; }
+
+ private:
+  std::string file_;
+  int unsourced_ = 0;
+};
+
+Eigen::Matrix3d read_matrix3(Reader& r, const YAML::Node& map, const std::string& key,
+                             const std::string& path) {
+  const YAML::Node node = r.child(map, key, path);
+  const std::string field = Reader::join(path, key);
+  Eigen::Matrix3d m;
+  if (!node.IsSequence() || node.size() != 3) r.fail(node, field, "expected 3 rows of 3 numbers");
+  for (std::size_t i = 0; i < 3; ++i) {
+    const YAML::Node row = node[i];
+    if (!row.IsSequence() || row.size() != 3) r.fail(row, field, "expected 3 rows of 3 numbers");
+    for (std::size_t j = 0; j < 3; ++j) {
+      std::string error;
+      const auto q = parse_quantity(row[j].Scalar(), Dimension::kDimensionless, error);
+      if (!q || q->si_values.size() != 1) r.fail(row[j], field, "not a number");
+      m(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = q->si_values[0];
+    }
+  }
+  if (!(m.transpose() * m).isApprox(Eigen::Matrix3d::Identity(), 1e-9)) {
+    r.fail(node, field, "must be orthonormal (a rotation or an axis permutation)");
+  }
+  return m;
+}
+
+dynamics::Cylinder read_cylinder(Reader& r, const YAML::Node& node, const std::string& path,
+                                 const dynamics::DhJoint& joint) {
+  using dynamics::LinkageType;
+  r.check_keys(node, path,
+               {"name", "linkage", "arm", "length_at_zero", "l1", "l2", "angle_offset",
+                "coefficients", "bore", "rod", "area_a", "area_b", "differential_spool", "stroke",
+                "max_speed", "max_acceleration"});
+  dynamics::Cylinder c;
+  c.name = node["name"].IsDefined() ? node["name"].Scalar() : joint.name;
+  const std::string linkage = r.text(node, "linkage", path);
+  if (linkage == "constant_arm") {
+    c.linkage = LinkageType::kConstantArm;
+    c.arm_m = r.value(node, "arm", path, Dimension::kLength);
+    c.c0_m = r.value(node, "length_at_zero", path, Dimension::kLength);
+    if (c.arm_m == 0.0) r.fail(node["arm"], path + ".arm", "must not be zero");
+  } else if (linkage == "triangle") {
+    c.linkage = LinkageType::kTriangle;
+    c.l1_m = r.value_in(node, "l1", path, Dimension::kLength, 1e-6, 100.0, "positive");
+    c.l2_m = r.value_in(node, "l2", path, Dimension::kLength, 1e-6, 100.0, "positive");
+    c.angle_offset_rad = r.value(node, "angle_offset", path, Dimension::kAngle);
+  } else if (linkage == "polynomial") {
+    c.linkage = LinkageType::kPolynomial;
+    c.poly_coeffs = r.values(node, "coefficients", path, Dimension::kLength, 0);
+    if (c.poly_coeffs.size() < 2) {
+      r.fail(node["coefficients"], path + ".coefficients", "needs at least 2 coefficients");
+    }
+  } else {
+    r.fail(node["linkage"], path + ".linkage",
+           "unknown linkage '" + linkage + "' (expected constant_arm, triangle or polynomial)");
+  }
+
+  const bool by_bore = node["bore"].IsDefined() || node["rod"].IsDefined();
+  const bool by_area = node["area_a"].IsDefined() || node["area_b"].IsDefined();
+  if (by_bore == by_area) {
+    r.fail(node, path, "give either bore and rod, or area_a and area_b (not both)");
+  }
+  if (by_bore) {
+    const double bore = r.value_in(node, "bore", path, Dimension::kLength, 1e-4, 2.0, "positive");
+    const double rod = r.value_in(node, "rod", path, Dimension::kLength, 0.0, bore,
+                                  "between 0 and the bore");
+    c.area_a_m2 = 0.25 * M_PI * bore * bore;
+    c.area_b_m2 = 0.25 * M_PI * (bore * bore - rod * rod);
+  } else {
+    c.area_a_m2 = r.value_in(node, "area_a", path, Dimension::kArea, 1e-8, 10.0, "positive");
+    c.area_b_m2 = r.value_in(node, "area_b", path, Dimension::kArea, 1e-8, 10.0, "positive");
+  }
+  c.differential_spool = r.flag(node, "differential_spool", path, false);
+  if (c.differential_spool && c.area_b_m2 >= c.area_a_m2) {
+    r.fail(node["differential_spool"], path + ".differential_spool",
+           "needs a rod-side area smaller than the piston area");
+  }
+  c.stroke_m = r.value_in(node, "stroke", path, Dimension::kLength, 1e-4, 50.0, "positive");
+  c.v_max_m_s = r.value_in(node, "max_speed", path, Dimension::kVelocity, 1e-6, 10.0,
+                           "positive and at most 10 m/s");
+  c.a_max_m_s2 = r.value_in(node, "max_acceleration", path, Dimension::kAcceleration, 1e-6, 100.0,
+                            "positive and at most 100 m/s^2");
+
+  // The joint range must fit the stroke, and the torque arm must keep its sign over it.
+  constexpr int kSamples = 64;
+  double c_min = 1e300, c_max = -1e300;
+  double arm_sign = 0.0;
+  for (int k = 0; k <= kSamples; ++k) {
+    const double q = joint.q_min + (joint.q_max - joint.q_min) * k / kSamples;
+    const double len = dynamics::cylinder_length(c, q);
+    const double arm = dynamics::cylinder_arm(c, q);
+    if (!std::isfinite(len) || !std::isfinite(arm) || std::abs(arm) < 1e-6 ||
+        (arm_sign != 0.0 && arm * arm_sign < 0.0)) {
+      r.fail(node["linkage"], path + ".linkage",
+             "the torque arm dc/dq vanishes or changes sign inside the joint range");
+    }
+    arm_sign = arm;
+    c_min = std::min(c_min, len);
+    c_max = std::max(c_max, len);
+  }
+  if (c_max - c_min > c.stroke_m * 1.02 + 1e-3) {
+    std::ostringstream why;
+    why << "the joint range needs " << (c_max - c_min) * 1e3 << " mm of stroke, the cylinder has "
+        << c.stroke_m * 1e3 << " mm";
+    r.fail(node["stroke"], path + ".stroke", why.str());
+  }
+  return c;
+}
+
+void read_joints(Reader& r, const YAML::Node& root, dynamics::CraneModel& model) {
+  const YAML::Node joints = r.child(root, "joints", "");
+  if (!joints.IsSequence() || joints.size() == 0 ||
+      joints.size() > static_cast<std::size_t>(dynamics::kMaxJoints)) {
+    r.fail(joints, "joints",
+           "expected a list of 1 to " + std::to_string(dynamics::kMaxJoints) + " joints");
+  }
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    const YAML::Node j = joints[i];
+    const std::string path = "joints[" + std::to_string(i) + "]";
+    r.check_keys(j, path, {"name", "type", "a", "alpha", "d", "theta_offset", "min", "max",
+                           "cylinder"});
+    dynamics::DhJoint joint;
+    joint.name = r.text(j, "name", path);
+    for (const auto& other : model.joints) {
+      if (other.name == joint.name) r.fail(j["name"], path + ".name", "duplicate joint name");
+    }
+    const std::string type = r.text(j, "type", path);
+    if (type == "revolute") {
+      joint.type = dynamics::JointType::kRevolute;
+    } else if (type == "prismatic") {
+      joint.type = dynamics::JointType::kPrismatic;
+    } else {
+      r.fail(j["type"], path + ".type", "expected revolute or prismatic, got '" + type + "'");
+    }
+    const Dimension qdim =
+        joint.type == dynamics::JointType::kRevolute ? Dimension::kAngle : Dimension::kLength;
+    joint.a_m = r.value(j, "a", path, Dimension::kLength);
+    joint.alpha_rad = r.value(j, "alpha", path, Dimension::kAngle);
+    joint.d_m = r.value(j, "d", path, Dimension::kLength);
+    joint.theta_rad = r.value(j, "theta_offset", path, Dimension::kAngle);
+    joint.q_min = r.value(j, "min", path, qdim);
+    joint.q_max = r.value(j, "max", path, qdim);
+    if (!(joint.q_min < joint.q_max)) r.fail(j["max"], path + ".max", "must be greater than min");
+    if (joint.type == dynamics::JointType::kRevolute &&
+        (joint.q_min < -M_PI - 1e-9 || joint.q_max > M_PI + 1e-9)) {
+      r.fail(j["min"], path + ".min", "a revolute range must lie within [-180, 180] deg");
+    }
+    model.cylinders.push_back(read_cylinder(r, r.child(j, "cylinder", path), path + ".cylinder",
+                                            joint));
+    model.joints.push_back(joint);
+  }
+}
+
+void read_bodies(Reader& r, const YAML::Node& root, dynamics::CraneModel& model) {
+  const YAML::Node bodies = r.child(root, "bodies", "");
+  if (!bodies.IsSequence() || bodies.size() == 0) r.fail(bodies, "bodies", "expected a list");
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const YAML::Node b = bodies[i];
+    const std::string path = "bodies[" + std::to_string(i) + "]";
+    r.check_keys(b, path, {"name", "frame", "mass", "com", "inertia"});
+    dynamics::Body body;
+    body.name = r.text(b, "name", path);
+    const YAML::Node frame = r.child(b, "frame", path);
+    try {
+      body.frame = frame.as<int>();
+    } catch (const YAML::Exception&) {
+      r.fail(frame, path + ".frame", "expected a whole number");
+    }
+    if (body.frame < 1 || body.frame > model.dof()) {
+      r.fail(frame, path + ".frame",
+             "must name a joint frame 1.." + std::to_string(model.dof()));
+    }
+    body.mass_kg = r.value_in(b, "mass", path, Dimension::kMass, 0.0, 1e6, "between 0 and 1e6 kg");
+    const auto com = r.values(b, "com", path, Dimension::kLength, 3);
+    body.com_m = Eigen::Vector3d(com[0], com[1], com[2]);
+    const auto inertia = r.values(b, "inertia", path, Dimension::kInertia, 3);
+    body.inertia_diag_kgm2 = Eigen::Vector3d(inertia[0], inertia[1], inertia[2]);
+    if (body.inertia_diag_kgm2.minCoeff() < 0.0) {
+      r.fail(b["inertia"], path + ".inertia", "principal moments must not be negative");
+    }
+    model.bodies.push_back(body);
+  }
+  const YAML::Node payload = r.child(root, "payload", "");
+  r.check_keys(payload, "payload", {"mass"});
+  dynamics::Body p;
+  p.name = "payload";
+  p.frame = model.dof();
+  p.mass_kg = r.value_in(payload, "mass", "payload", Dimension::kMass, 0.0, 1e5,
+                         "between 0 and 100000 kg");
+  model.bodies.push_back(p);
+}
+
+void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& model) {
+  const YAML::Node h = r.child(root, "hydraulics", "");
+  r.check_keys(h, "hydraulics", {"pump", "valves"});
+  const YAML::Node pump = r.child(h, "pump", "hydraulics");
+  const std::string pp = "hydraulics.pump";
+  r.check_keys(pump, pp,
+               {"max_flow", "max_pressure", "ls_margin", "prime_mover_power", "standby_pressure"});
+  auto& p = model.pump;
+  p.max_flow_m3_s = r.value_in(pump, "max_flow", pp, Dimension::kFlow, 1e-7, 1.0, "positive");
+  p.max_pressure_pa =
+      r.value_in(pump, "max_pressure", pp, Dimension::kPressure, 1e5, 1e8, "between 1 and 1000 bar");
+  p.ls_margin_pa = r.value_in(pump, "ls_margin", pp, Dimension::kPressure, 1e4, p.max_pressure_pa,
+                              "positive and below max_pressure");
+  p.prime_mover_power_w =
+      r.value_in(pump, "prime_mover_power", pp, Dimension::kPower, 1.0, 1e7, "positive");
+  p.standby_pressure_pa = r.value_in(pump, "standby_pressure", pp, Dimension::kPressure, 0.0,
+                                     p.max_pressure_pa, "between 0 and max_pressure");
+
+  const YAML::Node valves = r.child(h, "valves", "hydraulics");
+  const std::string vp = "hydraulics.valves";
+  r.check_keys(valves, vp, {"dead_zone", "time_constant", "delay"});
+  auto& v = model.valves;
+  v.dead_zone = r.value_in(valves, "dead_zone", vp, Dimension::kDimensionless, 0.0, 0.95,
+                           "between 0 and 0.95");
+  v.time_constant_s =
+      r.value_in(valves, "time_constant", vp, Dimension::kTime, 0.0, 5.0, "between 0 and 5 s");
+  v.delay_s = r.value_in(valves, "delay", vp, Dimension::kTime, 0.0, 2.0, "between 0 and 2 s");
+}
+
+CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view source_name) {
+  CraneConfig cfg;
+  cfg.source_name = std::string(source_name);
+  if (!root.IsMap()) r.fail(root, "", "expected a mapping at the top level");
+  r.check_keys(root, "",
+               {"format", "name", "frames", "joints", "bodies", "payload", "hydraulics", "control",
+                "simulation"});
+  const std::string format = r.text(root, "format", "");
+  if (format != kFormat) {
+    r.fail(root["format"], "format",
+           "unsupported format '" + format + "' (expected " + kFormat + ")");
+  }
+  auto& model = cfg.model;
+  model.name = r.text(root, "name", "");
+
+  const YAML::Node frames = r.child(root, "frames", "");
+  r.check_keys(frames, "frames", {"crane_from_base", "gravity"});
+  model.task_from_base = read_matrix3(r, frames, "crane_from_base", "frames");
+  const auto g = r.values(frames, "gravity", "frames", Dimension::kAcceleration, 3);
+  model.gravity_m_s2 = Eigen::Vector3d(g[0], g[1], g[2]);
+
+  read_joints(r, root, model);
+  read_bodies(r, root, model);
+  read_hydraulics(r, root, model);
+
+  const YAML::Node control = r.child(root, "control", "");
+  r.check_keys(control, "control", {"rate", "position_gain"});
+  cfg.control.rate_hz =
+      r.value_in(control, "rate", "control", Dimension::kFrequency, 1.0, 10000.0, "1 to 10000 Hz");
+  cfg.control.position_gain_1_s = r.value_in(control, "position_gain", "control",
+                                             Dimension::kInverseTime, 0.0, 1000.0, "0 to 1000 1/s");
+
+  const YAML::Node sim = r.child(root, "simulation", "");
+  r.check_keys(sim, "simulation", {"step", "initial"});
+  cfg.simulation.step_s =
+      r.value_in(sim, "step", "simulation", Dimension::kTime, 1e-5, 1e-2, "between 0.01 and 10 ms");
+  const double period = 1.0 / cfg.control.rate_hz;
+  const double ratio = period / cfg.simulation.step_s;
+  if (std::abs(ratio - std::round(ratio)) > 1e-6 * ratio) {
+    r.fail(sim["step"], "simulation.step",
+           "must divide the control period (" + std::to_string(period * 1e3) + " ms) evenly");
+  }
+  const YAML::Node initial = r.child(sim, "initial", "simulation");
+  if (!initial.IsMap()) r.fail(initial, "simulation.initial", "expected joint: value pairs");
+  cfg.simulation.q_initial.resize(model.dof());
+  for (int i = 0; i < model.dof(); ++i) {
+    const auto& joint = model.joints[i];
+    const Dimension qdim =
+        joint.type == dynamics::JointType::kRevolute ? Dimension::kAngle : Dimension::kLength;
+    const double q = r.value(initial, joint.name, "simulation.initial", qdim);
+    if (q < joint.q_min || q > joint.q_max) {
+      r.fail(initial[joint.name], "simulation.initial." + joint.name,
+             "outside the joint range");
+    }
+    cfg.simulation.q_initial[i] = q;
+  }
+  for (const auto& kv : initial) {
+    bool known = false;
+    for (const auto& joint : model.joints) known = known || joint.name == kv.first.Scalar();
+    if (!known) r.fail(kv.first, "simulation.initial." + kv.first.Scalar(), "no joint of that name");
+  }
+  cfg.unsourced_quantities = r.unsourced();
+  return cfg;
+}
+
+}  // namespace
+
+CraneConfig parse_crane_config(std::string_view yaml_text, std::string_view source_name) {
+  Reader reader{std::string(source_name)};
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(yaml_text));
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(std::string(source_name), e.mark.line + 1, "", "YAML syntax: " + e.msg);
+  }
+  try {
+    return read_config(reader, root, source_name);
+  } catch (const YAML::Exception& e) {  // a conversion yaml-cpp refused; report where
+    throw ConfigError(std::string(source_name), e.mark.line + 1, "", e.msg);
+  }
+}
+
+CraneConfig load_crane_config(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError(path.string(), 0, "", "cannot open the file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_crane_config(text.str(), path.string());
+}
+
+CraneConfig default_crane_config() {
+  return parse_crane_config(embedded::kK70mYaml, "<embedded config/cranes/k70m.yaml>");
+}
+
+CraneConfig planar_2r_config() {
+  return parse_crane_config(embedded::kPlanar2rYaml, "<embedded config/cranes/planar_2r.yaml>");
+}
+
+void set_payload_mass(dynamics::CraneModel& model, double mass_kg) {
+  if (!(mass_kg >= 0.0 && mass_kg <= 1e5)) {
+    throw std::invalid_argument("payload mass must be between 0 and 100000 kg");
+  }
+  for (auto& body : model.bodies) {
+    if (body.name == "payload") body.mass_kg = mass_kg;
+  }
+}
+
+}  // namespace craneassist::config

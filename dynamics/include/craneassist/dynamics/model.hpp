@@ -1,0 +1,104 @@
+// The immutable crane model: kinematics, cylinder geometry, masses and hydraulics.
+//
+// Like Pinocchio's Model, it is built once (from config/) and then only read; every algorithm
+// keeps its per-evaluation buffers in its own Data struct. All values are SI.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <string>
+#include <vector>
+
+namespace craneassist::dynamics {
+
+// Upper bound on the number of joints: vectors are Eigen's bounded-dynamic type, so they live on
+// the stack and a control cycle never allocates.
+inline constexpr int kMaxJoints = 6;
+
+using JointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJoints, 1>;
+using JointMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxJoints, kMaxJoints>;
+using TaskJacobian = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxJoints>;
+
+enum class JointType { kRevolute, kPrismatic };
+
+// Classical Denavit-Hartenberg row. Revolute: theta = q + theta_offset, d fixed.
+// Prismatic: d = d_offset + q, theta fixed.
+struct DhJoint {
+  std::string name;
+  JointType type = JointType::kRevolute;
+  double a_m = 0.0;
+  double alpha_rad = 0.0;
+  double d_m = 0.0;
+  double theta_rad = 0.0;
+  double q_min = 0.0;  // rad or m
+  double q_max = 0.0;
+};
+
+// A rigid body moving with DH frame `frame` (1..n). Centre of mass and inertia (about the centre
+// of mass) are given in that frame's axes.
+struct Body {
+  std::string name;
+  int frame = 0;
+  double mass_kg = 0.0;
+  Eigen::Vector3d com_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d inertia_diag_kgm2 = Eigen::Vector3d::Zero();
+};
+
+// How a joint coordinate maps to its cylinder length c(q) and torque arm dc/dq.
+enum class LinkageType {
+  kConstantArm,  // c = c0 + arm * q (rack and pinion, telescope multiplier, rotary actuator)
+  kTriangle,     // c = sqrt(l1^2 + l2^2 - 2 l1 l2 cos(q + angle_offset)) (lift cylinder)
+  kPolynomial,   // c = sum coeffs[k] q^(N-k), highest power first (tilt four-bar fit)
+};
+
+struct Cylinder {
+  std::string name;
+  LinkageType linkage = LinkageType::kConstantArm;
+  double arm_m = 0.0;              // kConstantArm: dc/dq (m/rad or m/m)
+  double c0_m = 0.0;               // kConstantArm: c at q = 0
+  double l1_m = 0.0, l2_m = 0.0;   // kTriangle
+  double angle_offset_rad = 0.0;   // kTriangle
+  std::vector<double> poly_coeffs;  // kPolynomial, highest power first
+  double area_a_m2 = 0.0;          // piston side
+  double area_b_m2 = 0.0;          // rod side
+  bool differential_spool = false;  // extension: pump supplies A_A - A_B when extending
+  double stroke_m = 0.0;
+  double v_max_m_s = 0.0;
+  double a_max_m_s2 = 0.0;
+};
+
+struct Pump {
+  double max_flow_m3_s = 0.0;
+  double max_pressure_pa = 0.0;  // relief setting
+  double ls_margin_pa = 0.0;
+  double prime_mover_power_w = 0.0;
+  double standby_pressure_pa = 0.0;  // supply pressure with no section open
+};
+
+struct ValveSections {
+  double dead_zone = 0.0;     // fraction of the spool (current) range with no flow
+  double time_constant_s = 0.0;
+  double delay_s = 0.0;
+};
+
+struct CraneModel {
+  std::string name;
+  std::vector<DhJoint> joints;      // n joints
+  std::vector<Body> bodies;         // rigid bodies; the payload is one of them (at the tip)
+  std::vector<Cylinder> cylinders;  // one per joint
+  Eigen::Vector3d gravity_m_s2 = Eigen::Vector3d(0, 0, -9.81);  // in the DH base frame
+  // Rows map base-frame coordinates to the crane (task) frame: x_crane = task_from_base * x_base.
+  Eigen::Matrix3d task_from_base = Eigen::Matrix3d::Identity();
+  Pump pump;
+  ValveSections valves;
+
+  int dof() const { return static_cast<int>(joints.size()); }
+};
+
+// Effective area the pump must fill for cylinder velocity v (algorithms.md section 2).
+inline double flow_area_m2(const Cylinder& c, double v_m_s) {
+  if (v_m_s >= 0.0) return c.differential_spool ? c.area_a_m2 - c.area_b_m2 : c.area_a_m2;
+  return c.area_b_m2;
+}
+
+}  // namespace craneassist::dynamics

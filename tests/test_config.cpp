@@ -1,0 +1,165 @@
+// Config loading: the shipped models, and every kind of error naming file, line and field.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+
+#include "craneassist/config/crane_config.hpp"
+#include "craneassist/config/quantity.hpp"
+
+using craneassist::config::ConfigError;
+using craneassist::config::Dimension;
+
+namespace {
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+const std::string kK70mPath = std::string(CRANEASSIST_SOURCE_DIR) + "/config/cranes/k70m.yaml";
+
+// Replaces the first occurrence of `from` in the K70M file and parses the result; returns the
+// error it throws.
+ConfigError error_after_edit(const std::string& from, const std::string& to) {
+  std::string text = read_file(kK70mPath);
+  const auto pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  text.replace(pos, from.size(), to);
+  try {
+    craneassist::config::parse_crane_config(text, "edited.yaml");
+  } catch (const ConfigError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no error after replacing '" << from << "' with '" << to << "'";
+  return ConfigError("", 0, "", "");
+}
+
+int line_of(const std::string& needle) {
+  const std::string text = read_file(kK70mPath);
+  const auto pos = text.find(needle);
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(pos), '\n'));
+}
+
+}  // namespace
+
+TEST(Quantity, ParsesValuesUnitsAndSource) {
+  std::string err;
+  auto q = craneassist::config::parse_quantity("325 L/min, paper", Dimension::kFlow, err);
+  ASSERT_TRUE(q) << err;
+  EXPECT_NEAR(q->si_values[0], 325e-3 / 60.0, 1e-15);
+  EXPECT_EQ(q->source, craneassist::config::Source::kPaper);
+  q = craneassist::config::parse_quantity("0 0 -9.81 m/s^2, standard", Dimension::kAcceleration,
+                                          err);
+  ASSERT_TRUE(q) << err;
+  EXPECT_EQ(q->si_values.size(), 3u);
+  q = craneassist::config::parse_quantity("90 deg", Dimension::kAngle, err);
+  ASSERT_TRUE(q);
+  EXPECT_NEAR(q->si_values[0], M_PI_2, 1e-15);
+  EXPECT_EQ(q->source, craneassist::config::Source::kUnstated);
+  EXPECT_FALSE(craneassist::config::parse_quantity("12 MPa", Dimension::kFlow, err));
+  EXPECT_NE(err.find("not a volume flow unit"), std::string::npos) << err;
+  EXPECT_FALSE(craneassist::config::parse_quantity("nan m", Dimension::kLength, err));
+  EXPECT_FALSE(craneassist::config::parse_quantity("1.0x m", Dimension::kLength, err));
+  EXPECT_FALSE(craneassist::config::parse_quantity("1 m, guessed", Dimension::kLength, err));
+  EXPECT_FALSE(craneassist::config::parse_quantity("1", Dimension::kLength, err));
+  EXPECT_FALSE(craneassist::config::parse_quantity("1 m m", Dimension::kLength, err));
+}
+
+TEST(CraneConfig, ReferenceCraneMatchesTheSpec) {
+  const auto cfg = craneassist::config::load_crane_config(kK70mPath);
+  const auto& m = cfg.model;
+  ASSERT_EQ(m.dof(), 4);
+  EXPECT_EQ(cfg.unsourced_quantities, 0) << "every shipped value must say where it comes from";
+  EXPECT_NEAR(m.cylinders[1].area_a_m2, 11.31e-3, 0.01e-3);
+  EXPECT_NEAR(m.cylinders[1].area_b_m2, 7.46e-3, 0.01e-3);
+  EXPECT_NEAR(m.cylinders[2].area_a_m2, 10.39e-3, 0.01e-3);
+  EXPECT_NEAR(m.cylinders[2].area_b_m2, 7.56e-3, 0.01e-3);
+  EXPECT_NEAR(m.cylinders[3].area_a_m2, 3.848e-3, 0.001e-3);
+  EXPECT_NEAR(m.cylinders[3].area_b_m2, 2.258e-3, 0.001e-3);
+  EXPECT_TRUE(m.cylinders[3].differential_spool);
+  EXPECT_NEAR(m.pump.max_flow_m3_s, 325e-3 / 60, 1e-12);
+  EXPECT_NEAR(m.pump.prime_mover_power_w, 35e3, 1e-9);
+  EXPECT_NEAR(m.valves.dead_zone, 0.53, 1e-12);
+  EXPECT_NEAR(m.joints[1].q_max, 1.097, 1e-12);
+  EXPECT_NEAR(m.joints[2].theta_rad, M_PI_2, 1e-12);
+  EXPECT_EQ(m.bodies.back().name, "payload");
+  EXPECT_EQ(m.bodies.back().frame, 4);
+  EXPECT_NEAR(cfg.control.rate_hz, 100.0, 1e-12);
+  EXPECT_NEAR(cfg.simulation.step_s, 1e-3, 1e-15);
+}
+
+TEST(CraneConfig, EmbeddedModelsEqualTheFiles) {
+  const auto embedded = craneassist::config::default_crane_config();
+  const auto file = craneassist::config::load_crane_config(kK70mPath);
+  EXPECT_EQ(embedded.model.name, file.model.name);
+  EXPECT_EQ(embedded.model.bodies.size(), file.model.bodies.size());
+  const auto planar = craneassist::config::planar_2r_config();
+  EXPECT_EQ(planar.model.dof(), 2);
+  EXPECT_EQ(planar.unsourced_quantities, 0);
+}
+
+TEST(CraneConfig, BadUnitNamesLineAndField) {
+  const auto e = error_after_edit("bore: 120 mm, paper", "bore: 120 mmm, paper");
+  EXPECT_EQ(e.file(), "edited.yaml");
+  EXPECT_EQ(e.line(), line_of("bore: 120 mm, paper"));
+  EXPECT_EQ(e.field(), "joints[1].cylinder.bore");
+  EXPECT_NE(std::string(e.what()).find("edited.yaml:"), std::string::npos);
+}
+
+TEST(CraneConfig, MissingFieldNamesTheField) {
+  const auto e = error_after_edit("    max_flow: 325 L/min, paper        # at 2500 rpm\n", "");
+  EXPECT_EQ(e.field(), "hydraulics.pump.max_flow");
+  EXPECT_GT(e.line(), 0);
+}
+
+TEST(CraneConfig, UnknownFieldIsATypo) {
+  const auto e = error_after_edit("stroke: 610 mm, paper", "strok: 610 mm, paper");
+  EXPECT_EQ(e.field(), "joints[1].cylinder.strok");
+  EXPECT_EQ(e.line(), line_of("stroke: 610 mm, paper"));
+}
+
+TEST(CraneConfig, WrongDimensionIsRejected) {
+  const auto e = error_after_edit("max_flow: 325 L/min", "max_flow: 325 MPa");
+  EXPECT_EQ(e.field(), "hydraulics.pump.max_flow");
+  EXPECT_NE(e.reason().find("L/min"), std::string::npos) << e.reason();
+}
+
+TEST(CraneConfig, OutOfRangeValuesAreRejected) {
+  EXPECT_EQ(error_after_edit("dead_zone: 0.53", "dead_zone: 1.5").field(),
+            "hydraulics.valves.dead_zone");
+  EXPECT_EQ(error_after_edit("mass: 0 kg, assumed\n\nhydraulics", "mass: -5 kg, assumed\n\nhydraulics")
+                .field(),
+            "payload.mass");
+  EXPECT_EQ(error_after_edit("lift: 20 deg", "lift: 80 deg").field(), "simulation.initial.lift");
+  EXPECT_EQ(error_after_edit("step: 1 ms", "step: 3 ms").field(), "simulation.step");
+}
+
+TEST(CraneConfig, JointRangeMustFitTheStroke) {
+  const auto e = error_after_edit("stroke: 725 mm, paper", "stroke: 500 mm, paper");
+  EXPECT_EQ(e.field(), "joints[2].cylinder.stroke");
+  EXPECT_NE(e.reason().find("mm of stroke"), std::string::npos) << e.reason();
+}
+
+TEST(CraneConfig, YamlSyntaxErrorHasALine) {
+  const auto e = error_after_edit("joints:\n", "joints: [\n");
+  EXPECT_GT(e.line(), 0);
+  EXPECT_NE(e.reason().find("YAML syntax"), std::string::npos);
+}
+
+TEST(CraneConfig, MissingFileIsReported) {
+  try {
+    craneassist::config::load_crane_config("/nonexistent/crane.yaml");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.file(), "/nonexistent/crane.yaml");
+    EXPECT_EQ(e.line(), 0);
+  }
+}
+
+TEST(CraneConfig, PayloadMassCanBeSet) {
+  auto cfg = craneassist::config::default_crane_config();
+  craneassist::config::set_payload_mass(cfg.model, 650.0);
+  EXPECT_DOUBLE_EQ(cfg.model.bodies.back().mass_kg, 650.0);
+  EXPECT_THROW(craneassist::config::set_payload_mass(cfg.model, -1.0), std::invalid_argument);
+}
