@@ -13,6 +13,8 @@ namespace craneassist::config {
 struct ControlSettings {
   double rate_hz = 100.0;
   double position_gain_1_s = 0.0;  // P feedback on cylinder position error
+  // Fraction of the pump's maximum flow the prescaling leaves for the feedback corrections.
+  double flow_reserve = 0.0;
 };
 
 struct SimulationSettings {

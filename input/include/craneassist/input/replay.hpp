@@ -1,0 +1,96 @@
+// Replay files: recorded tip-velocity commands (CSV), their strict reader, a real-time cursor for
+// per-cycle lookup and a writer. The format is specified in docs/replay-format.md.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <filesystem>
+#include <iosfwd>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace craneassist::input {
+
+// One command: from time t_s on, the tip velocity command is v_m_s (crane frame: x forward, y up,
+// z lateral), held until the next row's time (zero-order hold).
+struct ReplayRow {
+  double t_s;
+  Eigen::Vector3d v_m_s;
+};
+
+// A replay that was rejected. what() is "FILE:LINE: field 'NAME': REASON", or "FILE:LINE: REASON"
+// when the problem is not tied to one field. LINE is 1-based; 0 means the file could not be read.
+class ReplayError : public std::runtime_error {
+ public:
+  ReplayError(std::string file, std::size_t line, std::string field, std::string reason);
+
+  const std::string& file() const noexcept { return file_; }
+  std::size_t line() const noexcept { return line_; }
+  // Column name ("t", "v_x", "v_y", "v_z"), or empty when the error concerns no single field.
+  const std::string& field() const noexcept { return field_; }
+  const std::string& reason() const noexcept { return reason_; }
+
+ private:
+  std::string file_;
+  std::size_t line_;
+  std::string field_;
+  std::string reason_;
+};
+
+// Sanity limits enforced while reading.
+struct ReplayLimits {
+  double max_speed_m_s = 5.0;         // maximum magnitude of each velocity component
+  std::size_t max_rows = 10'000'000;  // maximum number of data rows
+};
+
+// A validated replay: at least one row, times finite, >= 0 and strictly increasing, velocity
+// components finite and within the limits.
+class Replay {
+ public:
+  // Reads and validates a file; the source name in errors is path.string(). Throws ReplayError,
+  // and std::invalid_argument if limits.max_speed_m_s is negative or NaN.
+  static Replay load_file(const std::filesystem::path& path, const ReplayLimits& limits = {});
+  // Validates text in the replay format; source_name is used in error messages. Throws as
+  // load_file.
+  static Replay parse(std::string_view text, std::string_view source_name,
+                      const ReplayLimits& limits = {});
+
+  const std::vector<ReplayRow>& rows() const noexcept { return rows_; }
+  // Time of the last row.
+  double end_time_s() const noexcept { return rows_.back().t_s; }
+  std::string_view source_name() const noexcept { return source_name_; }
+
+ private:
+  Replay(std::vector<ReplayRow> rows, std::string source_name)
+      : rows_(std::move(rows)), source_name_(std::move(source_name)) {}
+
+  std::vector<ReplayRow> rows_;
+  std::string source_name_;
+};
+
+// Zero-order-hold lookup for the real-time loop: no exceptions, no allocation. O(1) amortised for
+// non-decreasing query times; any other query (going back, jumping ahead) costs O(log n).
+// Keeps a reference to the replay's rows: the Replay must outlive the cursor and stay unmodified.
+class ReplayCursor {
+ public:
+  explicit ReplayCursor(const Replay& replay) noexcept : rows_(&replay.rows()) {}
+
+  // Velocity of the last row with t_s <= query (a row applies from exactly its own time on); zero
+  // before the first row's time and for a NaN query; the last row's value after the last row.
+  Eigen::Vector3d command_at(double t_s) noexcept;
+
+ private:
+  const std::vector<ReplayRow>* rows_;
+  // Number of rows with time <= the last query time, i.e. the active row is next_ - 1.
+  std::size_t next_ = 0;
+};
+
+// Writes the header and rows in the replay format ('\n' line endings, shortest round-trip number
+// form): parse() reads them back bit-exactly. Does not validate; rows that break the rules (e.g.
+// non-increasing times) produce a file that parse() rejects.
+void write_replay(std::ostream& out, const std::vector<ReplayRow>& rows);
+
+}  // namespace craneassist::input

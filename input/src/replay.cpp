@@ -1,0 +1,278 @@
+#include "craneassist/input/replay.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <ostream>
+#include <system_error>
+
+namespace craneassist::input {
+namespace {
+
+constexpr std::array<std::string_view, 4> kColumns = {"t", "v_x", "v_y", "v_z"};
+constexpr std::string_view kHeader = "t,v_x,v_y,v_z";
+constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
+// Shortest round-trip form of a double has at most 24 characters ("-2.2250738585072014e-308").
+constexpr std::size_t kMaxNumberChars = 32;
+
+std::string_view trim(std::string_view s) {
+  const auto is_space = [](char c) { return c == ' ' || c == '\t'; };
+  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+// Text from the file, quoted for an error message: control and non-ASCII bytes escaped, long text
+// shortened, so that a binary file or a stray '\r' cannot garble the message.
+std::string quoted(std::string_view s) {
+  constexpr std::size_t kMaxShown = 40;
+  std::string out = "'";
+  for (std::size_t i = 0; i < s.size() && i < kMaxShown; ++i) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      constexpr std::string_view kHex = "0123456789abcdef";
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 0xf];
+    }
+  }
+  if (s.size() > kMaxShown) out += "...";
+  out += '\'';
+  return out;
+}
+
+// Shortest round-trip decimal form, locale-independent.
+std::string_view format_number(double value, std::array<char, kMaxNumberChars>& buffer) {
+  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
+  return {buffer.data(), static_cast<std::size_t>(result.ptr - buffer.data())};
+}
+
+std::string number(double value) {
+  std::array<char, kMaxNumberChars> buffer{};
+  return std::string(format_number(value, buffer));
+}
+
+// Splits a line at commas into at most fields.size() trimmed fields; returns the total count.
+std::size_t split_fields(std::string_view line, std::array<std::string_view, 4>& fields) {
+  std::size_t count = 0;
+  while (true) {
+    const std::size_t comma = line.find(',');
+    const std::string_view field = line.substr(0, comma);
+    if (count < fields.size()) fields[count] = trim(field);
+    ++count;
+    if (comma == std::string_view::npos) return count;
+    line.remove_prefix(comma + 1);
+  }
+}
+
+class Parser {
+ public:
+  Parser(std::string_view source_name, const ReplayLimits& limits)
+      : source_(source_name), limits_(limits) {}
+
+  std::vector<ReplayRow> parse(std::string_view text);
+
+ private:
+  ReplayError error(std::size_t line, std::string_view field, std::string reason) const {
+    return ReplayError(source_, line, std::string(field), std::move(reason));
+  }
+  double parse_field(std::string_view text, std::size_t line, std::string_view field) const;
+  void check_header(std::string_view content, std::size_t line) const;
+  ReplayRow parse_row(std::string_view content, std::size_t line);
+
+  std::string source_;
+  ReplayLimits limits_;
+  std::vector<ReplayRow> rows_;
+  std::size_t previous_row_line_ = 0;
+};
+
+double Parser::parse_field(std::string_view text, std::size_t line, std::string_view field) const {
+  if (text.empty()) throw error(line, field, "missing value");
+  double value = 0.0;
+  const char* const last = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), last, value);
+  if (ec == std::errc::invalid_argument || ptr != last) {
+    throw error(line, field, "not a number: " + quoted(text));
+  }
+  if (ec == std::errc::result_out_of_range) {
+    throw error(line, field, "number out of range: " + quoted(text));
+  }
+  if (!std::isfinite(value)) throw error(line, field, "not a finite number: " + quoted(text));
+  return value;
+}
+
+void Parser::check_header(std::string_view content, std::size_t line) const {
+  std::array<std::string_view, 4> fields;
+  bool ok = split_fields(content, fields) == kColumns.size();
+  for (std::size_t i = 0; ok && i < kColumns.size(); ++i) ok = fields[i] == kColumns[i];
+  if (!ok) {
+    throw error(line, "",
+                "expected the header '" + std::string(kHeader) + "', got " + quoted(content));
+  }
+}
+
+ReplayRow Parser::parse_row(std::string_view content, std::size_t line) {
+  std::array<std::string_view, 4> fields;
+  const std::size_t count = split_fields(content, fields);
+  if (count != kColumns.size()) {
+    throw error(line, "",
+                "expected 4 fields (" + std::string(kHeader) + "), got " + std::to_string(count));
+  }
+  if (rows_.size() >= limits_.max_rows) {
+    throw error(line, "",
+                "too many data rows (limit " + std::to_string(limits_.max_rows) + " rows)");
+  }
+
+  ReplayRow row{};
+  row.t_s = parse_field(fields[0], line, kColumns[0]);
+  if (row.t_s < 0.0) throw error(line, kColumns[0], "negative time: " + quoted(fields[0]));
+  if (!rows_.empty() && !(row.t_s > rows_.back().t_s)) {
+    throw error(line, kColumns[0],
+                "time not strictly increasing: " + number(row.t_s) + " s follows " +
+                    number(rows_.back().t_s) + " s (line " + std::to_string(previous_row_line_) +
+                    ")");
+  }
+  for (Eigen::Index i = 0; i < 3; ++i) {
+    const auto column = static_cast<std::size_t>(i + 1);
+    const double v = parse_field(fields[column], line, kColumns[column]);
+    if (std::abs(v) > limits_.max_speed_m_s) {
+      throw error(line, kColumns[column],
+                  "magnitude of " + number(v) + " m/s exceeds the limit of " +
+                      number(limits_.max_speed_m_s) + " m/s");
+    }
+    row.v_m_s[i] = v;
+  }
+  return row;
+}
+
+std::vector<ReplayRow> Parser::parse(std::string_view text) {
+  if (text.starts_with(kUtf8Bom)) text.remove_prefix(kUtf8Bom.size());
+  bool have_header = false;
+  std::size_t line = 0;
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    std::size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view raw = text.substr(pos, end - pos);
+    pos = end + 1;
+    ++line;
+    if (!raw.empty() && raw.back() == '\r') raw.remove_suffix(1);
+    const std::string_view content = trim(raw);
+    if (content.empty() || content.front() == '#') continue;
+    if (!have_header) {
+      check_header(content, line);
+      have_header = true;
+    } else {
+      rows_.push_back(parse_row(content, line));
+      previous_row_line_ = line;
+    }
+  }
+  // Whole-file problems are reported at the last line (line 1 for an empty file).
+  const std::size_t last_line = std::max<std::size_t>(line, 1);
+  if (!have_header) {
+    throw error(last_line, "",
+                "missing header '" + std::string(kHeader) +
+                    "' (no line other than comments and blank lines)");
+  }
+  if (rows_.empty()) throw error(last_line, "", "no data rows after the header");
+  return std::move(rows_);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+ReplayError::ReplayError(std::string file, std::size_t line, std::string field, std::string reason)
+    : std::runtime_error(file + ":" + std::to_string(line) + ": " +
+                         (field.empty() ? std::string() : "field '" + field + "': ") + reason),
+      file_(std::move(file)),
+      line_(line),
+      field_(std::move(field)),
+      reason_(std::move(reason)) {}
+
+Replay Replay::parse(std::string_view text, std::string_view source_name,
+                     const ReplayLimits& limits) {
+  if (!(limits.max_speed_m_s >= 0.0)) {
+    throw std::invalid_argument("ReplayLimits::max_speed_m_s must be >= 0, got " +
+                                number(limits.max_speed_m_s));
+  }
+  Parser parser(source_name, limits);
+  return Replay(parser.parse(text), std::string(source_name));
+}
+
+Replay Replay::load_file(const std::filesystem::path& path, const ReplayLimits& limits) {
+  const std::string name = path.string();
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw ReplayError(name, 0, "", "cannot read file: is a directory");
+  }
+  errno = 0;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const int open_errno = errno;
+    if (!std::filesystem::exists(path, ec) && !ec) {
+      throw ReplayError(name, 0, "", "file not found");
+    }
+    throw ReplayError(
+        name, 0, "",
+        "cannot open file" +
+            (open_errno != 0 ? ": " + std::generic_category().message(open_errno) : std::string()));
+  }
+  std::string text;
+  std::array<char, 1 << 16> buffer{};
+  while (in.read(buffer.data(), static_cast<std::streamsize>(buffer.size())) || in.gcount() > 0) {
+    text.append(buffer.data(), static_cast<std::size_t>(in.gcount()));
+  }
+  if (in.bad()) throw ReplayError(name, 0, "", "read error");
+  return parse(text, name, limits);
+}
+
+Eigen::Vector3d ReplayCursor::command_at(double t_s) noexcept {
+  const std::vector<ReplayRow>& rows = *rows_;
+  const auto row_after = [](double t, const ReplayRow& row) { return t < row.t_s; };
+  if (std::isnan(t_s)) return Eigen::Vector3d::Zero();
+  if (next_ > 0 && rows[next_ - 1].t_s > t_s) {
+    // Going back in time: binary search among the rows already passed.
+    next_ = static_cast<std::size_t>(
+        std::upper_bound(rows.begin(), rows.begin() + static_cast<std::ptrdiff_t>(next_), t_s,
+                         row_after) -
+        rows.begin());
+  } else {
+    // Going forward: a few linear steps cover the per-cycle case, a binary search any jump.
+    constexpr int kLinearSteps = 4;
+    for (int step = 0; next_ < rows.size() && rows[next_].t_s <= t_s; ++step) {
+      if (step == kLinearSteps) {
+        next_ = static_cast<std::size_t>(
+            std::upper_bound(rows.begin() + static_cast<std::ptrdiff_t>(next_), rows.end(), t_s,
+                             row_after) -
+            rows.begin());
+        break;
+      }
+      ++next_;
+    }
+  }
+  return next_ == 0 ? Eigen::Vector3d::Zero() : rows[next_ - 1].v_m_s;
+}
+
+void write_replay(std::ostream& out, const std::vector<ReplayRow>& rows) {
+  out << kHeader << '\n';
+  std::array<char, kMaxNumberChars> buffer{};
+  std::string line;
+  for (const ReplayRow& row : rows) {
+    line.clear();
+    line += format_number(row.t_s, buffer);
+    for (Eigen::Index i = 0; i < 3; ++i) {
+      line += ',';
+      line += format_number(row.v_m_s[i], buffer);
+    }
+    line += '\n';
+    out << line;
+  }
+}
+
+}  // namespace craneassist::input

@@ -1,0 +1,19 @@
+// Which limit holds the motion back this cycle (MoveIt Servo's status idea): logged every cycle
+// and shown to the operator.
+#pragma once
+
+namespace craneassist::scaling {
+
+enum class ActiveLimit {
+  kNone,
+  kFlow,            // pump maximum flow
+  kCylinderSpeed,   // a cylinder's maximum speed (valve saturation)
+  kPower,           // prime-mover power (load-sensing pump power limit)
+  kTrackingError,   // the measured tip lags the reference
+  kJointLimit,      // a joint or cylinder end is near
+  kStaleInput,      // no valid operator input
+};
+
+const char* to_string(ActiveLimit limit);
+
+}  // namespace craneassist::scaling

@@ -1,0 +1,51 @@
+// The ODE-simulated crane behind the machine interface: rigid-body crane (dynamics::OdeCrane)
+// driven by pressure-compensated valve sections and a load-sensing pump without flow sharing.
+//
+// Each simulation step (config simulation.step, 1 ms by default):
+//   1. every valve section turns its (delayed, lagged) spool into a requested cylinder velocity;
+//   2. the LS pump shares what it can deliver by load pressure (ls_pump.hpp);
+//   3. each joint is driven as an ODE velocity motor at the delivered cylinder velocity, its force
+//      capped at the relief pressure on the pressurised area (a stalled cylinder stays put);
+//   4. the joint stops are the cylinder end stops;
+//   5. the motor reaction gives the cylinder force and, through a 5 ms first-order filter standing
+//      in for oil compressibility, the load pressures for the next step.
+// Pump flow, pressure, power and integrated energy are measured on the way.
+#pragma once
+
+#include <memory>
+
+#include "craneassist/dynamics/model.hpp"
+#include "craneassist/valves/machine_interface.hpp"
+
+namespace craneassist::sim_backend {
+
+using dynamics::JointVector;
+
+struct SimSettings {
+  double step_s = 1e-3;
+  JointVector q_initial;
+};
+
+class SimBackend final : public valves::MachineInterface {
+ public:
+  // Throws std::invalid_argument on a bad step or initial configuration.
+  SimBackend(const dynamics::CraneModel& model, const SimSettings& settings);
+  ~SimBackend() override;
+  SimBackend(const SimBackend&) = delete;
+  SimBackend& operator=(const SimBackend&) = delete;
+
+  valves::BackendStatus read(valves::MachineState& state) override;
+  valves::BackendStatus write(const valves::ValveCommand& command) override;
+  void advance(double dt_s) override;
+  const char* name() const override { return "sim"; }
+
+  double time_s() const;
+  // Cylinder forces of the last step (N, positive pushing the cylinder out).
+  const JointVector& cylinder_force_n() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace craneassist::sim_backend

@@ -1,0 +1,72 @@
+#include "craneassist/sim_backend/ls_pump.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace craneassist::sim_backend {
+
+double LsPump::deliverable_flow(double p) const {
+  if (p <= 0.0) return pump_.max_flow_m3_s;
+  return std::min(pump_.max_flow_m3_s, pump_.prime_mover_power_w / p);
+}
+
+double LsPump::section_flows(const JointVector& demand, const JointVector& load, double p,
+                             JointVector* fraction) const {
+  double total = 0.0;
+  for (int k = 0; k < demand.size(); ++k) {
+    const double f =
+        demand[k] > 0.0 ? std::sqrt(std::clamp((p - load[k]) / pump_.ls_margin_pa, 0.0, 1.0)) : 0.0;
+    if (fraction != nullptr) (*fraction)[k] = f;
+    total += f * demand[k];
+  }
+  return total;
+}
+
+void LsPump::solve(const JointVector& demand, const JointVector& load, LsPumpResult& out) const {
+  const int n = static_cast<int>(demand.size());
+  out.delivered_fraction.setZero(n);
+  double max_load = 0.0;
+  bool any = false;
+  for (int k = 0; k < n; ++k) {
+    if (demand[k] > 0.0) {
+      max_load = any ? std::max(max_load, load[k]) : load[k];
+      any = true;
+    }
+  }
+  out.limit = valves::PumpLimit::kNone;
+  if (!any) {
+    out.supply_pressure_pa = pump_.standby_pressure_pa;
+    out.flow_m3_s = 0.0;
+    out.power_w = 0.0;
+    return;
+  }
+  // Unsaturated LS operation: supply = highest load + margin, every section fully served.
+  const double p_ls = std::max(std::max(max_load, 0.0) + pump_.ls_margin_pa,
+                               pump_.standby_pressure_pa);
+  const double p_top = std::min(p_ls, pump_.max_pressure_pa);
+  double p = p_top;
+  if (section_flows(demand, load, p_top, nullptr) > deliverable_flow(p_top)) {
+    // Saturated: the balance sum Q_k(p) = Q_pump(p) has one root (left side rises with p, right
+    // side falls). Bisection, fixed iteration count.
+    double lo = 0.0, hi = p_top;
+    for (int it = 0; it < 60; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      if (section_flows(demand, load, mid, nullptr) > deliverable_flow(mid)) {
+        hi = mid;
+      } else {
+        lo = mid;
+      }
+    }
+    p = lo;
+    out.limit = pump_.prime_mover_power_w / std::max(p, 1.0) < pump_.max_flow_m3_s
+                    ? valves::PumpLimit::kPower
+                    : valves::PumpLimit::kMaxFlow;
+  } else if (p_ls > pump_.max_pressure_pa) {
+    out.limit = valves::PumpLimit::kRelief;
+  }
+  out.flow_m3_s = section_flows(demand, load, p, &out.delivered_fraction);
+  out.supply_pressure_pa = std::max(p, 0.0);
+  out.power_w = out.supply_pressure_pa * out.flow_m3_s;
+}
+
+}  // namespace craneassist::sim_backend

@@ -1,0 +1,445 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <new>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "craneassist/input/replay.hpp"
+
+// Counts heap allocations, to check that the real-time cursor does not allocate.
+namespace {
+std::atomic<std::size_t> g_allocations{0};
+}  // namespace
+
+// noinline: otherwise GCC's -Wmismatched-new-delete sees free() of operator new's result.
+[[gnu::noinline]] void* operator new(std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+[[gnu::noinline]] void operator delete(void* p) noexcept {
+  std::free(p);
+}
+[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
+
+namespace craneassist::input {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kSource = "bad_replay.csv";
+
+// Parses text that must be rejected; returns the error for further checks.
+ReplayError parse_error(std::string_view text, const ReplayLimits& limits = {}) {
+  try {
+    Replay::parse(text, kSource, limits);
+  } catch (const ReplayError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "accepted:\n" << text;
+  return ReplayError("", 0, "", "");
+}
+
+// Checks line, field, that the reason contains reason_part, and the what() layout.
+void expect_rejected(std::string_view text, std::size_t line, std::string_view field,
+                     std::string_view reason_part, const ReplayLimits& limits = {}) {
+  SCOPED_TRACE(std::string("text:\n") + std::string(text));
+  const ReplayError e = parse_error(text, limits);
+  EXPECT_EQ(e.file(), kSource);
+  EXPECT_EQ(e.line(), line);
+  EXPECT_EQ(e.field(), field);
+  EXPECT_NE(e.reason().find(reason_part), std::string::npos) << e.reason();
+  const std::string prefix = std::string(kSource) + ":" + std::to_string(line) + ": ";
+  const std::string field_part = field.empty() ? "" : "field '" + std::string(field) + "': ";
+  EXPECT_EQ(std::string(e.what()), prefix + field_part + e.reason());
+}
+
+void expect_vec(const Eigen::Vector3d& actual, double x, double y, double z) {
+  EXPECT_EQ(actual.x(), x);
+  EXPECT_EQ(actual.y(), y);
+  EXPECT_EQ(actual.z(), z);
+}
+
+// A temporary file removed at scope exit.
+class TempFile {
+ public:
+  explicit TempFile(std::string_view contents) {
+    path_ = fs::temp_directory_path() /
+            ("craneassist_test_replay_" + std::to_string(std::random_device{}()) + ".csv");
+    std::ofstream out(path_, std::ios::binary);
+    out << contents;
+  }
+  ~TempFile() {
+    std::error_code ec;
+    fs::remove(path_, ec);
+  }
+  TempFile(const TempFile&) = delete;
+  TempFile& operator=(const TempFile&) = delete;
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+// ---- accepted input --------------------------------------------------------------------------
+
+TEST(ReplayParse, MinimalFile) {
+  const Replay r = Replay::parse("t,v_x,v_y,v_z\n0,0.1,-0.2,0.3\n", "min.csv");
+  ASSERT_EQ(r.rows().size(), 1u);
+  EXPECT_EQ(r.rows()[0].t_s, 0.0);
+  expect_vec(r.rows()[0].v_m_s, 0.1, -0.2, 0.3);
+  EXPECT_EQ(r.end_time_s(), 0.0);
+  EXPECT_EQ(r.source_name(), "min.csv");
+}
+
+TEST(ReplayParse, CommentsBlankLinesAndWhitespace) {
+  const Replay r = Replay::parse(
+      "# recorded 2024-05-01\n"
+      "\n"
+      "   \t\n"
+      "  # indented comment\n"
+      " t , v_x,\tv_y ,v_z \n"
+      "# between rows\n"
+      "0, 0.5, 0, 0\n"
+      "\n"
+      "  1.5 ,0,  0.25,-1e-1\t\n"
+      "2,0,0,0",  // no final newline
+      "c.csv");
+  ASSERT_EQ(r.rows().size(), 3u);
+  EXPECT_EQ(r.rows()[1].t_s, 1.5);
+  expect_vec(r.rows()[1].v_m_s, 0.0, 0.25, -0.1);
+  EXPECT_EQ(r.end_time_s(), 2.0);
+}
+
+TEST(ReplayParse, WindowsLineEndingsAndByteOrderMark) {
+  const Replay r = Replay::parse(
+      "\xEF\xBB\xBF# exported\r\nt,v_x,v_y,v_z\r\n\r\n0,1,0,0\r\n3,0,0,0\r\n", "w.csv");
+  ASSERT_EQ(r.rows().size(), 2u);
+  expect_vec(r.rows()[0].v_m_s, 1.0, 0.0, 0.0);
+  EXPECT_EQ(r.end_time_s(), 3.0);
+}
+
+TEST(ReplayParse, FirstRowMayStartLaterThanZeroAndSpeedAtLimitIsAccepted) {
+  const Replay r = Replay::parse("t,v_x,v_y,v_z\n2.5,5,-5,0\n", "x");
+  EXPECT_EQ(r.rows()[0].t_s, 2.5);
+  expect_vec(r.rows()[0].v_m_s, 5.0, -5.0, 0.0);
+  // Negative zero is not a negative time.
+  EXPECT_NO_THROW(Replay::parse("t,v_x,v_y,v_z\n-0,0,0,0\n", "x"));
+}
+
+TEST(ReplayParse, RowLimitReachedExactlyIsAccepted) {
+  ReplayLimits limits;
+  limits.max_rows = 2;
+  EXPECT_EQ(Replay::parse("t,v_x,v_y,v_z\n0,0,0,0\n1,0,0,0\n", "x", limits).rows().size(), 2u);
+}
+
+TEST(ReplayParse, InvalidLimitsAreAProgrammingError) {
+  ReplayLimits limits;
+  limits.max_speed_m_s = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(Replay::parse("t,v_x,v_y,v_z\n0,0,0,0\n", "x", limits), std::invalid_argument);
+  limits.max_speed_m_s = -1.0;
+  EXPECT_THROW(Replay::parse("t,v_x,v_y,v_z\n0,0,0,0\n", "x", limits), std::invalid_argument);
+}
+
+// ---- rejected input: one test per rule ----------------------------------------------------------
+
+TEST(ReplayReject, MissingHeader) {
+  expect_rejected("", 1, "", "missing header");
+  expect_rejected("# only a comment\n\n# another\n", 3, "", "missing header");
+}
+
+TEST(ReplayReject, IncorrectHeader) {
+  expect_rejected("# c\nt,vx,v_y,v_z\n0,0,0,0\n", 2, "", "expected the header 't,v_x,v_y,v_z'");
+  expect_rejected("0,0,0,0\n1,0,0,0\n", 1, "", "got '0,0,0,0'");
+  expect_rejected("t,v_x,v_y\n", 1, "", "expected the header");
+  expect_rejected("t,v_x,v_y,v_z,extra\n", 1, "", "expected the header");
+  expect_rejected("T,V_X,V_Y,V_Z\n", 1, "", "expected the header");
+  expect_rejected("t;v_x;v_y;v_z\n", 1, "", "expected the header");
+}
+
+TEST(ReplayReject, WrongNumberOfFields) {
+  expect_rejected("t,v_x,v_y,v_z\n0,0,0,0\n1,0,0\n", 3, "", "expected 4 fields");
+  expect_rejected("t,v_x,v_y,v_z\n0,0,0,0,0\n", 2, "", "got 5");
+  expect_rejected("t,v_x,v_y,v_z\n0,0,0,0,\n", 2, "", "got 5");
+  expect_rejected("t,v_x,v_y,v_z\n0 0 0 0\n", 2, "", "got 1");
+}
+
+TEST(ReplayReject, NotANumber) {
+  const std::string h = "t,v_x,v_y,v_z\n";
+  expect_rejected(h + "0,0,0.1x,0\n", 2, "v_y", "not a number: '0.1x'");
+  expect_rejected(h + "abc,0,0,0\n", 2, "t", "not a number: 'abc'");
+  expect_rejected(h + "0,1 2,0,0\n", 2, "v_x", "not a number: '1 2'");
+  expect_rejected(h + "0,0,0,0x1\n", 2, "v_z", "not a number: '0x1'");
+  expect_rejected(h + "0,0,0,1,5\n", 2, "", "expected 4 fields");  // decimal comma
+  expect_rejected(h + "0,+1,0,0\n", 2, "v_x", "not a number: '+1'");
+  expect_rejected(h + "0,,0,0\n", 2, "v_x", "missing value");
+  expect_rejected(h + "0,0,0,1e400\n", 2, "v_z", "number out of range: '1e400'");
+  // Unprintable bytes are escaped in the message.
+  expect_rejected(h + "0,0,0,1\r2\n", 2, "v_z", "not a number: '1\\x0d2'");
+}
+
+TEST(ReplayReject, NanOrInfinite) {
+  const std::string h = "t,v_x,v_y,v_z\n";
+  expect_rejected(h + "0,nan,0,0\n", 2, "v_x", "not a finite number: 'nan'");
+  expect_rejected(h + "0,0,-inf,0\n", 2, "v_y", "not a finite number: '-inf'");
+  expect_rejected(h + "0,0,0,0\ninfinity,0,0,0\n", 3, "t", "not a finite number: 'infinity'");
+}
+
+TEST(ReplayReject, NegativeTime) {
+  expect_rejected("t,v_x,v_y,v_z\n-0.5,0,0,0\n", 2, "t", "negative time: '-0.5'");
+}
+
+TEST(ReplayReject, TimeNotStrictlyIncreasing) {
+  expect_rejected("t,v_x,v_y,v_z\n0,0,0,0\n# c\n1,0,0,0\n1,0,0,0\n", 5, "t",
+                  "time not strictly increasing: 1 s follows 1 s (line 4)");
+  expect_rejected("t,v_x,v_y,v_z\n0,0,0,0\n2,0,0,0\n1.5,0,0,0\n", 4, "t",
+                  "1.5 s follows 2 s (line 3)");
+}
+
+TEST(ReplayReject, NoDataRows) {
+  expect_rejected("t,v_x,v_y,v_z\n", 1, "", "no data rows");
+  expect_rejected("# c\nt,v_x,v_y,v_z\n\n# end\n", 4, "", "no data rows");
+}
+
+TEST(ReplayReject, SpeedAboveLimit) {
+  const std::string h = "t,v_x,v_y,v_z\n";
+  expect_rejected(h + "0,5.01,0,0\n", 2, "v_x", "magnitude of 5.01 m/s exceeds the limit of 5 m/s");
+  expect_rejected(h + "0,0,-6,0\n", 2, "v_y", "magnitude of -6 m/s");
+  ReplayLimits limits;
+  limits.max_speed_m_s = 0.5;
+  expect_rejected(h + "0,0,0,0\n1,0,0,0.75\n", 3, "v_z", "exceeds the limit of 0.5 m/s", limits);
+}
+
+TEST(ReplayReject, TooManyRows) {
+  ReplayLimits limits;
+  limits.max_rows = 2;
+  expect_rejected("t,v_x,v_y,v_z\n0,0,0,0\n1,0,0,0\n# c\n2,0,0,0\n", 5, "",
+                  "too many data rows (limit 2 rows)", limits);
+}
+
+TEST(ReplayReject, ErrorMessageFormat) {
+  EXPECT_STREQ(parse_error("t,v_x,v_y,v_z\n0,0,0.1x,0\n").what(),
+               "bad_replay.csv:2: field 'v_y': not a number: '0.1x'");
+  EXPECT_STREQ(parse_error("t,v_x,v_y,v_z\n0,0,0\n").what(),
+               "bad_replay.csv:2: expected 4 fields (t,v_x,v_y,v_z), got 3");
+}
+
+// ---- files -------------------------------------------------------------------------------------
+
+TEST(ReplayFile, LoadsATemporaryFile) {
+  const TempFile file("t,v_x,v_y,v_z\r\n0,0.2,0,0\r\n1,0,0,0\r\n");
+  const Replay r = Replay::load_file(file.path());
+  ASSERT_EQ(r.rows().size(), 2u);
+  expect_vec(r.rows()[0].v_m_s, 0.2, 0.0, 0.0);
+  EXPECT_EQ(r.source_name(), file.path().string());
+}
+
+TEST(ReplayFile, ErrorsInAFileNameTheFile) {
+  const TempFile file("t,v_x,v_y,v_z\n0,0,0,0\n1,0,9,0\n");
+  try {
+    Replay::load_file(file.path());
+    FAIL() << "accepted";
+  } catch (const ReplayError& e) {
+    EXPECT_EQ(e.file(), file.path().string());
+    EXPECT_EQ(e.line(), 3u);
+    EXPECT_EQ(e.field(), "v_y");
+    EXPECT_EQ(std::string(e.what()).rfind(file.path().string() + ":3: field 'v_y': ", 0), 0u)
+        << e.what();
+  }
+}
+
+TEST(ReplayFile, MissingFileIsLineZero) {
+  const fs::path missing = fs::temp_directory_path() / "craneassist_no_such_replay.csv";
+  try {
+    Replay::load_file(missing);
+    FAIL() << "accepted";
+  } catch (const ReplayError& e) {
+    EXPECT_EQ(e.line(), 0u);
+    EXPECT_EQ(e.field(), "");
+    EXPECT_EQ(std::string(e.what()), missing.string() + ":0: file not found");
+  }
+}
+
+TEST(ReplayFile, DirectoryIsRejected) {
+  try {
+    Replay::load_file(fs::temp_directory_path());
+    FAIL() << "accepted";
+  } catch (const ReplayError& e) {
+    EXPECT_EQ(e.line(), 0u);
+    EXPECT_NE(e.reason().find("directory"), std::string::npos) << e.what();
+  }
+}
+
+// The example in docs/replay-format.md must stay valid.
+TEST(ReplayFile, DocumentationExampleParses) {
+  std::ifstream doc(fs::path(CRANEASSIST_SOURCE_DIR) / "docs" / "replay-format.md");
+  ASSERT_TRUE(doc) << "docs/replay-format.md missing";
+  std::string line;
+  std::string example;
+  bool in_block = false;
+  while (std::getline(doc, line)) {
+    if (!in_block && line == "```csv") {
+      in_block = true;
+    } else if (in_block && line == "```") {
+      break;
+    } else if (in_block) {
+      example += line + "\n";
+    }
+  }
+  ASSERT_FALSE(example.empty()) << "no ```csv block in docs/replay-format.md";
+  const Replay r = Replay::parse(example, "docs example");
+  EXPECT_GE(r.rows().size(), 2u);
+  expect_vec(r.rows().back().v_m_s, 0.0, 0.0, 0.0);  // ends with a zero row
+}
+
+// ---- zero-order hold
+// -----------------------------------------------------------------------------
+
+Replay three_rows() {
+  return Replay::parse("t,v_x,v_y,v_z\n1,0.1,0,0\n2,0,0.2,0\n4,0,0,0.3\n", "zoh.csv");
+}
+
+TEST(ReplayZeroOrderHold, ZeroOrderHold) {
+  const Replay r = three_rows();
+  ReplayCursor c(r);
+  expect_vec(c.command_at(0.0), 0, 0, 0);  // before the first row: zero
+  expect_vec(c.command_at(std::nextafter(1.0, 0.0)), 0, 0, 0);
+  expect_vec(c.command_at(1.0), 0.1, 0, 0);  // a row applies from exactly its time
+  expect_vec(c.command_at(1.999), 0.1, 0, 0);
+  expect_vec(c.command_at(2.0), 0, 0.2, 0);
+  expect_vec(c.command_at(std::nextafter(4.0, 0.0)), 0, 0.2, 0);
+  expect_vec(c.command_at(4.0), 0, 0, 0.3);
+  expect_vec(c.command_at(1e9), 0, 0, 0.3);  // after the last row: held
+  expect_vec(c.command_at(std::numeric_limits<double>::infinity()), 0, 0, 0.3);
+}
+
+TEST(ReplayZeroOrderHold, BackwardAndJumps) {
+  const Replay r = three_rows();
+  ReplayCursor c(r);
+  expect_vec(c.command_at(10.0), 0, 0, 0.3);  // jump to the end first
+  expect_vec(c.command_at(2.5), 0, 0.2, 0);   // back
+  expect_vec(c.command_at(1.0), 0.1, 0, 0);   // back onto a row time
+  expect_vec(c.command_at(-1.0), 0, 0, 0);    // back before the start
+  expect_vec(c.command_at(-std::numeric_limits<double>::infinity()), 0, 0, 0);
+  expect_vec(c.command_at(4.0), 0, 0, 0.3);                                     // forward again
+  expect_vec(c.command_at(std::numeric_limits<double>::quiet_NaN()), 0, 0, 0);  // NaN: safe zero
+  expect_vec(c.command_at(4.0), 0, 0, 0.3);
+}
+
+TEST(ReplayZeroOrderHold, MatchesLinearScanForRandomQueries) {
+  std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> gap(0.001, 0.1);
+  std::uniform_real_distribution<double> speed(-1.0, 1.0);
+  std::vector<ReplayRow> rows;
+  double t = 0.5;
+  for (int i = 0; i < 2000; ++i) {
+    rows.push_back({t, Eigen::Vector3d(speed(rng), speed(rng), speed(rng))});
+    t += gap(rng);
+  }
+  std::ostringstream text;
+  write_replay(text, rows);
+  const Replay r = Replay::parse(text.str(), "random.csv");
+  const auto reference = [&](double q) -> Eigen::Vector3d {
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    for (const ReplayRow& row : rows) {
+      if (row.t_s <= q) v = row.v_m_s;
+    }
+    return v;
+  };
+
+  ReplayCursor c(r);
+  std::uniform_real_distribution<double> any_time(-1.0, t + 1.0);
+  std::uniform_int_distribution<std::size_t> any_row(0, rows.size() - 1);
+  std::uniform_real_distribution<double> step(0.0, 0.05);
+  double q = -0.1;
+  for (int i = 0; i < 20000; ++i) {
+    const int kind = i % 7;
+    if (kind == 0) {
+      q = any_time(rng);  // random jump, either direction
+    } else if (kind == 1) {
+      q = rows[any_row(rng)].t_s;  // exactly on a row time
+    } else {
+      q += step(rng);  // typical control-loop progression
+    }
+    ASSERT_EQ(c.command_at(q), reference(q)) << "query " << q;
+  }
+}
+
+TEST(ReplayZeroOrderHold, NoAllocationAndNoexcept) {
+  static_assert(noexcept(std::declval<ReplayCursor&>().command_at(0.0)));
+  const Replay r = three_rows();
+  ReplayCursor c(r);
+  double sum = 0.0;
+  const std::size_t before = g_allocations.load();
+  for (int i = 0; i < 10000; ++i) sum += c.command_at(i * 0.001).sum();
+  for (int i = 10000; i > 0; --i) sum += c.command_at(i * 0.001).sum();
+  EXPECT_EQ(g_allocations.load(), before);
+  EXPECT_GT(sum, 0.0);
+  // The counter does see allocations.
+  std::ostringstream os;
+  os << std::string(1000, 'x');
+  EXPECT_GT(g_allocations.load(), before);
+}
+
+// ---- writer ------------------------------------------------------------------------------------
+
+TEST(ReplayWrite, Format) {
+  std::ostringstream out;
+  write_replay(out, {{0.0, Eigen::Vector3d(0.1, -0.25, 0.0)}, {1.5, Eigen::Vector3d::Zero()}});
+  EXPECT_EQ(out.str(), "t,v_x,v_y,v_z\n0,0.1,-0.25,0\n1.5,0,0,0\n");
+}
+
+TEST(ReplayWrite, RoundTripIsBitExact) {
+  // Awkward values, then random bit patterns within the limits (incl. subnormals).
+  std::vector<ReplayRow> rows = {
+      {0.0, Eigen::Vector3d(0.1, 1.0 / 3.0, -2.0 / 3.0)},
+      {0.1, Eigen::Vector3d(std::numeric_limits<double>::min(), -0.0, 5.0)},
+      {1e-300, Eigen::Vector3d(std::numeric_limits<double>::denorm_min(), -5.0, 4.999999999999999)},
+      {123456789.123456789, Eigen::Vector3d(1e-17, -1.2345678901234567, 0.30000000000000004)},
+  };
+  std::sort(rows.begin(), rows.end(),
+            [](const ReplayRow& a, const ReplayRow& b) { return a.t_s < b.t_s; });
+  std::mt19937_64 rng(7);
+  const auto random_speed = [&] {
+    while (true) {
+      const double v = std::bit_cast<double>(rng());
+      if (std::isfinite(v) && std::abs(v) <= 5.0) return v;
+    }
+  };
+  double t = rows.back().t_s;
+  for (int i = 0; i < 5000; ++i) {
+    t = std::nextafter(t, 1e300) + std::abs(random_speed()) * 1e3;
+    rows.push_back({t, Eigen::Vector3d(random_speed(), random_speed(), random_speed())});
+  }
+
+  std::ostringstream out;
+  write_replay(out, rows);
+  const Replay r = Replay::parse(out.str(), "roundtrip.csv");
+  ASSERT_EQ(r.rows().size(), rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(r.rows()[i].t_s),
+              std::bit_cast<std::uint64_t>(rows[i].t_s))
+        << "row " << i;
+    for (Eigen::Index k = 0; k < 3; ++k) {
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(r.rows()[i].v_m_s[k]),
+                std::bit_cast<std::uint64_t>(rows[i].v_m_s[k]))
+          << "row " << i << " component " << k << " value " << rows[i].v_m_s[k];
+    }
+  }
+}
+
+}  // namespace
+}  // namespace craneassist::input

@@ -1,0 +1,33 @@
+// Cylinder velocity references to spool commands: a linear dead-zone inverse with optional P
+// feedback on cylinder position, I = DZI(v_ref + Kp e) (paper 000 appendix A, here with a
+// straight-line velocity-vs-current table; the measured table and the eps_v/eps_p activation
+// rule come with the valve-control work).
+#pragma once
+
+#include "craneassist/dynamics/model.hpp"
+#include "craneassist/valves/machine_interface.hpp"
+
+namespace craneassist::valves {
+
+struct ProportionalValvesInput {
+  JointVector velocity_ref_m_s;  // cylinder velocity references
+  JointVector position_error_m;  // cylinder position reference minus measurement
+};
+
+class ProportionalValves {
+ public:
+  ProportionalValves(const dynamics::CraneModel& model, double position_gain_1_s);
+
+  // Spool commands in [-1, 1]; 0 for a reference below min_speed (stays in the dead zone).
+  void update(const ProportionalValvesInput& in, ValveCommand& out) const;
+
+  // The inverse mapping the valve follows: spool command to steady cylinder velocity.
+  static double velocity_from_spool(double spool, double dead_zone, double v_max_m_s);
+  static double spool_from_velocity(double velocity_m_s, double dead_zone, double v_max_m_s);
+
+ private:
+  const dynamics::CraneModel& model_;
+  double position_gain_1_s_;
+};
+
+}  // namespace craneassist::valves
