@@ -38,7 +38,8 @@ ConfigError error_after_edit(const std::string& from, const std::string& to) {
 int line_of(const std::string& needle) {
   const std::string text = read_file(kK70mPath);
   const auto pos = text.find(needle);
-  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(pos), '\n'));
+  return 1 +
+         static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(pos), '\n'));
 }
 
 }  // namespace
@@ -128,9 +129,10 @@ TEST(CraneConfig, WrongDimensionIsRejected) {
 TEST(CraneConfig, OutOfRangeValuesAreRejected) {
   EXPECT_EQ(error_after_edit("dead_zone: 0.53", "dead_zone: 1.5").field(),
             "hydraulics.valves.dead_zone");
-  EXPECT_EQ(error_after_edit("mass: 0 kg, assumed\n\nhydraulics", "mass: -5 kg, assumed\n\nhydraulics")
-                .field(),
-            "payload.mass");
+  EXPECT_EQ(
+      error_after_edit("mass: 0 kg, assumed\n\nhydraulics", "mass: -5 kg, assumed\n\nhydraulics")
+          .field(),
+      "payload.mass");
   EXPECT_EQ(error_after_edit("lift: 20 deg", "lift: 80 deg").field(), "simulation.initial.lift");
   EXPECT_EQ(error_after_edit("step: 1 ms", "step: 3 ms").field(), "simulation.step");
 }

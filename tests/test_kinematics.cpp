@@ -77,7 +77,8 @@ TEST(Kinematics, JacobianMatchesFiniteDifferences) {
         JointVector qp = q, qm = q;
         qp[i] += h;
         qm[i] -= h;
-        const Eigen::Vector3d fd = (tip_position(m, data, qp) - tip_position(m, data, qm)) / (2 * h);
+        const Eigen::Vector3d fd =
+            (tip_position(m, data, qp) - tip_position(m, data, qm)) / (2 * h);
         EXPECT_LT((jac.col(i) - fd).norm(), 1e-7) << "joint " << i;
       }
     }
@@ -181,7 +182,8 @@ TEST(InverseKinematics, RecoversJointsGivenExtension) {
   }
   EXPECT_GT(solved, 150);
   JointVector q_out;
-  EXPECT_EQ(solve_given_extension(m, Eigen::Vector3d(20, 0, 0), 0.0, q_out), IkStatus::kUnreachable);
+  EXPECT_EQ(solve_given_extension(m, Eigen::Vector3d(20, 0, 0), 0.0, q_out),
+            IkStatus::kUnreachable);
 }
 
 TEST(InverseKinematics, RatesGivenExtensionMeetTheTipVelocity) {

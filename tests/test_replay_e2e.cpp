@@ -36,7 +36,7 @@ struct ReplayRun {
 };
 
 ReplayRun run(const config::CraneConfig& cfg, const std::string& replay_file, bool scaling,
-        const std::filesystem::path& log_path) {
+              const std::filesystem::path& log_path) {
   const auto replay = input::Replay::load_file(kSource + "/examples/replays/" + replay_file);
   sim_backend::SimBackend machine(cfg.model, {cfg.simulation.step_s, cfg.simulation.q_initial});
   app::CsvLog log(log_path, cfg.model.dof());
@@ -67,20 +67,22 @@ ReplayRun run(const config::CraneConfig& cfg, const std::string& replay_file, bo
 TEST(ReplayEndToEnd, FlowPrescalingKeepsTheTipDirectionWhenThePumpSaturates) {
   const auto cfg = flow_limited_crane();
   const auto dir = std::filesystem::temp_directory_path();
-  const ReplayRun unscaled = run(cfg, "combined_move.csv", false, dir / "craneassist_e2e_unscaled.csv");
+  const ReplayRun unscaled =
+      run(cfg, "combined_move.csv", false, dir / "craneassist_e2e_unscaled.csv");
   const ReplayRun scaled = run(cfg, "combined_move.csv", true, dir / "craneassist_e2e_scaled.csv");
   const double commanded_elevation = std::asin(0.8 / std::sqrt(0.36 + 0.64 + 1.44)) * 180 / M_PI;
 
   // Closing-note figures.
-  std::printf("[ figures  ] no scaling: max %.2f deg, rms %.2f deg, saturated %d cycles, "
-              "min tip elevation %.1f deg (commanded %.1f)\n",
-              unscaled.summary.max_direction_error_deg, unscaled.summary.rms_direction_error_deg,
-              unscaled.summary.pump_saturated_cycles, unscaled.min_elevation_deg,
-              commanded_elevation);
-  std::printf("[ figures  ] flow prescaling: max %.2f deg, rms %.2f deg, saturated %d cycles, "
-              "min tip elevation %.1f deg\n",
-              scaled.summary.max_direction_error_deg, scaled.summary.rms_direction_error_deg,
-              scaled.summary.pump_saturated_cycles, scaled.min_elevation_deg);
+  std::printf(
+      "[ figures  ] no scaling: max %.2f deg, rms %.2f deg, saturated %d cycles, "
+      "min tip elevation %.1f deg (commanded %.1f)\n",
+      unscaled.summary.max_direction_error_deg, unscaled.summary.rms_direction_error_deg,
+      unscaled.summary.pump_saturated_cycles, unscaled.min_elevation_deg, commanded_elevation);
+  std::printf(
+      "[ figures  ] flow prescaling: max %.2f deg, rms %.2f deg, saturated %d cycles, "
+      "min tip elevation %.1f deg\n",
+      scaled.summary.max_direction_error_deg, scaled.summary.rms_direction_error_deg,
+      scaled.summary.pump_saturated_cycles, scaled.min_elevation_deg);
 
   // Without scaling the pump saturates, the most loaded cylinder starves and the tip dips.
   EXPECT_GT(unscaled.summary.pump_saturated_cycles, 100);
@@ -115,16 +117,36 @@ TEST(ReplayEndToEnd, DemoRunsAndLogsEveryDocumentedColumn) {
   std::getline(in, first_line);
   header += first_line;
   header += ",";
-  for (const char* column :
-       {"t", "cmd_vx", "cmd_vy", "cmd_vz", "ref_vx", "ref_vy", "ref_vz", "tip_x", "tip_y", "tip_z",
-        "tip_vx", "tip_vy", "tip_vz", "q1", "q2", "q3", "q4", "q1_ref", "q2_ref", "q3_ref",
-        "q4_ref", "pump_flow_m3s", "pump_pressure_pa", "pump_power_w", "energy_j",
-        "active_limit"}) {
+  for (const char* column : {"t",
+                             "cmd_vx",
+                             "cmd_vy",
+                             "cmd_vz",
+                             "ref_vx",
+                             "ref_vy",
+                             "ref_vz",
+                             "tip_x",
+                             "tip_y",
+                             "tip_z",
+                             "tip_vx",
+                             "tip_vy",
+                             "tip_vz",
+                             "q1",
+                             "q2",
+                             "q3",
+                             "q4",
+                             "q1_ref",
+                             "q2_ref",
+                             "q3_ref",
+                             "q4_ref",
+                             "pump_flow_m3s",
+                             "pump_pressure_pa",
+                             "pump_power_w",
+                             "energy_j",
+                             "active_limit"}) {
     std::string needle = ",";
     needle += column;
     needle += ",";
-    EXPECT_NE(header.find(needle), std::string::npos)
-        << column;
+    EXPECT_NE(header.find(needle), std::string::npos) << column;
   }
   int rows = 0;
   std::string line;

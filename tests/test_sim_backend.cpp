@@ -118,12 +118,9 @@ TEST(ValveSection, DelayLagAndDeadZone) {
 
 class SimCrane : public ::testing::Test {
  protected:
-  void SetUp() override {
-    cfg_ = config::default_crane_config();
-  }
+  void SetUp() override { cfg_ = config::default_crane_config(); }
   sim_backend::SimBackend make() {
-    return sim_backend::SimBackend(cfg_.model,
-                                   {cfg_.simulation.step_s, cfg_.simulation.q_initial});
+    return sim_backend::SimBackend(cfg_.model, {cfg_.simulation.step_s, cfg_.simulation.q_initial});
   }
   config::CraneConfig cfg_;
 };

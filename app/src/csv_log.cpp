@@ -6,7 +6,8 @@
 namespace craneassist::app {
 
 std::string CsvLog::header(int dof) {
-  std::string h = "t,cmd_vx,cmd_vy,cmd_vz,ref_vx,ref_vy,ref_vz,tip_x,tip_y,tip_z,tip_vx,tip_vy,tip_vz";
+  std::string h =
+      "t,cmd_vx,cmd_vy,cmd_vz,ref_vx,ref_vy,ref_vz,tip_x,tip_y,tip_z,tip_vx,tip_vy,tip_vz";
   for (int i = 1; i <= dof; ++i) h += ",q" + std::to_string(i);
   for (int i = 1; i <= dof; ++i) h += ",q" + std::to_string(i) + "_ref";
   h += ",pump_flow_m3s,pump_pressure_pa,pump_power_w,energy_j,active_limit,scale,flow_demand_m3s,"
@@ -26,7 +27,9 @@ CsvLog::CsvLog(const std::filesystem::path& path, int dof, std::size_t capacity_
   writer_ = std::thread([this] { writer_loop(); });
 }
 
-CsvLog::~CsvLog() { close(); }
+CsvLog::~CsvLog() {
+  close();
+}
 
 bool CsvLog::push(const LogRow& row) noexcept {
   const std::size_t head = head_.load(std::memory_order_relaxed);

@@ -1,8 +1,8 @@
 // craneassist: boom-tip control for hydraulic cranes. The composition root: command line,
 // config loading, wiring of the pipeline and the backend, the summary.
-#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -49,8 +49,7 @@ double cli_quantity(const std::string& option, const std::string& text, config::
 }
 
 void print_summary(const app::RunSummary& s, const config::CraneConfig& cfg,
-                   const std::string& replay_name, const ReplayArgs& args,
-                   const app::CsvLog* log) {
+                   const std::string& replay_name, const ReplayArgs& args, const app::CsvLog* log) {
   const double speedup = s.wall_time_s > 0.0 ? s.duration_s / s.wall_time_s : 0.0;
   std::printf("craneassist replay: %s on %s\n", replay_name.c_str(), cfg.model.name.c_str());
   std::printf("  backend %s, scaling %s, control %.0f Hz\n", args.backend.c_str(),
@@ -58,13 +57,15 @@ void print_summary(const app::RunSummary& s, const config::CraneConfig& cfg,
   std::printf("  ran %.2f s of machine time in %.3f s (%.0fx real time), %d cycles\n", s.duration_s,
               s.wall_time_s, speedup, s.cycles);
   std::printf("  tip: path %.2f m, peak speed %.2f m/s\n", s.tip_path_m, s.peak_tip_speed_m_s);
-  std::printf("  tip direction error, commanded vs measured (steady, > 0.05 m/s): max %.2f deg, "
-              "rms %.2f deg over %d cycles\n",
-              s.max_direction_error_deg, s.rms_direction_error_deg, s.direction_samples);
-  std::printf("  pump: energy %.1f kJ, peak power %.1f kW (limit %.1f kW), peak flow %.0f L/min, "
-              "saturated in %d cycles\n",
-              s.energy_j / 1e3, s.peak_power_w / 1e3, cfg.model.pump.prime_mover_power_w / 1e3,
-              s.peak_flow_m3_s * 60e3, s.pump_saturated_cycles);
+  std::printf(
+      "  tip direction error, commanded vs measured (steady, > 0.05 m/s): max %.2f deg, "
+      "rms %.2f deg over %d cycles\n",
+      s.max_direction_error_deg, s.rms_direction_error_deg, s.direction_samples);
+  std::printf(
+      "  pump: energy %.1f kJ, peak power %.1f kW (limit %.1f kW), peak flow %.0f L/min, "
+      "saturated in %d cycles\n",
+      s.energy_j / 1e3, s.peak_power_w / 1e3, cfg.model.pump.prime_mover_power_w / 1e3,
+      s.peak_flow_m3_s * 60e3, s.pump_saturated_cycles);
   std::printf("  active limit (cycles):");
   for (std::size_t i = 0; i < s.limit_cycles.size(); ++i) {
     if (s.limit_cycles[i] > 0) {
@@ -148,10 +149,13 @@ int main(int argc, char** argv) {
   ReplayArgs args;
   auto* replay = cli.add_subcommand(
       "replay", "Drive the crane from a replay file (default: the bundled demo) and log the run");
-  replay->add_option("file", args.replay_file, "Replay CSV (t,v_x,v_y,v_z); see docs/replay-format.md")
+  replay
+      ->add_option("file", args.replay_file,
+                   "Replay CSV (t,v_x,v_y,v_z); see docs/replay-format.md")
       ->check(CLI::ExistingFile);
-  replay->add_option("--config", args.config_file,
-                     "Crane config YAML (default: the embedded K70M reference crane)")
+  replay
+      ->add_option("--config", args.config_file,
+                   "Crane config YAML (default: the embedded K70M reference crane)")
       ->check(CLI::ExistingFile);
   replay->add_option("--backend", args.backend, "Machine backend")
       ->check(CLI::IsMember({"sim"}))
@@ -159,9 +163,11 @@ int main(int argc, char** argv) {
   replay->add_option("--log", args.log_file, "Per-cycle CSV log (docs/log-format.md)")
       ->capture_default_str();
   replay->add_flag("--no-log", args.no_log, "Do not write the log");
-  replay->add_flag("--no-scaling", args.no_scaling,
-                   "Pass the command through without flow prescaling (to see what scaling prevents)");
-  replay->add_flag("--realtime", args.realtime, "Pace the loop at real time (default: as fast as possible)");
+  replay->add_flag(
+      "--no-scaling", args.no_scaling,
+      "Pass the command through without flow prescaling (to see what scaling prevents)");
+  replay->add_flag("--realtime", args.realtime,
+                   "Pace the loop at real time (default: as fast as possible)");
   replay->add_option("--settle", args.settle_s, "Seconds to keep running after the last replay row")
       ->check(CLI::Range(0.0, 600.0))
       ->capture_default_str();
@@ -175,13 +181,15 @@ int main(int argc, char** argv) {
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return cli.exit(e);
+    // --help and --version exit 0; every usage error exits 2, like a bad config or replay.
+    return cli.exit(e) == 0 ? kExitOk : kExitUsage;
   }
   if (*replay) {
     try {
       return run_replay_command(args);
     } catch (const CLI::Error& e) {
-      return cli.exit(e);
+      cli.exit(e);
+      return kExitUsage;
     }
   }
   return kExitUsage;

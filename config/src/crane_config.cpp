@@ -56,8 +56,8 @@ class Reader {
     return node.Scalar();
   }
 
-  std::vector<double> values(const YAML::Node& map, const std::string& key,
-                             const std::string& path, Dimension dimension, std::size_t count) {
+  std::vector<double> values(const YAML::Node& map, const std::string& key, const std::string& path,
+                             Dimension dimension, std::size_t count) {
     const YAML::Node node = child(map, key, path);
     const std::string field = join(path, key);
     if (!node.IsScalar()) fail(node, field, "expected \"VALUE UNIT, SOURCE\"");
@@ -168,8 +168,8 @@ dynamics::Cylinder read_cylinder(Reader& r, const YAML::Node& node, const std::s
   }
   if (by_bore) {
     const double bore = r.value_in(node, "bore", path, Dimension::kLength, 1e-4, 2.0, "positive");
-    const double rod = r.value_in(node, "rod", path, Dimension::kLength, 0.0, bore,
-                                  "between 0 and the bore");
+    const double rod =
+        r.value_in(node, "rod", path, Dimension::kLength, 0.0, bore, "between 0 and the bore");
     c.area_a_m2 = 0.25 * M_PI * bore * bore;
     c.area_b_m2 = 0.25 * M_PI * (bore * bore - rod * rod);
   } else {
@@ -223,8 +223,8 @@ void read_joints(Reader& r, const YAML::Node& root, dynamics::CraneModel& model)
   for (std::size_t i = 0; i < joints.size(); ++i) {
     const YAML::Node j = joints[i];
     const std::string path = "joints[" + std::to_string(i) + "]";
-    r.check_keys(j, path, {"name", "type", "a", "alpha", "d", "theta_offset", "min", "max",
-                           "cylinder"});
+    r.check_keys(j, path,
+                 {"name", "type", "a", "alpha", "d", "theta_offset", "min", "max", "cylinder"});
     dynamics::DhJoint joint;
     joint.name = r.text(j, "name", path);
     for (const auto& other : model.joints) {
@@ -251,8 +251,8 @@ void read_joints(Reader& r, const YAML::Node& root, dynamics::CraneModel& model)
         (joint.q_min < -M_PI - 1e-9 || joint.q_max > M_PI + 1e-9)) {
       r.fail(j["min"], path + ".min", "a revolute range must lie within [-180, 180] deg");
     }
-    model.cylinders.push_back(read_cylinder(r, r.child(j, "cylinder", path), path + ".cylinder",
-                                            joint));
+    model.cylinders.push_back(
+        read_cylinder(r, r.child(j, "cylinder", path), path + ".cylinder", joint));
     model.joints.push_back(joint);
   }
 }
@@ -273,8 +273,7 @@ void read_bodies(Reader& r, const YAML::Node& root, dynamics::CraneModel& model)
       r.fail(frame, path + ".frame", "expected a whole number");
     }
     if (body.frame < 1 || body.frame > model.dof()) {
-      r.fail(frame, path + ".frame",
-             "must name a joint frame 1.." + std::to_string(model.dof()));
+      r.fail(frame, path + ".frame", "must name a joint frame 1.." + std::to_string(model.dof()));
     }
     body.mass_kg = r.value_in(b, "mass", path, Dimension::kMass, 0.0, 1e6, "between 0 and 1e6 kg");
     const auto com = r.values(b, "com", path, Dimension::kLength, 3);
@@ -291,8 +290,8 @@ void read_bodies(Reader& r, const YAML::Node& root, dynamics::CraneModel& model)
   dynamics::Body p;
   p.name = "payload";
   p.frame = model.dof();
-  p.mass_kg = r.value_in(payload, "mass", "payload", Dimension::kMass, 0.0, 1e5,
-                         "between 0 and 100000 kg");
+  p.mass_kg =
+      r.value_in(payload, "mass", "payload", Dimension::kMass, 0.0, 1e5, "between 0 and 100000 kg");
   model.bodies.push_back(p);
 }
 
@@ -305,8 +304,8 @@ void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& mo
                {"max_flow", "max_pressure", "ls_margin", "prime_mover_power", "standby_pressure"});
   auto& p = model.pump;
   p.max_flow_m3_s = r.value_in(pump, "max_flow", pp, Dimension::kFlow, 1e-7, 1.0, "positive");
-  p.max_pressure_pa =
-      r.value_in(pump, "max_pressure", pp, Dimension::kPressure, 1e5, 1e8, "between 1 and 1000 bar");
+  p.max_pressure_pa = r.value_in(pump, "max_pressure", pp, Dimension::kPressure, 1e5, 1e8,
+                                 "between 1 and 1000 bar");
   p.ls_margin_pa = r.value_in(pump, "ls_margin", pp, Dimension::kPressure, 1e4, p.max_pressure_pa,
                               "positive and below max_pressure");
   p.prime_mover_power_w =
@@ -378,15 +377,15 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
         joint.type == dynamics::JointType::kRevolute ? Dimension::kAngle : Dimension::kLength;
     const double q = r.value(initial, joint.name, "simulation.initial", qdim);
     if (q < joint.q_min || q > joint.q_max) {
-      r.fail(initial[joint.name], "simulation.initial." + joint.name,
-             "outside the joint range");
+      r.fail(initial[joint.name], "simulation.initial." + joint.name, "outside the joint range");
     }
     cfg.simulation.q_initial[i] = q;
   }
   for (const auto& kv : initial) {
     bool known = false;
     for (const auto& joint : model.joints) known = known || joint.name == kv.first.Scalar();
-    if (!known) r.fail(kv.first, "simulation.initial." + kv.first.Scalar(), "no joint of that name");
+    if (!known)
+      r.fail(kv.first, "simulation.initial." + kv.first.Scalar(), "no joint of that name");
   }
   cfg.unsourced_quantities = r.unsourced();
   return cfg;

@@ -16,30 +16,18 @@ struct UnitDef {
 constexpr double kPi = std::numbers::pi;
 
 constexpr UnitDef kUnits[] = {
-    {"m", Dimension::kLength, 1.0},
-    {"mm", Dimension::kLength, 1e-3},
-    {"cm", Dimension::kLength, 1e-2},
-    {"rad", Dimension::kAngle, 1.0},
-    {"deg", Dimension::kAngle, kPi / 180.0},
-    {"kg", Dimension::kMass, 1.0},
-    {"kg*m^2", Dimension::kInertia, 1.0},
-    {"m/s", Dimension::kVelocity, 1.0},
-    {"mm/s", Dimension::kVelocity, 1e-3},
-    {"m/s^2", Dimension::kAcceleration, 1.0},
-    {"m^2", Dimension::kArea, 1.0},
-    {"cm^2", Dimension::kArea, 1e-4},
-    {"mm^2", Dimension::kArea, 1e-6},
-    {"m^3/s", Dimension::kFlow, 1.0},
-    {"L/min", Dimension::kFlow, 1e-3 / 60.0},
-    {"Pa", Dimension::kPressure, 1.0},
-    {"kPa", Dimension::kPressure, 1e3},
-    {"MPa", Dimension::kPressure, 1e6},
-    {"bar", Dimension::kPressure, 1e5},
-    {"W", Dimension::kPower, 1.0},
-    {"kW", Dimension::kPower, 1e3},
-    {"s", Dimension::kTime, 1.0},
-    {"ms", Dimension::kTime, 1e-3},
-    {"Hz", Dimension::kFrequency, 1.0},
+    {"m", Dimension::kLength, 1.0},           {"mm", Dimension::kLength, 1e-3},
+    {"cm", Dimension::kLength, 1e-2},         {"rad", Dimension::kAngle, 1.0},
+    {"deg", Dimension::kAngle, kPi / 180.0},  {"kg", Dimension::kMass, 1.0},
+    {"kg*m^2", Dimension::kInertia, 1.0},     {"m/s", Dimension::kVelocity, 1.0},
+    {"mm/s", Dimension::kVelocity, 1e-3},     {"m/s^2", Dimension::kAcceleration, 1.0},
+    {"m^2", Dimension::kArea, 1.0},           {"cm^2", Dimension::kArea, 1e-4},
+    {"mm^2", Dimension::kArea, 1e-6},         {"m^3/s", Dimension::kFlow, 1.0},
+    {"L/min", Dimension::kFlow, 1e-3 / 60.0}, {"Pa", Dimension::kPressure, 1.0},
+    {"kPa", Dimension::kPressure, 1e3},       {"MPa", Dimension::kPressure, 1e6},
+    {"bar", Dimension::kPressure, 1e5},       {"W", Dimension::kPower, 1.0},
+    {"kW", Dimension::kPower, 1e3},           {"s", Dimension::kTime, 1.0},
+    {"ms", Dimension::kTime, 1e-3},           {"Hz", Dimension::kFrequency, 1.0},
     {"1/s", Dimension::kInverseTime, 1.0},
 };
 
@@ -63,20 +51,34 @@ std::optional<double> parse_number(std::string_view token) {
 
 const char* to_string(Dimension d) {
   switch (d) {
-    case Dimension::kDimensionless: return "dimensionless";
-    case Dimension::kLength: return "length";
-    case Dimension::kAngle: return "angle";
-    case Dimension::kMass: return "mass";
-    case Dimension::kInertia: return "moment of inertia";
-    case Dimension::kVelocity: return "velocity";
-    case Dimension::kAcceleration: return "acceleration";
-    case Dimension::kArea: return "area";
-    case Dimension::kFlow: return "volume flow";
-    case Dimension::kPressure: return "pressure";
-    case Dimension::kPower: return "power";
-    case Dimension::kTime: return "time";
-    case Dimension::kFrequency: return "frequency";
-    case Dimension::kInverseTime: return "inverse time";
+    case Dimension::kDimensionless:
+      return "dimensionless";
+    case Dimension::kLength:
+      return "length";
+    case Dimension::kAngle:
+      return "angle";
+    case Dimension::kMass:
+      return "mass";
+    case Dimension::kInertia:
+      return "moment of inertia";
+    case Dimension::kVelocity:
+      return "velocity";
+    case Dimension::kAcceleration:
+      return "acceleration";
+    case Dimension::kArea:
+      return "area";
+    case Dimension::kFlow:
+      return "volume flow";
+    case Dimension::kPressure:
+      return "pressure";
+    case Dimension::kPower:
+      return "power";
+    case Dimension::kTime:
+      return "time";
+    case Dimension::kFrequency:
+      return "frequency";
+    case Dimension::kInverseTime:
+      return "inverse time";
   }
   return "?";
 }

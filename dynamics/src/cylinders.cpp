@@ -28,7 +28,8 @@ double cylinder_length(const Cylinder& cyl, double q) {
       return cyl.c0_m + cyl.arm_m * q;
     case LinkageType::kTriangle: {
       const double b = q + cyl.angle_offset_rad;
-      return std::sqrt(cyl.l1_m * cyl.l1_m + cyl.l2_m * cyl.l2_m - 2.0 * cyl.l1_m * cyl.l2_m * std::cos(b));
+      return std::sqrt(cyl.l1_m * cyl.l1_m + cyl.l2_m * cyl.l2_m -
+                       2.0 * cyl.l1_m * cyl.l2_m * std::cos(b));
     }
     case LinkageType::kPolynomial:
       return eval_poly(cyl.poly_coeffs, q).value;
@@ -79,7 +80,8 @@ void cylinder_arms(const CraneModel& model, const JointVector& q, JointVector& d
 
 double pump_flow_demand(const CraneModel& model, const JointVector& v) {
   double q = 0.0;
-  for (int i = 0; i < model.dof(); ++i) q += flow_area_m2(model.cylinders[i], v[i]) * std::abs(v[i]);
+  for (int i = 0; i < model.dof(); ++i)
+    q += flow_area_m2(model.cylinders[i], v[i]) * std::abs(v[i]);
   return q;
 }
 

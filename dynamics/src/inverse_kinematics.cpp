@@ -6,16 +6,22 @@
 namespace craneassist::dynamics {
 namespace {
 
-bool near(double a, double b) { return std::abs(a - b) < 1e-9; }
+bool near(double a, double b) {
+  return std::abs(a - b) < 1e-9;
+}
 
 }  // namespace
 
 const char* to_string(IkStatus status) {
   switch (status) {
-    case IkStatus::kOk: return "ok";
-    case IkStatus::kUnreachable: return "unreachable";
-    case IkStatus::kOutsideJointLimits: return "outside joint limits";
-    case IkStatus::kSingular: return "singular";
+    case IkStatus::kOk:
+      return "ok";
+    case IkStatus::kUnreachable:
+      return "unreachable";
+    case IkStatus::kOutsideJointLimits:
+      return "outside joint limits";
+    case IkStatus::kSingular:
+      return "singular";
   }
   return "?";
 }
@@ -26,10 +32,9 @@ bool is_loader_structure(const CraneModel& m) {
   return j[0].type == JointType::kRevolute && near(j[0].alpha_rad, M_PI_2) &&
          near(j[0].theta_rad, 0.0) && j[1].type == JointType::kRevolute &&
          near(j[1].alpha_rad, 0.0) && near(j[1].d_m, 0.0) && near(j[1].theta_rad, 0.0) &&
-         j[2].type == JointType::kRevolute && near(j[2].alpha_rad, M_PI_2) &&
-         near(j[2].d_m, 0.0) && near(j[2].theta_rad, M_PI_2) &&
-         j[3].type == JointType::kPrismatic && near(j[3].a_m, 0.0) &&
-         near(j[3].alpha_rad, -M_PI_2) && near(j[3].theta_rad, 0.0) &&
+         j[2].type == JointType::kRevolute && near(j[2].alpha_rad, M_PI_2) && near(j[2].d_m, 0.0) &&
+         near(j[2].theta_rad, M_PI_2) && j[3].type == JointType::kPrismatic &&
+         near(j[3].a_m, 0.0) && near(j[3].alpha_rad, -M_PI_2) && near(j[3].theta_rad, 0.0) &&
          m.task_from_base.isApprox((Eigen::Matrix3d() << 1, 0, 0, 0, 0, 1, 0, 1, 0).finished());
 }
 

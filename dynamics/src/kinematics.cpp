@@ -54,7 +54,8 @@ void tip_jacobian_dot(const CraneModel& model, KinematicsData& data, const Joint
   for (int k = 1; k <= n; ++k) {
     const Eigen::Vector3d z = data.frames[k - 1].linear().col(2);
     const bool revolute = model.joints[k - 1].type == JointType::kRevolute;
-    data.omega[k] = data.omega[k - 1] + (revolute ? Eigen::Vector3d(z * qdot[k - 1]) : Eigen::Vector3d::Zero());
+    data.omega[k] =
+        data.omega[k - 1] + (revolute ? Eigen::Vector3d(z * qdot[k - 1]) : Eigen::Vector3d::Zero());
     data.origin_velocity[k] =
         data.origin_velocity[k - 1] +
         data.omega[k].cross(data.frames[k].translation() - data.frames[k - 1].translation()) +
@@ -68,7 +69,8 @@ void tip_jacobian_dot(const CraneModel& model, KinematicsData& data, const Joint
     const Eigen::Vector3d z_dot = data.omega[i].cross(z);
     Eigen::Vector3d col;
     if (model.joints[i].type == JointType::kRevolute) {
-      col = z_dot.cross(p - data.frames[i].translation()) + z.cross(p_dot - data.origin_velocity[i]);
+      col =
+          z_dot.cross(p - data.frames[i].translation()) + z.cross(p_dot - data.origin_velocity[i]);
     } else {
       col = z_dot;
     }

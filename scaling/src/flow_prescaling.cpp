@@ -8,13 +8,20 @@ namespace craneassist::scaling {
 
 const char* to_string(ActiveLimit limit) {
   switch (limit) {
-    case ActiveLimit::kNone: return "none";
-    case ActiveLimit::kFlow: return "flow";
-    case ActiveLimit::kCylinderSpeed: return "cylinder_speed";
-    case ActiveLimit::kPower: return "power";
-    case ActiveLimit::kTrackingError: return "tracking_error";
-    case ActiveLimit::kJointLimit: return "joint_limit";
-    case ActiveLimit::kStaleInput: return "stale_input";
+    case ActiveLimit::kNone:
+      return "none";
+    case ActiveLimit::kFlow:
+      return "flow";
+    case ActiveLimit::kCylinderSpeed:
+      return "cylinder_speed";
+    case ActiveLimit::kPower:
+      return "power";
+    case ActiveLimit::kTrackingError:
+      return "tracking_error";
+    case ActiveLimit::kJointLimit:
+      return "joint_limit";
+    case ActiveLimit::kStaleInput:
+      return "stale_input";
   }
   return "?";
 }

@@ -41,8 +41,8 @@ void LsPump::solve(const JointVector& demand, const JointVector& load, LsPumpRes
     return;
   }
   // Unsaturated LS operation: supply = highest load + margin, every section fully served.
-  const double p_ls = std::max(std::max(max_load, 0.0) + pump_.ls_margin_pa,
-                               pump_.standby_pressure_pa);
+  const double p_ls =
+      std::max(std::max(max_load, 0.0) + pump_.ls_margin_pa, pump_.standby_pressure_pa);
   const double p_top = std::min(p_ls, pump_.max_pressure_pa);
   double p = p_top;
   if (section_flows(demand, load, p_top, nullptr) > deliverable_flow(p_top)) {

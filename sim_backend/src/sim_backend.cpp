@@ -23,14 +23,19 @@ constexpr double kWorldCfm = 1e-10;
 struct SimBackend::Impl {
   Impl(const dynamics::CraneModel& m, const SimSettings& s)
       : model(m), settings(s), pump(m.pump), world(make_world(m)) {
+    // A threading implementation of this world's own: ODE's shared default aborts when two
+    // worlds step at the same time in different threads.
+    threading = dThreadingAllocateSelfThreadedImplementation();
+    dWorldSetStepThreadingImplementation(world, dThreadingImplementationGetFunctions(threading),
+                                         threading);
     crane = std::make_unique<dynamics::OdeCrane>(model, world, s.q_initial);
     crane->enable_end_stops(true);
     const int n = model.dof();
     feedback.resize(static_cast<std::size_t>(n) + 1);
     for (int i = 1; i <= n; ++i) {
       dJointSetFeedback(crane->joint(i), &feedback[static_cast<std::size_t>(i)]);
-      sections.emplace_back(model.valves, model.cylinders[static_cast<std::size_t>(i - 1)].v_max_m_s,
-                            s.step_s);
+      sections.emplace_back(model.valves,
+                            model.cylinders[static_cast<std::size_t>(i - 1)].v_max_m_s, s.step_s);
     }
     spool_command.setZero(n);
     requested_velocity.setZero(n);
@@ -48,7 +53,9 @@ struct SimBackend::Impl {
 
   ~Impl() {
     crane.reset();
+    dWorldSetStepThreadingImplementation(world, nullptr, nullptr);
     dWorldDestroy(world);
+    dThreadingFreeImplementation(threading);
   }
 
   static dWorldID make_world(const dynamics::CraneModel& m) {
@@ -128,7 +135,8 @@ struct SimBackend::Impl {
     for (int i = 0; i < n; ++i) {
       const auto& cyl = model.cylinders[static_cast<std::size_t>(i)];
       requested_velocity[i] = sections[static_cast<std::size_t>(i)].step(spool_command[i]);
-      demand[i] = dynamics::flow_area_m2(cyl, requested_velocity[i]) * std::abs(requested_velocity[i]);
+      demand[i] =
+          dynamics::flow_area_m2(cyl, requested_velocity[i]) * std::abs(requested_velocity[i]);
     }
     pump.solve(demand, load_pressure, pump_result);
     step_physics(false);
@@ -141,6 +149,7 @@ struct SimBackend::Impl {
   SimSettings settings;
   LsPump pump;
   dWorldID world;
+  dThreadingImplementationID threading = nullptr;
   std::unique_ptr<dynamics::OdeCrane> crane;
   std::vector<dJointFeedback> feedback;
   std::vector<ValveSection> sections;
@@ -189,8 +198,12 @@ void SimBackend::advance(double dt_s) {
   for (long k = 0; k < steps; ++k) impl_->step();
 }
 
-double SimBackend::time_s() const { return impl_->t_s; }
+double SimBackend::time_s() const {
+  return impl_->t_s;
+}
 
-const JointVector& SimBackend::cylinder_force_n() const { return impl_->force; }
+const JointVector& SimBackend::cylinder_force_n() const {
+  return impl_->force;
+}
 
 }  // namespace craneassist::sim_backend

@@ -7,19 +7,26 @@ namespace craneassist::valves {
 
 const char* to_string(PumpLimit limit) {
   switch (limit) {
-    case PumpLimit::kNone: return "none";
-    case PumpLimit::kMaxFlow: return "max_flow";
-    case PumpLimit::kPower: return "power";
-    case PumpLimit::kRelief: return "relief";
+    case PumpLimit::kNone:
+      return "none";
+    case PumpLimit::kMaxFlow:
+      return "max_flow";
+    case PumpLimit::kPower:
+      return "power";
+    case PumpLimit::kRelief:
+      return "relief";
   }
   return "?";
 }
 
 const char* to_string(BackendStatus status) {
   switch (status) {
-    case BackendStatus::kOk: return "ok";
-    case BackendStatus::kNoData: return "no data";
-    case BackendStatus::kFault: return "fault";
+    case BackendStatus::kOk:
+      return "ok";
+    case BackendStatus::kNoData:
+      return "no data";
+    case BackendStatus::kFault:
+      return "fault";
   }
   return "?";
 }
@@ -45,8 +52,7 @@ void ProportionalValves::update(const ProportionalValvesInput& in, ValveCommand&
   out.spool.resize(n);
   for (int i = 0; i < n; ++i) {
     const double v = in.velocity_ref_m_s[i] + position_gain_1_s_ * in.position_error_m[i];
-    out.spool[i] =
-        spool_from_velocity(v, model_.valves.dead_zone, model_.cylinders[i].v_max_m_s);
+    out.spool[i] = spool_from_velocity(v, model_.valves.dead_zone, model_.cylinders[i].v_max_m_s);
   }
 }
 

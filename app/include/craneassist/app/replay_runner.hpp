@@ -43,8 +43,7 @@ struct RunSummary {
 };
 
 RunSummary run_replay(const config::CraneConfig& config, const input::Replay& replay,
-                      valves::MachineInterface& machine, const RunOptions& options,
-                      CsvLog* log);
+                      valves::MachineInterface& machine, const RunOptions& options, CsvLog* log);
 
 // Angle between two vectors in degrees (0 when either is zero).
 double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b);

@@ -10,7 +10,7 @@
 namespace craneassist::dynamics {
 
 double cylinder_length(const Cylinder& cylinder, double q);
-double cylinder_arm(const Cylinder& cylinder, double q);       // dc/dq
+double cylinder_arm(const Cylinder& cylinder, double q);        // dc/dq
 double cylinder_arm_slope(const Cylinder& cylinder, double q);  // d2c/dq2
 
 // Vector forms over all joints of the model.

@@ -1,4 +1,5 @@
-// Non-redundant inverse kinematics of a K70M-type loader given its extension (paper 000 eqs. 33-35).
+// Non-redundant inverse kinematics of a K70M-type loader given its extension (paper 000 eqs.
+// 33-35).
 //
 // With the extension q4 (or its rate) chosen, slew, lift and tilt follow uniquely: slew from the
 // tip's bearing, lift and tilt from a two-link problem in the vertical plane whose second link

@@ -16,7 +16,8 @@ namespace craneassist::dynamics {
 inline constexpr int kMaxJoints = 6;
 
 using JointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJoints, 1>;
-using JointMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxJoints, kMaxJoints>;
+using JointMatrix =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxJoints, kMaxJoints>;
 using TaskJacobian = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxJoints>;
 
 enum class JointType { kRevolute, kPrismatic };
@@ -54,13 +55,13 @@ enum class LinkageType {
 struct Cylinder {
   std::string name;
   LinkageType linkage = LinkageType::kConstantArm;
-  double arm_m = 0.0;              // kConstantArm: dc/dq (m/rad or m/m)
-  double c0_m = 0.0;               // kConstantArm: c at q = 0
-  double l1_m = 0.0, l2_m = 0.0;   // kTriangle
-  double angle_offset_rad = 0.0;   // kTriangle
+  double arm_m = 0.0;               // kConstantArm: dc/dq (m/rad or m/m)
+  double c0_m = 0.0;                // kConstantArm: c at q = 0
+  double l1_m = 0.0, l2_m = 0.0;    // kTriangle
+  double angle_offset_rad = 0.0;    // kTriangle
   std::vector<double> poly_coeffs;  // kPolynomial, highest power first
-  double area_a_m2 = 0.0;          // piston side
-  double area_b_m2 = 0.0;          // rod side
+  double area_a_m2 = 0.0;           // piston side
+  double area_b_m2 = 0.0;           // rod side
   bool differential_spool = false;  // extension: pump supplies A_A - A_B when extending
   double stroke_m = 0.0;
   double v_max_m_s = 0.0;
@@ -76,7 +77,7 @@ struct Pump {
 };
 
 struct ValveSections {
-  double dead_zone = 0.0;     // fraction of the spool (current) range with no flow
+  double dead_zone = 0.0;  // fraction of the spool (current) range with no flow
   double time_constant_s = 0.0;
   double delay_s = 0.0;
 };

@@ -19,9 +19,8 @@ struct JointRateBounds {
 // Bounds that respect joint velocity limits and bring a joint to rest at its position limit
 // within its acceleration limit (qdot^2 <= 2 a (distance to the limit)), and at the latest in one
 // period. All arguments per joint; positions in the joint's units.
-void joint_rate_bounds(const CraneModel& model, const JointVector& q,
-                       const JointVector& qdot_max, const JointVector& qddot_max, double period_s,
-                       JointRateBounds& out);
+void joint_rate_bounds(const CraneModel& model, const JointVector& q, const JointVector& qdot_max,
+                       const JointVector& qddot_max, double period_s, JointRateBounds& out);
 
 struct SnsResult {
   JointVector qdot;

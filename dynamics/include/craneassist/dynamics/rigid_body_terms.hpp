@@ -19,7 +19,7 @@
 // whole crane rigidly about/along the fixed base axis, which leaves the kinetic energy unchanged),
 // so dH/dq_1 = 0 is not probed.
 //
-// Cost: n + 1 ODE steps for H and g, plus 2 (n - 1) n steps for C qdot when qdot != 0 (37 steps
+// Cost: n + 1 ODE steps for H and g, plus 2 (n - 1) n steps for C qdot when qdot != 0 (29 steps
 // for the 4-joint crane). No heap allocation after construction except what ODE itself does
 // (see rigid_body_terms.cpp). One instance per thread; instances in different threads may run
 // in parallel (each world has its own ODE threading implementation).

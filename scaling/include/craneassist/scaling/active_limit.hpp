@@ -6,12 +6,12 @@ namespace craneassist::scaling {
 
 enum class ActiveLimit {
   kNone,
-  kFlow,            // pump maximum flow
-  kCylinderSpeed,   // a cylinder's maximum speed (valve saturation)
-  kPower,           // prime-mover power (load-sensing pump power limit)
-  kTrackingError,   // the measured tip lags the reference
-  kJointLimit,      // a joint or cylinder end is near
-  kStaleInput,      // no valid operator input
+  kFlow,           // pump maximum flow
+  kCylinderSpeed,  // a cylinder's maximum speed (valve saturation)
+  kPower,          // prime-mover power (load-sensing pump power limit)
+  kTrackingError,  // the measured tip lags the reference
+  kJointLimit,     // a joint or cylinder end is near
+  kStaleInput,     // no valid operator input
 };
 
 const char* to_string(ActiveLimit limit);

@@ -1,0 +1,71 @@
+// Speed of the control cycle and of the simulator (docs/benchmarks.md has the figures).
+//   build/bench/bench_pipeline --benchmark_repetitions=5 --benchmark_report_aggregates_only
+#include <benchmark/benchmark.h>
+
+#include "craneassist/app/controller.hpp"
+#include "craneassist/config/crane_config.hpp"
+#include "craneassist/dynamics/rigid_body_terms.hpp"
+#include "craneassist/sim_backend/sim_backend.hpp"
+
+using namespace craneassist;
+
+namespace {
+
+// One control period (10 ms) of the simulated reference crane moving with every section open:
+// the cost of the simulator per control cycle. real_time_factor = simulated / computer time.
+void BM_SimulatorControlPeriod(benchmark::State& state) {
+  const auto cfg = config::default_crane_config();
+  sim_backend::SimBackend sim(cfg.model, {cfg.simulation.step_s, cfg.simulation.q_initial});
+  valves::ValveCommand cmd;
+  cmd.spool = dynamics::JointVector::Constant(4, 0.7);
+  cmd.spool[3] = 0.0;
+  const double period = 1.0 / cfg.control.rate_hz;
+  int k = 0;
+  for (auto _ : state) {
+    cmd.spool[1] = (k++ / 100) % 2 == 0 ? 0.7 : -0.7;  // reverse the lift every second
+    sim.write(cmd);
+    sim.advance(period);
+  }
+  state.counters["real_time_factor"] = benchmark::Counter(
+      period * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_SimulatorControlPeriod)->Unit(benchmark::kMicrosecond);
+
+// One controller update (redundancy resolution, prescaling, valve mapping) of a moving crane.
+void BM_ControllerUpdate(benchmark::State& state) {
+  const auto cfg = config::default_crane_config();
+  app::Controller controller(cfg, {});
+  valves::MachineState s;
+  s.q = cfg.simulation.q_initial;
+  s.qdot = dynamics::JointVector::Zero(4);
+  s.load_pressure_pa = dynamics::JointVector::Zero(4);
+  s.valid = true;
+  controller.reset(s);
+  app::ControllerOutput out;
+  const Eigen::Vector3d v(0.3, 0.2, 0.4);
+  for (auto _ : state) {
+    controller.update(s, v, out);
+    benchmark::DoNotOptimize(out.valves.spool.data());
+    s.q = out.q_ref;
+  }
+}
+BENCHMARK(BM_ControllerUpdate)->Unit(benchmark::kMicrosecond);
+
+// H(q), C(q,qdot) qdot and g(q) from the ODE model of the reference crane.
+void BM_RigidBodyTerms(benchmark::State& state) {
+  const auto cfg = config::default_crane_config();
+  dynamics::RigidBodyTerms terms(cfg.model);
+  dynamics::DynamicsTerms out;
+  dynamics::JointVector q = cfg.simulation.q_initial;
+  dynamics::JointVector qdot(4);
+  qdot << 0.1, 0.2, -0.2, 0.3;
+  for (auto _ : state) {
+    terms.compute(q, qdot, out);
+    benchmark::DoNotOptimize(out.mass.data());
+  }
+}
+BENCHMARK(BM_RigidBodyTerms)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Set up (Debian packages), build, and run the whole test suite twice: a release build, then a
+# build with AddressSanitizer and UndefinedBehaviorSanitizer. Also checks the formatting.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+tools/install-deps.sh
+jobs="$(nproc)"
+
+echo "== formatting (clang-format)"
+find app bench config dynamics input scaling sim_backend tests valves \( -name '*.cpp' -o -name '*.hpp' \) \
+  -print0 | xargs -0 clang-format --dry-run --Werror
+
+echo "== release build and tests"
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$jobs"
+ctest --test-dir build --output-on-failure -j"$jobs"
+
+echo "== AddressSanitizer + UndefinedBehaviorSanitizer build and tests"
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCRANEASSIST_SANITIZE=ON \
+  -DCRANEASSIST_BUILD_BENCH=OFF >/dev/null
+cmake --build build-asan -j"$jobs"
+ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  ctest --test-dir build-asan --output-on-failure -j"$jobs"
