@@ -66,6 +66,24 @@ void BM_RigidBodyTerms(benchmark::State& state) {
 }
 BENCHMARK(BM_RigidBodyTerms)->Unit(benchmark::kMicrosecond);
 
+// The per-cycle path dynamics m = H f', b = H f'' sdot^2 + C(q, f' sdot) f' sdot + g of the
+// reference crane (2 ODE steps), moving.
+void BM_PathTerms(benchmark::State& state) {
+  const auto cfg = config::default_crane_config();
+  dynamics::RigidBodyTerms terms(cfg.model);
+  dynamics::PathTerms out;
+  const dynamics::JointVector q = cfg.simulation.q_initial;
+  dynamics::JointVector f1(4), f2(4);
+  f1 << 0.1, 0.2, -0.2, 0.3;
+  f2 << 0.02, -0.05, 0.04, 0.01;
+  const double sdot = 0.5;
+  for (auto _ : state) {
+    terms.path_terms(q, f1, f2, sdot, out);
+    benchmark::DoNotOptimize(out.b.data());
+  }
+}
+BENCHMARK(BM_PathTerms)->Unit(benchmark::kMicrosecond);
+
 }  // namespace
 
 BENCHMARK_MAIN();

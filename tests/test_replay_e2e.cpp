@@ -35,13 +35,13 @@ struct ReplayRun {
   double min_elevation_deg = 90.0;  // of the measured tip velocity while moving fast
 };
 
-ReplayRun run(const config::CraneConfig& cfg, const std::string& replay_file, bool scaling,
+ReplayRun run(const config::CraneConfig& cfg, const std::string& replay_file, app::ScalingMode mode,
               const std::filesystem::path& log_path) {
   const auto replay = input::Replay::load_file(kSource + "/examples/replays/" + replay_file);
   sim_backend::SimBackend machine(cfg.model, {cfg.simulation.step_s, cfg.simulation.q_initial});
   app::CsvLog log(log_path, cfg.model.dof());
   app::RunOptions options;
-  options.controller.flow_prescaling = scaling;
+  options.controller.mode = mode;
   ReplayRun r;
   r.summary = app::run_replay(cfg, replay, machine, options, &log);
   // The elevation of the measured tip velocity, from the log (independent of the summary).
@@ -68,8 +68,9 @@ TEST(ReplayEndToEnd, FlowPrescalingKeepsTheTipDirectionWhenThePumpSaturates) {
   const auto cfg = flow_limited_crane();
   const auto dir = std::filesystem::temp_directory_path();
   const ReplayRun unscaled =
-      run(cfg, "combined_move.csv", false, dir / "craneassist_e2e_unscaled.csv");
-  const ReplayRun scaled = run(cfg, "combined_move.csv", true, dir / "craneassist_e2e_scaled.csv");
+      run(cfg, "combined_move.csv", app::ScalingMode::kNone, dir / "craneassist_e2e_unscaled.csv");
+  const ReplayRun scaled = run(cfg, "combined_move.csv", app::ScalingMode::kFlowOnly,
+                               dir / "craneassist_e2e_scaled.csv");
   const double commanded_elevation = std::asin(0.8 / std::sqrt(0.36 + 0.64 + 1.44)) * 180 / M_PI;
 
   // Closing-note figures.
@@ -101,7 +102,7 @@ TEST(ReplayEndToEnd, FlowPrescalingKeepsTheTipDirectionWhenThePumpSaturates) {
 TEST(ReplayEndToEnd, DemoRunsAndLogsEveryDocumentedColumn) {
   const auto cfg = config::default_crane_config();
   const auto log_path = std::filesystem::temp_directory_path() / "craneassist_e2e_demo.csv";
-  const ReplayRun r = run(cfg, "demo.csv", true, log_path);
+  const ReplayRun r = run(cfg, "demo.csv", app::ScalingMode::kFull, log_path);
   const auto replay = input::Replay::load_file(kSource + "/examples/replays/demo.csv");
   EXPECT_EQ(r.summary.cycles, static_cast<int>(std::round((replay.end_time_s() + 1.0) * 100)) + 1);
   EXPECT_EQ(r.summary.log_rows_dropped, 0u);

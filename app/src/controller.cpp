@@ -2,103 +2,184 @@
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
 
 #include "craneassist/dynamics/cylinders.hpp"
 
 namespace craneassist::app {
+namespace {
+
+scaling::PowerBound to_power_bound(config::PowerBoundSetting s) {
+  switch (s) {
+    case config::PowerBoundSetting::kLoadSensing:
+      return scaling::PowerBound::kLoadSensing;
+    case config::PowerBoundSetting::kActuatorSum:
+      return scaling::PowerBound::kActuatorPowerSum;
+    case config::PowerBoundSetting::kNone:
+      return scaling::PowerBound::kNone;
+  }
+  return scaling::PowerBound::kLoadSensing;
+}
+
+}  // namespace
+
+const char* to_string(ScalingMode mode) {
+  switch (mode) {
+    case ScalingMode::kFull:
+      return "full";
+    case ScalingMode::kFlowOnly:
+      return "flow";
+    case ScalingMode::kNone:
+      return "none";
+  }
+  return "?";
+}
 
 Controller::Controller(const config::CraneConfig& config, const ControllerOptions& options)
     : model_(config.model),
       options_(options),
       period_s_(1.0 / config.control.rate_hz),
       flow_reserve_(config.control.flow_reserve),
-      valves_(config.model, config.control.position_gain_1_s) {
+      tracking_error_ok_m_(config.scaling.tracking_error_ok_m),
+      tracking_alpha_(period_s_ / (config.scaling.tracking_error_filter_s + period_s_)),
+      follower_(config.model, config.control.position_gain_1_s, period_s_) {
   const int n = model_.dof();
   q_ref_ = config.simulation.q_initial;
   dc_dq_.setZero(n);
   qddot_max_.setZero(n);
-  c_ref_.setZero(n);
-  c_meas_.setZero(n);
-  valve_in_.velocity_ref_m_s.setZero(n);
-  valve_in_.position_error_m.setZero(n);
-  const double valve_lag_s = model_.valves.delay_s + model_.valves.time_constant_s;
-  c_ref_history_.assign(static_cast<std::size_t>(std::lround(valve_lag_s / period_s_)) + 1,
-                        JointVector::Zero(n));
+  if (options_.mode == ScalingMode::kFull) {
+    const auto& sc = config.scaling;
+    terms_ = std::make_unique<dynamics::RigidBodyTerms>(model_);
+    tip_path_ = std::make_unique<scaling::TipPath>(
+        model_, scaling::TipPathConfig{period_s_, sc.direction_change_acceleration_m_s2,
+                                       sc.jerk_max_m_s3, sc.acceleration_max_m_s2});
+    scaler_ = std::make_unique<scaling::PathScaler>(
+        model_,
+        scaling::PathScalerConfig{period_s_, sc.jerk_max_m_s3, sc.acceleration_max_m_s2,
+                                  flow_reserve_, to_power_bound(sc.power_bound)},
+        *terms_);
+  }
 }
+
+Controller::~Controller() = default;
 
 void Controller::reset(const valves::MachineState& state) {
   q_ref_ = state.q;
-  dynamics::cylinder_lengths(model_, q_ref_, c_ref_);
-  for (auto& c : c_ref_history_) c = c_ref_;
-  history_head_ = 0;
-}
-
-void Controller::stop(ControllerOutput& out) {
-  const int n = model_.dof();
-  out.valves.spool.setZero(n);
-  out.qdot_ref.setZero(n);
-  out.q_ref = q_ref_;
-  out.ref_tip_velocity_m_s.setZero();
-  out.scale = 0.0;
-  out.flow_demand_m3_s = 0.0;
-  out.limit = scaling::ActiveLimit::kStaleInput;
+  follower_.reset(q_ref_);
+  tip_error_filtered_m_ = 0.0;
+  if (tip_path_) tip_path_->reset();
+  if (scaler_) scaler_->reset();
 }
 
 ControllerStatus Controller::update(const valves::MachineState& state, const Eigen::Vector3d& v_cmd,
                                     ControllerOutput& out) {
   const int n = model_.dof();
-  if (!state.valid || state.q.size() != n || !state.q.allFinite() || !v_cmd.allFinite()) {
-    stop(out);
+  const bool state_ok =
+      state.valid && state.q.size() == n && state.q.allFinite() && state.qdot.allFinite();
+  const bool command_ok = v_cmd.allFinite();
+  const bool stale = !state_ok || !command_ok;
+  out.flow_demand_m3_s = 0.0;
+
+  if (options_.mode == ScalingMode::kFull) {
+    update_full(state, command_ok ? v_cmd : Eigen::Vector3d::Zero(), stale, out);
+  } else if (stale) {
+    out.qdot_ref.setZero(n);
+    out.ref_tip_velocity_m_s.setZero();
+    out.scale = 0.0;
+    out.limit = scaling::ActiveLimit::kStaleInput;
+    out.s = out.sdot = out.sddot = out.sdddot = out.sddot_min = out.sddot_max = 0.0;
+  } else {
+    update_rate_prescaled(v_cmd, out);
+  }
+  out.q_ref = q_ref_;
+
+  const bool at_rest = out.qdot_ref.isZero(0.0) && out.sddot == 0.0;
+  if (stale && at_rest) {
+    out.valves.spool.setZero(n);  // stopped: valves neutral
     return ControllerStatus::kStopped;
   }
-  // The reference generator runs on its own state q_ref, so the reference tip path is exactly
-  // the commanded line; the valves' P term makes the machine follow it (a lagging machine does
-  // not bend the reference).
-  dynamics::cylinder_arms(model_, q_ref_, dc_dq_);
-  for (int i = 0; i < n; ++i) {
-    const auto& cyl = model_.cylinders[static_cast<std::size_t>(i)];
-    qddot_max_[i] = cyl.a_max_m_s2 / std::abs(dc_dq_[i]);
+  follower_.update(q_ref_, out.qdot_ref, state_ok ? &state.q : nullptr, out.valves);
+  return stale ? ControllerStatus::kStopping : ControllerStatus::kRunning;
+}
+
+void Controller::update_full(const valves::MachineState& state, const Eigen::Vector3d& v_cmd,
+                             bool stale, ControllerOutput& out) {
+  // Tracking error of the measured tip against the reference of one valve delay ago, filtered.
+  const bool state_ok = state.valid && state.q.size() == model_.dof() && state.q.allFinite();
+  if (state_ok) {
+    const Eigen::Vector3d tip_meas = dynamics::tip_position(model_, kin_, state.q);
+    const Eigen::Vector3d tip_ref =
+        dynamics::tip_position(model_, kin_, follower_.delayed_reference_q());
+    const double error = (tip_ref - tip_meas).norm();
+    tip_error_filtered_m_ += tracking_alpha_ * (error - tip_error_filtered_m_);
   }
 
-  // Redundancy resolution. Its bounds only keep the joints off their ends (end damping); speed
-  // limits are the prescaling's job, applied uniformly.
+  const double s_before = scaler_->state().s;
+  tip_path_->update(q_ref_, v_cmd, scaler_->state().sdot, tip_out_);
+  scaling::PathScalerInput in;
+  in.sdot_request = tip_out_.sdot_request;
+  in.tracking_factor = scaling::tracking_factor(tip_error_filtered_m_, tracking_error_ok_m_);
+  in.sdot_joint_limit = tip_out_.sdot_joint_limit;
+  in.stale_input = stale;
+  scaler_->update(q_ref_, tip_out_.geometry, in, scaler_out_);
+
+  const auto& g = tip_out_.geometry;
+  const auto& st = scaler_out_.state;
+  const double ds = st.s - s_before;
+  for (int i = 0; i < model_.dof(); ++i) {
+    const auto& joint = model_.joints[static_cast<std::size_t>(i)];
+    q_ref_[i] =
+        std::clamp(q_ref_[i] + g.f1[i] * ds + 0.5 * g.f2[i] * ds * ds, joint.q_min, joint.q_max);
+  }
+  out.qdot_ref = g.f1 * st.sdot;
+  out.ref_tip_velocity_m_s = tip_out_.direction * st.sdot;
+  const double v_cmd_norm = v_cmd.norm();
+  out.scale = v_cmd_norm > 0.0 ? st.sdot / v_cmd_norm : 1.0;
+  out.flow_demand_m3_s = scaler_out_.speed.flow_per_speed_m3 * v_cmd_norm;
+  out.limit = scaler_out_.limit;
+  out.s = st.s;
+  out.sdot = st.sdot;
+  out.sddot = st.sddot;
+  out.sdddot = st.sdddot;
+  out.sddot_min = scaler_out_.bounds.sddot_min;
+  out.sddot_max = scaler_out_.bounds.sddot_max;
+  out.tip_error_m = tip_error_filtered_m_;
+  out.ref_power_w = scaling::load_sensing_power(model_, g, scaler_out_.terms, st.sdot, st.sddot);
+}
+
+void Controller::update_rate_prescaled(const Eigen::Vector3d& v_cmd, ControllerOutput& out) {
+  const int n = model_.dof();
+  dynamics::cylinder_arms(model_, q_ref_, dc_dq_);
+  for (int i = 0; i < n; ++i) {
+    qddot_max_[i] = model_.cylinders[static_cast<std::size_t>(i)].a_max_m_s2 / std::abs(dc_dq_[i]);
+  }
+  // Redundancy resolution. Its bounds only keep the joints off their ends; speed limits are the
+  // prescaling's job, applied uniformly.
   dynamics::tip_jacobian(model_, kin_, q_ref_, jacobian_);
   constexpr double kUnbounded = 1e3;
   dynamics::joint_rate_bounds(model_, q_ref_, JointVector::Constant(n, kUnbounded), qddot_max_,
                               period_s_, bounds_);
   dynamics::sns_velocity_ik(jacobian_, v_cmd, bounds_, sns_);
 
-  // Flow prescaling.
   double scale = sns_.task_scale;
   out.limit = sns_.task_scale < 1.0 - 1e-9 ? scaling::ActiveLimit::kJointLimit
                                            : scaling::ActiveLimit::kNone;
   scaling::flow_prescale(model_, dc_dq_, sns_.qdot, flow_reserve_, prescale_);
   out.flow_demand_m3_s = prescale_.flow_demand_m3_s;
-  if (options_.flow_prescaling && prescale_.scale < 1.0) {
+  const bool prescale = options_.mode == ScalingMode::kFlowOnly;
+  if (prescale && prescale_.scale < 1.0) {
     scale *= prescale_.scale;
     out.limit = prescale_.limit;
   }
-  out.qdot_ref = sns_.qdot * (options_.flow_prescaling ? prescale_.scale : 1.0);
+  out.qdot_ref = sns_.qdot * (prescale ? prescale_.scale : 1.0);
   out.scale = v_cmd.norm() > 0.0 ? scale : 1.0;
   out.ref_tip_velocity_m_s = jacobian_ * out.qdot_ref;
-
-  // Reference integration, kept inside the joint ranges.
   for (int i = 0; i < n; ++i) {
     const auto& joint = model_.joints[static_cast<std::size_t>(i)];
     q_ref_[i] = std::clamp(q_ref_[i] + out.qdot_ref[i] * period_s_, joint.q_min, joint.q_max);
   }
-  out.q_ref = q_ref_;
-
-  // Valve commands.
-  dynamics::cylinder_lengths(model_, q_ref_, c_ref_);
-  dynamics::cylinder_lengths(model_, state.q, c_meas_);
-  for (int i = 0; i < n; ++i) valve_in_.velocity_ref_m_s[i] = dc_dq_[i] * out.qdot_ref[i];
-  c_ref_history_[history_head_] = c_ref_;
-  history_head_ = (history_head_ + 1) % c_ref_history_.size();
-  valve_in_.position_error_m = c_ref_history_[history_head_] - c_meas_;  // oldest entry
-  valves_.update(valve_in_, out.valves);
-  return ControllerStatus::kRunning;
+  out.s = out.sdot = out.sddot = out.sdddot = out.sddot_min = out.sddot_max = 0.0;
+  out.tip_error_m = 0.0;
+  out.ref_power_w = 0.0;
 }
 
 }  // namespace craneassist::app

@@ -12,6 +12,7 @@ std::string CsvLog::header(int dof) {
   for (int i = 1; i <= dof; ++i) h += ",q" + std::to_string(i) + "_ref";
   h += ",pump_flow_m3s,pump_pressure_pa,pump_power_w,energy_j,active_limit,scale,flow_demand_m3s,"
        "pump_limit";
+  h += ",s,sdot,sddot,sdddot,sddot_min,sddot_max,tip_error_m,ref_power_w";
   for (int i = 1; i <= dof; ++i) h += ",spool" + std::to_string(i);
   for (int i = 1; i <= dof; ++i) h += ",p_load" + std::to_string(i) + "_pa";
   return h;
@@ -52,6 +53,8 @@ void CsvLog::write_row(const LogRow& r) {
   std::fprintf(file_, ",%.6g,%.6g,%.6g,%.6g,%s,%.6g,%.6g,%s", r.pump_flow_m3s, r.pump_pressure_pa,
                r.pump_power_w, r.energy_j, r.active_limit, r.scale, r.flow_demand_m3s,
                r.pump_limit);
+  std::fprintf(file_, ",%.6f,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g", r.s, r.sdot, r.sddot, r.sdddot,
+               r.sddot_min, r.sddot_max, r.tip_error_m, r.ref_power_w);
   for (int i = 0; i < dof_; ++i) std::fprintf(file_, ",%.5f", r.spool[static_cast<std::size_t>(i)]);
   for (int i = 0; i < dof_; ++i) {
     std::fprintf(file_, ",%.6g", r.load_pressure[static_cast<std::size_t>(i)]);

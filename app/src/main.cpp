@@ -11,6 +11,7 @@
 #include "craneassist/app/csv_log.hpp"
 #include "craneassist/app/embedded_replays.hpp"
 #include "craneassist/app/replay_runner.hpp"
+#include "craneassist/app/sine_path_experiment.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/config/quantity.hpp"
 #include "craneassist/input/replay.hpp"
@@ -31,6 +32,8 @@ struct ReplayArgs {
   std::string log_file = "craneassist-log.csv";
   bool no_log = false;
   bool no_scaling = false;
+  std::string scaling = "full";
+  std::string power_bound;  // empty: the config's
   bool realtime = false;
   double settle_s = 1.0;
   std::optional<double> payload_kg;
@@ -48,12 +51,29 @@ double cli_quantity(const std::string& option, const std::string& text, config::
   return q->si_values[0];
 }
 
+const char* power_bound_name(config::PowerBoundSetting b) {
+  switch (b) {
+    case config::PowerBoundSetting::kLoadSensing:
+      return "load-sensing";
+    case config::PowerBoundSetting::kActuatorSum:
+      return "actuator power sum (baseline)";
+    case config::PowerBoundSetting::kNone:
+      return "none";
+  }
+  return "?";
+}
+
 void print_summary(const app::RunSummary& s, const config::CraneConfig& cfg,
-                   const std::string& replay_name, const ReplayArgs& args, const app::CsvLog* log) {
+                   const std::string& replay_name, app::ScalingMode mode, const app::CsvLog* log) {
   const double speedup = s.wall_time_s > 0.0 ? s.duration_s / s.wall_time_s : 0.0;
   std::printf("craneassist replay: %s on %s\n", replay_name.c_str(), cfg.model.name.c_str());
-  std::printf("  backend %s, scaling %s, control %.0f Hz\n", args.backend.c_str(),
-              args.no_scaling ? "off (--no-scaling)" : "flow prescaling", cfg.control.rate_hz);
+  std::printf("  backend sim, scaling %s, control %.0f Hz, payload %.0f kg\n",
+              mode == app::ScalingMode::kFull ? (std::string("full (power bound: ") +
+                                                 power_bound_name(cfg.scaling.power_bound) + ")")
+                                                    .c_str()
+              : mode == app::ScalingMode::kFlowOnly ? "flow prescaling only"
+                                                    : "none",
+              cfg.control.rate_hz, cfg.model.bodies.back().mass_kg);
   std::printf("  ran %.2f s of machine time in %.3f s (%.0fx real time), %d cycles\n", s.duration_s,
               s.wall_time_s, speedup, s.cycles);
   std::printf("  tip: path %.2f m, peak speed %.2f m/s\n", s.tip_path_m, s.peak_tip_speed_m_s);
@@ -66,6 +86,10 @@ void print_summary(const app::RunSummary& s, const config::CraneConfig& cfg,
       "saturated in %d cycles\n",
       s.energy_j / 1e3, s.peak_power_w / 1e3, cfg.model.pump.prime_mover_power_w / 1e3,
       s.peak_flow_m3_s * 60e3, s.pump_saturated_cycles);
+  if (mode == app::ScalingMode::kFull) {
+    std::printf("  path jerk: peak %.2f m/s^3 (bound %.2f)\n", s.peak_path_jerk,
+                cfg.scaling.jerk_max_m_s3);
+  }
   std::printf("  active limit (cycles):");
   for (std::size_t i = 0; i < s.limit_cycles.size(); ++i) {
     if (s.limit_cycles[i] > 0) {
@@ -87,6 +111,13 @@ int run_replay_command(const ReplayArgs& args) {
     cfg = args.config_file.empty() ? config::default_crane_config()
                                    : config::load_crane_config(args.config_file);
     if (args.payload_kg) config::set_payload_mass(cfg.model, *args.payload_kg);
+    if (args.power_bound == "load_sensing") {
+      cfg.scaling.power_bound = config::PowerBoundSetting::kLoadSensing;
+    } else if (args.power_bound == "actuator_sum") {
+      cfg.scaling.power_bound = config::PowerBoundSetting::kActuatorSum;
+    } else if (args.power_bound == "none") {
+      cfg.scaling.power_bound = config::PowerBoundSetting::kNone;
+    }
     if (!args.pump_max_flow.empty()) {
       cfg.model.pump.max_flow_m3_s =
           cli_quantity("--pump-max-flow", args.pump_max_flow, config::Dimension::kFlow);
@@ -119,7 +150,10 @@ int run_replay_command(const ReplayArgs& args) {
     std::optional<app::CsvLog> log;
     if (!args.no_log) log.emplace(args.log_file, cfg.model.dof());
     app::RunOptions options;
-    options.controller.flow_prescaling = !args.no_scaling;
+    options.controller.mode = args.no_scaling          ? app::ScalingMode::kNone
+                              : args.scaling == "flow" ? app::ScalingMode::kFlowOnly
+                              : args.scaling == "none" ? app::ScalingMode::kNone
+                                                       : app::ScalingMode::kFull;
     options.realtime = args.realtime;
     options.settle_s = args.settle_s;
     spdlog::info("running {} ({:.1f} s) on {} with the {} backend{}", replay_name,
@@ -127,10 +161,73 @@ int run_replay_command(const ReplayArgs& args) {
                  args.realtime ? ", paced at real time" : "");
     const app::RunSummary summary =
         app::run_replay(cfg, replay, machine, options, log ? &*log : nullptr);
-    print_summary(summary, cfg, replay_name, args, log ? &*log : nullptr);
+    print_summary(summary, cfg, replay_name, options.controller.mode, log ? &*log : nullptr);
     if (summary.log_rows_dropped > 0) {
       spdlog::warn("the log writer fell behind: {} rows dropped", summary.log_rows_dropped);
     }
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return kExitRuntime;
+  }
+  return kExitOk;
+}
+
+struct ExperimentArgs {
+  std::string config_file;  // empty: the embedded planar 2R arm
+  std::string power_bound = "load_sensing";
+  double speed = 2.0;
+  double duration_s = 8.0;
+  double jerk_max = 1000.0;
+  std::string log_file = "craneassist-2r.csv";
+  bool no_log = false;
+  bool pump_limiter = false;
+};
+
+int run_experiment_command(const ExperimentArgs& args) {
+  config::CraneConfig cfg;
+  try {
+    cfg = args.config_file.empty() ? config::planar_2r_config()
+                                   : config::load_crane_config(args.config_file);
+  } catch (const config::ConfigError& e) {
+    spdlog::error("config: {}", e.what());
+    return kExitUsage;
+  }
+  if (cfg.model.dof() != 2) {
+    spdlog::error("config: {}: the 2R experiment needs a two-joint model", cfg.source_name);
+    return kExitUsage;
+  }
+  try {
+    app::SinePathOptions options;
+    options.sdot_request = args.speed;
+    options.duration_s = args.duration_s;
+    options.jerk_max = args.jerk_max;
+    options.power_bound = args.power_bound == "actuator_sum"
+                              ? scaling::PowerBound::kActuatorPowerSum
+                          : args.power_bound == "none" ? scaling::PowerBound::kNone
+                                                       : scaling::PowerBound::kLoadSensing;
+    dynamics::JointVector q0, f1, f2;
+    app::sine_path(0.0, q0, f1, f2);
+    options.pump_power_limiter = args.pump_limiter;
+    sim_backend::SimBackend machine(app::machine_model(cfg, options), {cfg.simulation.step_s, q0});
+    std::optional<app::CsvLog> log;
+    if (!args.no_log) log.emplace(args.log_file, cfg.model.dof());
+    const auto s = app::run_sine_path(cfg, options, machine, log ? &*log : nullptr);
+    if (log) log->close();
+    const double p_max = cfg.model.pump.prime_mover_power_w;
+    std::printf("craneassist experiment-2r: %s, f(s) = [pi/6 - sin s, -pi/6 - 0.5 sin s]\n",
+                cfg.model.name.c_str());
+    std::printf("  power bound %s, requested sdot %.2f 1/s, jerk bound %.0f, %d cycles\n",
+                scaling::to_string(options.power_bound), args.speed, args.jerk_max, s.cycles);
+    std::printf("  path covered s = %.2f in %.1f s, peak path jerk %.1f\n", s.s_final,
+                args.duration_s, s.peak_path_jerk);
+    std::printf(
+        "  pump power: measured peak %.2f kW, model-predicted LS peak %.2f kW, limit %.2f kW"
+        " (%+.1f %%)\n",
+        s.peak_pump_power_w / 1e3, s.peak_planned_ls_power_w / 1e3, p_max / 1e3,
+        100.0 * (s.peak_pump_power_w / p_max - 1.0));
+    std::printf("  simulated pump power limiter %s, engaged in %d cycles; energy %.1f kJ\n",
+                args.pump_limiter ? "on" : "off", s.cycles_power_limited, s.energy_j / 1e3);
+    if (log) std::printf("  log: %s (%zu rows)\n", log->path().c_str(), log->rows_written());
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return kExitRuntime;
@@ -163,9 +260,19 @@ int main(int argc, char** argv) {
   replay->add_option("--log", args.log_file, "Per-cycle CSV log (docs/log-format.md)")
       ->capture_default_str();
   replay->add_flag("--no-log", args.no_log, "Do not write the log");
-  replay->add_flag(
-      "--no-scaling", args.no_scaling,
-      "Pass the command through without flow prescaling (to see what scaling prevents)");
+  replay
+      ->add_option("--scaling", args.scaling,
+                   "full: power-limited, jerk-bounded path scaling; flow: flow and cylinder-speed "
+                   "prescaling only; none: the command unscaled")
+      ->check(CLI::IsMember({"full", "flow", "none"}))
+      ->capture_default_str();
+  replay->add_flag("--no-scaling", args.no_scaling,
+                   "Same as --scaling none (to see what scaling prevents)");
+  replay
+      ->add_option("--power-bound", args.power_bound,
+                   "Override the config's power bound: load_sensing, actuator_sum (the older "
+                   "baseline) or none")
+      ->check(CLI::IsMember({"load_sensing", "actuator_sum", "none"}));
   replay->add_flag("--realtime", args.realtime,
                    "Pace the loop at real time (default: as fast as possible)");
   replay->add_option("--settle", args.settle_s, "Seconds to keep running after the last replay row")
@@ -178,12 +285,40 @@ int main(int argc, char** argv) {
   replay->add_option("--prime-mover-power", args.prime_mover_power,
                      "Override the power available to the pump, e.g. \"60 kW\"");
 
+  ExperimentArgs exp;
+  auto* experiment = cli.add_subcommand(
+      "experiment-2r",
+      "Reproduce the 2R experiment of the power-limited scaling paper on the simulated arm");
+  experiment->add_option("--config", exp.config_file, "Two-joint arm config (default: embedded 2R)")
+      ->check(CLI::ExistingFile);
+  experiment
+      ->add_option("--power-bound", exp.power_bound,
+                   "load_sensing (the correct LS bound), actuator_sum (the older baseline) "
+                   "or none")
+      ->check(CLI::IsMember({"load_sensing", "actuator_sum", "none"}))
+      ->capture_default_str();
+  experiment->add_option("--speed", exp.speed, "Requested path speed, 1/s")
+      ->check(CLI::Range(0.01, 20.0))
+      ->capture_default_str();
+  experiment->add_option("--duration", exp.duration_s, "Seconds to run")
+      ->check(CLI::Range(0.1, 600.0))
+      ->capture_default_str();
+  experiment->add_option("--jerk", exp.jerk_max, "Path jerk bound, 1/s^3")
+      ->check(CLI::Range(1.0, 1e6))
+      ->capture_default_str();
+  experiment->add_option("--log", exp.log_file, "Per-cycle CSV log")->capture_default_str();
+  experiment->add_flag("--no-log", exp.no_log, "Do not write the log");
+  experiment->add_flag("--pump-limiter", exp.pump_limiter,
+                       "Keep the simulated pump's power limiter (default: off, so the measured "
+                       "power shows what the trajectory demands)");
+
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     // --help and --version exit 0; every usage error exits 2, like a bad config or replay.
     return cli.exit(e) == 0 ? kExitOk : kExitUsage;
   }
+  if (*experiment) return run_experiment_command(exp);
   if (*replay) {
     try {
       return run_replay_command(args);

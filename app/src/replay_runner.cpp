@@ -41,7 +41,8 @@ RunSummary run_replay(const config::CraneConfig& config, const input::Replay& re
     const double t = k * period;
     machine.read(state);
     const Eigen::Vector3d cmd = cursor.command_at(t);
-    if (controller.update(state, cmd, out) == ControllerStatus::kStopped) ++summary.stopped_cycles;
+    if (controller.update(state, cmd, out) != ControllerStatus::kRunning) ++summary.stopped_cycles;
+    summary.peak_path_jerk = std::max(summary.peak_path_jerk, std::abs(out.sdddot));
     machine.write(out.valves);
 
     // Measured tip position and velocity.
@@ -59,6 +60,11 @@ RunSummary run_replay(const config::CraneConfig& config, const input::Replay& re
     summary.peak_tip_speed_m_s = std::max(summary.peak_tip_speed_m_s, speed);
     if (k > 0) summary.tip_path_m += (tip - last_tip).norm();
     last_tip = tip;
+    // Direction statistics: the reference has been on the command (direction blending done)
+    // for the settling window, and the tip moves.
+    if (!(cmd.norm() > 0.0 && angle_deg(cmd, out.ref_tip_velocity_m_s) < 0.5)) {
+      cmd_since_s = t + period;  // not on the command yet: the window starts later
+    }
     if (cmd.norm() > 0.0 && speed > options.min_speed_m_s &&
         t - cmd_since_s >= options.steady_after_s) {
       const double err = angle_deg(cmd, tip_v);
@@ -98,6 +104,14 @@ RunSummary run_replay(const config::CraneConfig& config, const input::Replay& re
       row.active_limit = scaling::to_string(out.limit);
       row.pump_limit = valves::to_string(state.pump.limit);
       row.scale = out.scale;
+      row.s = out.s;
+      row.sdot = out.sdot;
+      row.sddot = out.sddot;
+      row.sdddot = out.sdddot;
+      row.sddot_min = out.sddot_min;
+      row.sddot_max = out.sddot_max;
+      row.tip_error_m = out.tip_error_m;
+      row.ref_power_w = out.ref_power_w;
       row.flow_demand_m3s = out.flow_demand_m3_s;
       log->push(row);
     }

@@ -330,7 +330,7 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   if (!root.IsMap()) r.fail(root, "", "expected a mapping at the top level");
   r.check_keys(root, "",
                {"format", "name", "frames", "joints", "bodies", "payload", "hydraulics", "control",
-                "simulation"});
+                "scaling", "simulation"});
   const std::string format = r.text(root, "format", "");
   if (format != kFormat) {
     r.fail(root["format"], "format",
@@ -357,6 +357,35 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
                                              Dimension::kInverseTime, 0.0, 1000.0, "0 to 1000 1/s");
   cfg.control.flow_reserve = r.value_in(control, "flow_reserve", "control",
                                         Dimension::kDimensionless, 0.0, 0.5, "between 0 and 0.5");
+
+  const YAML::Node scaling = r.child(root, "scaling", "");
+  const std::string sp = "scaling";
+  r.check_keys(scaling, sp,
+               {"jerk_max", "acceleration_max", "direction_change_acceleration",
+                "tracking_error_ok", "tracking_error_filter", "power_bound"});
+  auto& sc = cfg.scaling;
+  sc.jerk_max_m_s3 =
+      r.value_in(scaling, "jerk_max", sp, Dimension::kJerk, 1e-3, 1e4, "between 0.001 and 10000");
+  sc.acceleration_max_m_s2 = r.value_in(scaling, "acceleration_max", sp, Dimension::kAcceleration,
+                                        1e-3, 100.0, "between 0.001 and 100");
+  sc.direction_change_acceleration_m_s2 =
+      r.value_in(scaling, "direction_change_acceleration", sp, Dimension::kAcceleration, 1e-3,
+                 100.0, "between 0.001 and 100");
+  sc.tracking_error_ok_m = r.value_in(scaling, "tracking_error_ok", sp, Dimension::kLength, 1e-4,
+                                      10.0, "between 0.1 mm and 10 m");
+  sc.tracking_error_filter_s = r.value_in(scaling, "tracking_error_filter", sp, Dimension::kTime,
+                                          0.0, 10.0, "between 0 and 10 s");
+  const std::string bound = r.text(scaling, "power_bound", sp);
+  if (bound == "load_sensing") {
+    sc.power_bound = PowerBoundSetting::kLoadSensing;
+  } else if (bound == "actuator_sum") {
+    sc.power_bound = PowerBoundSetting::kActuatorSum;
+  } else if (bound == "none") {
+    sc.power_bound = PowerBoundSetting::kNone;
+  } else {
+    r.fail(scaling["power_bound"], sp + ".power_bound",
+           "expected load_sensing, actuator_sum or none, got '" + bound + "'");
+  }
 
   const YAML::Node sim = r.child(root, "simulation", "");
   r.check_keys(sim, "simulation", {"step", "initial"});

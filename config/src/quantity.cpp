@@ -16,18 +16,31 @@ struct UnitDef {
 constexpr double kPi = std::numbers::pi;
 
 constexpr UnitDef kUnits[] = {
-    {"m", Dimension::kLength, 1.0},           {"mm", Dimension::kLength, 1e-3},
-    {"cm", Dimension::kLength, 1e-2},         {"rad", Dimension::kAngle, 1.0},
-    {"deg", Dimension::kAngle, kPi / 180.0},  {"kg", Dimension::kMass, 1.0},
-    {"kg*m^2", Dimension::kInertia, 1.0},     {"m/s", Dimension::kVelocity, 1.0},
-    {"mm/s", Dimension::kVelocity, 1e-3},     {"m/s^2", Dimension::kAcceleration, 1.0},
-    {"m^2", Dimension::kArea, 1.0},           {"cm^2", Dimension::kArea, 1e-4},
-    {"mm^2", Dimension::kArea, 1e-6},         {"m^3/s", Dimension::kFlow, 1.0},
-    {"L/min", Dimension::kFlow, 1e-3 / 60.0}, {"Pa", Dimension::kPressure, 1.0},
-    {"kPa", Dimension::kPressure, 1e3},       {"MPa", Dimension::kPressure, 1e6},
-    {"bar", Dimension::kPressure, 1e5},       {"W", Dimension::kPower, 1.0},
-    {"kW", Dimension::kPower, 1e3},           {"s", Dimension::kTime, 1.0},
-    {"ms", Dimension::kTime, 1e-3},           {"Hz", Dimension::kFrequency, 1.0},
+    {"m", Dimension::kLength, 1.0},
+    {"mm", Dimension::kLength, 1e-3},
+    {"cm", Dimension::kLength, 1e-2},
+    {"rad", Dimension::kAngle, 1.0},
+    {"deg", Dimension::kAngle, kPi / 180.0},
+    {"kg", Dimension::kMass, 1.0},
+    {"kg*m^2", Dimension::kInertia, 1.0},
+    {"m/s", Dimension::kVelocity, 1.0},
+    {"mm/s", Dimension::kVelocity, 1e-3},
+    {"m/s^2", Dimension::kAcceleration, 1.0},
+    {"m/s^3", Dimension::kJerk, 1.0},
+    {"m^2", Dimension::kArea, 1.0},
+    {"cm^2", Dimension::kArea, 1e-4},
+    {"mm^2", Dimension::kArea, 1e-6},
+    {"m^3/s", Dimension::kFlow, 1.0},
+    {"L/min", Dimension::kFlow, 1e-3 / 60.0},
+    {"Pa", Dimension::kPressure, 1.0},
+    {"kPa", Dimension::kPressure, 1e3},
+    {"MPa", Dimension::kPressure, 1e6},
+    {"bar", Dimension::kPressure, 1e5},
+    {"W", Dimension::kPower, 1.0},
+    {"kW", Dimension::kPower, 1e3},
+    {"s", Dimension::kTime, 1.0},
+    {"ms", Dimension::kTime, 1e-3},
+    {"Hz", Dimension::kFrequency, 1.0},
     {"1/s", Dimension::kInverseTime, 1.0},
 };
 
@@ -65,6 +78,8 @@ const char* to_string(Dimension d) {
       return "velocity";
     case Dimension::kAcceleration:
       return "acceleration";
+    case Dimension::kJerk:
+      return "jerk";
     case Dimension::kArea:
       return "area";
     case Dimension::kFlow:

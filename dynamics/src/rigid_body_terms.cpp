@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "craneassist/dynamics/kinematics.hpp"
 #include "craneassist/dynamics/ode_crane.hpp"
 
 // Allocation. dWorldStep takes its working memory (island lists, constraint Jacobian, the LCP
@@ -17,6 +18,10 @@
 namespace craneassist::dynamics {
 
 namespace {
+
+Eigen::Vector3d vec(const dReal* v) {
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
 
 JointVector mid_range(const CraneModel& model) {
   JointVector q = JointVector::Zero(model.dof());
@@ -63,9 +68,30 @@ RigidBodyTerms::RigidBodyTerms(const CraneModel& model)
     mass_plus_ = JointMatrix::Zero(n_, n_);
     mass_minus_ = JointMatrix::Zero(n_, n_);
     identity_ = JointMatrix::Identity(n_, n_);
-    // Warm-up: the first dWorldStep allocates ODE's step arena.
+    path_acc_ = JointVector::Zero(n_);
+    path_qdot_ = JointVector::Zero(n_);
+    for (int i = 1; i <= n_; ++i) {
+      dMass mass;
+      dBodyGetMass(crane_->body(i), &mass);  // inertia in body axes, about the centre of mass
+      for (int row = 0; row < 3; ++row) {
+        for (int col = 0; col < 3; ++col) inertia_body_[i](row, col) = mass.I[4 * row + col];
+      }
+      // Motor reactions of path_terms(); ODE fills these on every step.
+      dJointSetFeedback(crane_->joint(i), &feedback_[i]);
+      // Rigid motor rows (the motor CFM defaults to the world's CFM at joint creation; say it).
+      if (crane_->model().joints[i - 1].type == JointType::kRevolute) {
+        dJointSetHingeParam(crane_->joint(i), dParamCFM, 0.0);
+      } else {
+        dJointSetSliderParam(crane_->joint(i), dParamCFM, 0.0);
+      }
+    }
+    // Warm-up: the first dWorldStep allocates ODE's step arena; the motor steps of path_terms()
+    // have n more constraint rows, so size it for those too.
     probe_mass_matrix(q0, mass_plus_);
     probe_gravity_acceleration(q0, qddot_);
+    PathTerms warm_up;
+    const JointVector ones = JointVector::Ones(n_);
+    path_terms(q0, ones, ones, 1.0, warm_up);
   } catch (...) {
     release();
     throw;
@@ -85,6 +111,7 @@ void RigidBodyTerms::release() {
 
 void RigidBodyTerms::step_from_rest(const JointVector& q, const JointVector& effort,
                                     bool with_gravity, JointVector& qddot) {
+  power_motors(false);
   crane_->set_state(q, zero_);
   for (int i = 1; i <= n_; ++i) {
     dBodySetForce(crane_->body(i), 0.0, 0.0, 0.0);
@@ -161,6 +188,113 @@ void RigidBodyTerms::compute(const JointVector& q, const JointVector& qdot, Dyna
   probe_gravity_acceleration(q, qddot_);
   out.gravity.noalias() = -out.mass * qddot_;
   coriolis(q, qdot, out.coriolis);
+}
+
+void RigidBodyTerms::power_motors(bool on) {
+  if (on == motors_on_) return;
+  // dInfinity makes the motor row an unbounded (equality) row of ODE's LCP; 0 removes the row.
+  const double fmax = on ? dInfinity : 0.0;
+  for (int i = 1; i <= n_; ++i) {
+    if (crane_->model().joints[i - 1].type == JointType::kRevolute) {
+      dJointSetHingeParam(crane_->joint(i), dParamFMax, fmax);
+    } else {
+      dJointSetSliderParam(crane_->joint(i), dParamFMax, fmax);
+    }
+  }
+  motors_on_ = on;
+}
+
+void RigidBodyTerms::motor_step(const JointVector& q, const JointVector& qddot, bool with_gravity,
+                                const JointVector* velocity_products, JointVector& effort) {
+  power_motors(true);
+  crane_->set_state(q, zero_);
+  for (int i = 1; i <= n_; ++i) {
+    dBodySetForce(crane_->body(i), 0.0, 0.0, 0.0);
+    dBodySetTorque(crane_->body(i), 0.0, 0.0, 0.0);
+    // From rest the motor row enforces rate = dParamVel after the step: dt * qddot.
+    const double rate = kProbeStepS * qddot[i - 1];
+    if (crane_->model().joints[i - 1].type == JointType::kRevolute) {
+      dJointSetHingeParam(crane_->joint(i), dParamVel, rate);
+    } else {
+      dJointSetSliderParam(crane_->joint(i), dParamVel, rate);
+    }
+  }
+  if (with_gravity) {
+    dWorldSetGravity(world_, gravity_m_s2_.x(), gravity_m_s2_.y(), gravity_m_s2_.z());
+  } else {
+    dWorldSetGravity(world_, 0.0, 0.0, 0.0);
+  }
+  if (velocity_products != nullptr) add_velocity_product_wrenches(*velocity_products);
+  if (dWorldStep(world_, kProbeStepS) == 0) {
+    throw std::runtime_error("RigidBodyTerms: dWorldStep failed (out of memory)");
+  }
+  read_motor_efforts(effort);
+}
+
+void RigidBodyTerms::add_velocity_product_wrenches(const JointVector& qdot) {
+  // Forward recursion at qddot = 0 in base-frame coordinates: w = angular velocity of frame i,
+  // alpha = its angular acceleration, acc = acceleration of its origin o_i. The axis z_{i-1} is
+  // fixed in frame i-1; o_i - o_{i-1} is fixed in frame i for a hinge (o_{i-1} is on its axis)
+  // and grows by z_{i-1} qdot_i for a slider.
+  const KinematicsData& kin = crane_->kinematics();
+  Eigen::Vector3d w = Eigen::Vector3d::Zero();
+  Eigen::Vector3d alpha = Eigen::Vector3d::Zero();
+  Eigen::Vector3d acc = Eigen::Vector3d::Zero();
+  for (int i = 1; i <= n_; ++i) {
+    const Eigen::Vector3d z = kin.frames[i - 1].linear().col(2);
+    const Eigen::Vector3d link = kin.frames[i].translation() - kin.frames[i - 1].translation();
+    const double rate = qdot[i - 1];
+    if (crane_->model().joints[i - 1].type == JointType::kRevolute) {
+      alpha += w.cross(z * rate);
+      w += z * rate;
+      acc += alpha.cross(link) + w.cross(w.cross(link));
+    } else {
+      acc += alpha.cross(link) + w.cross(w.cross(link)) + 2.0 * w.cross(z * rate);
+    }
+    const Eigen::Matrix3d& r = kin.frames[i].linear();
+    const Eigen::Vector3d arm = r * crane_->com_local(i);
+    const Eigen::Vector3d acc_com = acc + alpha.cross(arm) + w.cross(w.cross(arm));
+    const Eigen::Matrix3d inertia = r * inertia_body_[i] * r.transpose();
+    const Eigen::Vector3d force = crane_->mass(i) * acc_com;
+    const Eigen::Vector3d torque = inertia * alpha + w.cross(inertia * w);  // about the CoM
+    dBodyAddForce(crane_->body(i), -force.x(), -force.y(), -force.z());
+    dBodyAddTorque(crane_->body(i), -torque.x(), -torque.y(), -torque.z());
+  }
+}
+
+void RigidBodyTerms::read_motor_efforts(JointVector& effort) const {
+  // Geometry of the set_state() pose, which is the pose ODE built the constraint rows at (the
+  // step has since moved the bodies). Joint i attaches body i first, so f1, t1 act on the child.
+  const KinematicsData& kin = crane_->kinematics();
+  effort.resize(n_);
+  for (int i = 1; i <= n_; ++i) {
+    const dJointFeedback& fb = feedback_[i];
+    const Eigen::Vector3d z = kin.frames[i - 1].linear().col(2);
+    const Eigen::Vector3d f1 = vec(fb.f1);
+    if (crane_->model().joints[i - 1].type == JointType::kRevolute) {
+      // Moment about the hinge axis through o_{i-1} of the wrench on the child.
+      const Eigen::Vector3d com = kin.frames[i] * crane_->com_local(i);
+      const Eigen::Vector3d arm = com - kin.frames[i - 1].translation();
+      effort[i - 1] = z.dot(vec(fb.t1) + arm.cross(f1));
+    } else {
+      effort[i - 1] = z.dot(f1);
+    }
+  }
+}
+
+void RigidBodyTerms::path_terms(const JointVector& q, const JointVector& f1, const JointVector& f2,
+                                double sdot, PathTerms& out) {
+  // m = H f': gravity off, no external wrenches, motors at qddot = f'.
+  motor_step(q, f1, false, nullptr, out.m);
+  // b = H f'' sdot^2 + C(q, f' sdot) f' sdot + g.
+  const double sdot2 = sdot * sdot;
+  path_acc_ = f2 * sdot2;
+  if (sdot == 0.0) {
+    motor_step(q, path_acc_, true, nullptr, out.b);
+    return;
+  }
+  path_qdot_ = f1 * sdot;
+  motor_step(q, path_acc_, true, &path_qdot_, out.b);
 }
 
 }  // namespace craneassist::dynamics

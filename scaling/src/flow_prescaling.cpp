@@ -20,6 +20,8 @@ const char* to_string(ActiveLimit limit) {
       return "tracking_error";
     case ActiveLimit::kJointLimit:
       return "joint_limit";
+    case ActiveLimit::kCylinderAcceleration:
+      return "cylinder_acceleration";
     case ActiveLimit::kStaleInput:
       return "stale_input";
   }

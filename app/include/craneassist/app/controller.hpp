@@ -1,78 +1,106 @@
-// The per-cycle control pipeline, read top to bottom (MoveIt Servo's shape):
+// The per-cycle control pipeline, read top to bottom (MoveIt Servo's shape). With full scaling
+// (the default):
 //   tip-velocity command
-//   -> redundancy resolution (joint-limited pseudo-inverse, SNS)
-//   -> flow prescaling (pump flow and cylinder speeds, uniform so the tip keeps its direction)
-//   -> reference integration (the reference runs on its own joint state q_ref)
-//   -> valve commands (dead-zone inverse of the cylinder velocity reference plus P feedback on
-//      the cylinder position error)
+//   -> path-velocity decomposition: direction (blended) and speed    scaling::TipPath
+//   -> redundancy resolution of the direction (SNS), f' and f''      scaling::TipPath
+//   -> speed limits: flow, cylinder speeds, end damping, power, tracking error
+//   -> acceleration bounds from the ODE dynamics (load-sensing power, cylinder accelerations)
+//   -> jerk-bounded scaling filter: s, sdot, sddot, sdddot           scaling::PathScaler
+//   -> reference integration along the path (the reference runs on its own joint state q_ref)
+//   -> valve commands: dead-zone inverse of the cylinder velocity reference plus P feedback on
+//      the cylinder position error against the reference of one valve delay ago
+// The other modes are baselines: kFlowOnly prescales the joint rates for flow and cylinder speed
+// only (no power limit, no filter); kNone passes the command through unscaled.
 // Constructed once with the model; update() allocates nothing and throws nothing.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
 #include "craneassist/dynamics/redundancy.hpp"
+#include "craneassist/dynamics/rigid_body_terms.hpp"
 #include "craneassist/scaling/active_limit.hpp"
 #include "craneassist/scaling/flow_prescaling.hpp"
+#include "craneassist/scaling/path_scaler.hpp"
+#include "craneassist/scaling/tip_path.hpp"
 #include "craneassist/valves/machine_interface.hpp"
-#include "craneassist/valves/proportional_valves.hpp"
+#include "craneassist/valves/reference_follower.hpp"
 
 namespace craneassist::app {
 
 using dynamics::JointVector;
 
+enum class ScalingMode {
+  kFull,      // power-limited, jerk-bounded path scaling
+  kFlowOnly,  // uniform flow and cylinder-speed prescaling only
+  kNone,      // no scaling (what a machine without craneassist does)
+};
+const char* to_string(ScalingMode mode);
+
 struct ControllerOptions {
-  bool flow_prescaling = true;  // false: --no-scaling (what a machine without craneassist does)
+  ScalingMode mode = ScalingMode::kFull;
 };
 
 struct ControllerOutput {
   valves::ValveCommand valves;
   JointVector q_ref, qdot_ref;
   Eigen::Vector3d ref_tip_velocity_m_s = Eigen::Vector3d::Zero();
-  double scale = 1.0;  // total factor applied to the commanded tip speed
-  double flow_demand_m3_s = 0.0;
+  double scale = 1.0;             // reference tip speed over commanded tip speed
+  double flow_demand_m3_s = 0.0;  // of the unscaled command
   scaling::ActiveLimit limit = scaling::ActiveLimit::kNone;
+  // Path scaling (kFull; zero otherwise).
+  double s = 0.0, sdot = 0.0, sddot = 0.0, sdddot = 0.0;
+  double sddot_min = 0.0, sddot_max = 0.0;
+  double tip_error_m = 0.0;  // filtered tracking error used for the slow-down
+  double ref_power_w = 0.0;  // LS pump power the model predicts for the reference
 };
 
-enum class ControllerStatus { kRunning, kStopped };
+enum class ControllerStatus { kRunning, kStopping, kStopped };
 
 class Controller {
  public:
   Controller(const config::CraneConfig& config, const ControllerOptions& options);
+  ~Controller();
 
-  // Starts the reference at the measured configuration.
+  // Starts the reference at the measured configuration, at rest.
   void reset(const valves::MachineState& state);
 
-  // One control period. An invalid measurement or a non-finite command stops the motion
-  // (neutral valves, kStaleInput) and returns kStopped.
+  // One control period. An invalid measurement or a non-finite command brings the motion to a
+  // jerk-limited stop along the current direction (kStopping, limit stale_input) and then holds
+  // with neutral valves (kStopped); the other modes stop at once.
   ControllerStatus update(const valves::MachineState& state, const Eigen::Vector3d& v_cmd_m_s,
                           ControllerOutput& out);
 
   double period_s() const { return period_s_; }
 
  private:
-  void stop(ControllerOutput& out);
+  void update_full(const valves::MachineState& state, const Eigen::Vector3d& v_cmd, bool stale,
+                   ControllerOutput& out);
+  void update_rate_prescaled(const Eigen::Vector3d& v_cmd, ControllerOutput& out);
 
   const dynamics::CraneModel& model_;
   ControllerOptions options_;
   double period_s_;
   double flow_reserve_;
-  valves::ProportionalValves valves_;
+  double tracking_error_ok_m_;
+  double tracking_alpha_;
+  valves::ReferenceFollower follower_;
+  std::unique_ptr<dynamics::RigidBodyTerms> terms_;
+  std::unique_ptr<scaling::TipPath> tip_path_;
+  std::unique_ptr<scaling::PathScaler> scaler_;
   // Per-cycle working data (Pinocchio's Data), preallocated.
   dynamics::KinematicsData kin_;
   dynamics::TaskJacobian jacobian_;
   dynamics::JointRateBounds bounds_;
   dynamics::SnsResult sns_;
   scaling::FlowPrescalingResult prescale_;
-  JointVector dc_dq_, qddot_max_, c_ref_, c_meas_;
-  valves::ProportionalValvesInput valve_in_;
+  scaling::TipPathOutput tip_out_;
+  scaling::PathScalerOutput scaler_out_;
+  JointVector dc_dq_, qddot_max_;
   JointVector q_ref_;
-  // Cylinder position references of the last cycles: the P term compares the measurement with
-  // the reference of one valve delay (transport delay plus spool lag) ago, so the valve's own
-  // dead time is not mistaken for a tracking error (a Smith-predictor-style compensation).
-  std::vector<JointVector> c_ref_history_;
-  std::size_t history_head_ = 0;
+  double tip_error_filtered_m_ = 0.0;
 };
 
 }  // namespace craneassist::app

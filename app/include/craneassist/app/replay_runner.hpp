@@ -15,8 +15,9 @@ struct RunOptions {
   ControllerOptions controller;
   bool realtime = false;  // pace the loop at the control rate
   double settle_s = 1.0;  // keep running this long after the last replay row
-  // Direction statistics count a cycle when the command has been steady this long and the
-  // measured tip moves faster than min_speed_m_s.
+  // Direction statistics count a cycle when the reference direction has been on the command
+  // (within 0.5 deg, i.e. direction blending done) this long and the measured tip moves faster
+  // than min_speed_m_s.
   double steady_after_s = 0.5;
   double min_speed_m_s = 0.05;
 };
@@ -37,8 +38,9 @@ struct RunSummary {
   // Angle between commanded and reference tip velocity (what the controller asked for).
   double max_reference_direction_error_deg = 0.0;
   int pump_saturated_cycles = 0;
+  double peak_path_jerk = 0.0;  // max |sdddot| of the reference (full scaling)
   int stopped_cycles = 0;
-  std::array<int, 7> limit_cycles{};  // indexed by scaling::ActiveLimit
+  std::array<int, scaling::kActiveLimitCount> limit_cycles{};  // indexed by scaling::ActiveLimit
   std::size_t log_rows_dropped = 0;
 };
 

@@ -17,6 +17,18 @@ struct ControlSettings {
   double flow_reserve = 0.0;
 };
 
+// The path scaling of the tip motion (docs/scaling.md).
+enum class PowerBoundSetting { kLoadSensing, kActuatorSum, kNone };
+
+struct ScalingSettings {
+  double jerk_max_m_s3 = 4.0;                       // path jerk bound
+  double acceleration_max_m_s2 = 1.0;               // path acceleration bound
+  double direction_change_acceleration_m_s2 = 0.6;  // tip normal acceleration when turning
+  double tracking_error_ok_m = 0.05;                // slow-down threshold e_ok
+  double tracking_error_filter_s = 0.05;            // first-order filter on the tip error
+  PowerBoundSetting power_bound = PowerBoundSetting::kLoadSensing;
+};
+
 struct SimulationSettings {
   double step_s = 1e-3;
   dynamics::JointVector q_initial;
@@ -25,6 +37,7 @@ struct SimulationSettings {
 struct CraneConfig {
   dynamics::CraneModel model;
   ControlSettings control;
+  ScalingSettings scaling;
   SimulationSettings simulation;
   std::string source_name;  // file the config came from, or "<embedded k70m.yaml>"
   // Number of quantities in the file that do not state where they come from.

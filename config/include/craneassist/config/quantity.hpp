@@ -19,6 +19,7 @@ enum class Dimension {
   kInertia,
   kVelocity,
   kAcceleration,
+  kJerk,
   kArea,
   kFlow,
   kPressure,

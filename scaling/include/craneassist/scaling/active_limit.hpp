@@ -6,13 +6,15 @@ namespace craneassist::scaling {
 
 enum class ActiveLimit {
   kNone,
-  kFlow,           // pump maximum flow
-  kCylinderSpeed,  // a cylinder's maximum speed (valve saturation)
-  kPower,          // prime-mover power (load-sensing pump power limit)
-  kTrackingError,  // the measured tip lags the reference
-  kJointLimit,     // a joint or cylinder end is near
-  kStaleInput,     // no valid operator input
+  kFlow,                  // pump maximum flow
+  kCylinderSpeed,         // a cylinder's maximum speed (valve saturation)
+  kPower,                 // prime-mover power (load-sensing pump power limit)
+  kTrackingError,         // the measured tip lags the reference
+  kJointLimit,            // a joint or cylinder end is near
+  kStaleInput,            // no valid operator input
+  kCylinderAcceleration,  // a cylinder's maximum acceleration (path curvature at speed)
 };
+inline constexpr int kActiveLimitCount = 8;
 
 const char* to_string(ActiveLimit limit);
 

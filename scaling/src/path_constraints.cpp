@@ -1,0 +1,161 @@
+#include "craneassist/scaling/path_constraints.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace craneassist::scaling {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kTinyRate = 1e-12;
+
+// Direction of cylinder i along the path (+1 extending, -1 retracting, 0 not moving).
+double motion_sign(const PathGeometry& path, int i) {
+  const double v = path.dc_dq[i] * path.f1[i];
+  if (std::abs(v) < kTinyRate) return 0.0;
+  return v > 0.0 ? 1.0 : -1.0;
+}
+
+// One side of a linear inequality k x + c <= limit, folded into [lo, hi].
+void apply_upper(double k, double c, double limit, ActiveLimit kind, AccelerationBounds& b) {
+  if (k > kTinyRate) {
+    const double x = (limit - c) / k;
+    if (x < b.sddot_max) {
+      b.sddot_max = x;
+      b.limit_max = kind;
+    }
+  } else if (k < -kTinyRate) {
+    const double x = (limit - c) / k;
+    if (x > b.sddot_min) {
+      b.sddot_min = x;
+      b.limit_min = kind;
+    }
+  } else if (c > limit) {
+    // Not satisfiable by any acceleration at this speed: ask for the strongest deceleration the
+    // other bounds allow; the speed limits bring the speed itself down.
+    b.sddot_max = -kInf;
+    b.limit_max = kind;
+  }
+}
+
+}  // namespace
+
+const char* to_string(PowerBound bound) {
+  switch (bound) {
+    case PowerBound::kLoadSensing:
+      return "load_sensing";
+    case PowerBound::kActuatorPowerSum:
+      return "actuator_sum";
+    case PowerBound::kNone:
+      return "none";
+  }
+  return "?";
+}
+
+void path_speed_limits(const dynamics::CraneModel& model, const PathGeometry& path,
+                       double flow_reserve, SpeedLimits& out) {
+  out.sdot_cylinder = kInf;
+  out.cylinder = -1;
+  double flow = 0.0;
+  for (int i = 0; i < model.dof(); ++i) {
+    const auto& cyl = model.cylinders[static_cast<std::size_t>(i)];
+    const double v = path.dc_dq[i] * path.f1[i];  // cylinder velocity per unit path speed
+    flow += dynamics::flow_area_m2(cyl, v) * std::abs(v);
+    if (std::abs(v) > kTinyRate && cyl.v_max_m_s / std::abs(v) < out.sdot_cylinder) {
+      out.sdot_cylinder = cyl.v_max_m_s / std::abs(v);
+      out.cylinder = i;
+    }
+  }
+  out.flow_per_speed_m3 = flow;
+  out.sdot_flow = flow > 0.0 ? model.pump.max_flow_m3_s * (1.0 - flow_reserve) / flow : kInf;
+}
+
+void path_acceleration_bounds(const dynamics::CraneModel& model, const PathGeometry& path,
+                              const dynamics::PathTerms& terms, double sdot,
+                              const AccelerationLimits& limits, AccelerationBounds& b) {
+  const int n = model.dof();
+  b.sddot_min = -limits.path_acceleration_max;
+  b.sddot_max = limits.path_acceleration_max;
+  b.limit_min = ActiveLimit::kNone;
+  b.limit_max = ActiveLimit::kNone;
+  b.sdot_power = kInf;
+  b.sdot_acceleration = kInf;
+  b.pressure_limit_pa = kInf;
+  const double speed = std::max(sdot, 0.0);
+
+  // Cylinder accelerations a_i = (r'_i f1_i^2 + r_i f2_i) sdot^2 + r_i f1_i sddot.
+  for (int i = 0; i < n; ++i) {
+    const double a_max = model.cylinders[static_cast<std::size_t>(i)].a_max_m_s2;
+    const double k = path.dc_dq[i] * path.f1[i];
+    const double curvature = path.d2c_dq2[i] * path.f1[i] * path.f1[i] + path.dc_dq[i] * path.f2[i];
+    const double c = curvature * speed * speed;
+    if (std::abs(curvature) > 0.0) {
+      b.sdot_acceleration = std::min(b.sdot_acceleration, std::sqrt(a_max / std::abs(curvature)));
+    }
+    apply_upper(k, c, a_max, ActiveLimit::kNone, b);
+    apply_upper(-k, -c, a_max, ActiveLimit::kNone, b);
+  }
+
+  const auto& pump = model.pump;
+  if (limits.power_bound == PowerBound::kLoadSensing) {
+    double flow_per_speed = 0.0;
+    double max_static_pressure = -kInf;
+    for (int i = 0; i < n; ++i) {
+      const double sign = motion_sign(path, i);
+      if (sign == 0.0) continue;
+      const auto& cyl = model.cylinders[static_cast<std::size_t>(i)];
+      const double v = path.dc_dq[i] * path.f1[i];
+      flow_per_speed += dynamics::flow_area_m2(cyl, v) * std::abs(v);
+      const double scale = sign / (path.dc_dq[i] * dynamics::flow_area_m2(cyl, v));
+      max_static_pressure = std::max(max_static_pressure, scale * terms.b[i]);
+    }
+    const double flow = flow_per_speed * speed;
+    const double p_power = flow > 0.0 ? pump.prime_mover_power_w / flow - pump.ls_margin_pa : kInf;
+    const double p_relief = pump.max_pressure_pa - pump.ls_margin_pa;
+    b.pressure_limit_pa = std::min(p_power, p_relief);
+    for (int i = 0; i < n; ++i) {
+      const double sign = motion_sign(path, i);
+      if (sign == 0.0) continue;
+      const double area = dynamics::flow_area_m2(model.cylinders[static_cast<std::size_t>(i)],
+                                                 path.dc_dq[i] * path.f1[i]);
+      const double scale = sign / (path.dc_dq[i] * area);
+      apply_upper(scale * terms.m[i], scale * terms.b[i], b.pressure_limit_pa, ActiveLimit::kPower,
+                  b);
+    }
+    // Quasi-static limit: the speed at which the current loads take exactly P_max at sddot = 0.
+    if (flow_per_speed > 0.0) {
+      const double p_supply = std::max(max_static_pressure, 0.0) + pump.ls_margin_pa;
+      b.sdot_power = p_supply > p_relief + pump.ls_margin_pa
+                         ? 0.0
+                         : pump.prime_mover_power_w / (p_supply * flow_per_speed);
+    }
+  } else if (limits.power_bound == PowerBound::kActuatorPowerSum) {
+    // |sdot f1 . (m sddot + b)| <= P_max
+    const double k = speed * path.f1.dot(terms.m);
+    const double c = speed * path.f1.dot(terms.b);
+    apply_upper(k, c, pump.prime_mover_power_w, ActiveLimit::kPower, b);
+    apply_upper(-k, -c, pump.prime_mover_power_w, ActiveLimit::kPower, b);
+    const double static_power_per_speed = std::abs(path.f1.dot(terms.b));
+    if (static_power_per_speed > 0.0) {
+      b.sdot_power = pump.prime_mover_power_w / static_power_per_speed;
+    }
+  }
+}
+
+double load_sensing_power(const dynamics::CraneModel& model, const PathGeometry& path,
+                          const dynamics::PathTerms& terms, double sdot, double sddot) {
+  double flow = 0.0;
+  double p_max = 0.0;
+  for (int i = 0; i < model.dof(); ++i) {
+    const double sign = motion_sign(path, i);
+    if (sign == 0.0) continue;
+    const double v = path.dc_dq[i] * path.f1[i];
+    const double area = dynamics::flow_area_m2(model.cylinders[static_cast<std::size_t>(i)], v);
+    flow += area * std::abs(v) * sdot;
+    p_max = std::max(p_max, sign * (terms.m[i] * sddot + terms.b[i]) / (path.dc_dq[i] * area));
+  }
+  return (p_max + model.pump.ls_margin_pa) * flow;
+}
+
+}  // namespace craneassist::scaling

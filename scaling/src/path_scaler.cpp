@@ -1,0 +1,77 @@
+#include "craneassist/scaling/path_scaler.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace craneassist::scaling {
+
+double tracking_factor(double error_m, double error_ok_m) {
+  if (!(error_m > error_ok_m)) return 1.0;
+  return error_ok_m / error_m;
+}
+
+PathScaler::PathScaler(const dynamics::CraneModel& model, const PathScalerConfig& config,
+                       dynamics::RigidBodyTerms& terms)
+    : model_(model),
+      config_(config),
+      terms_(terms),
+      filter_(ScalingFilterConfig{config.period_s, config.jerk_max}) {
+  acceleration_limits_.path_acceleration_max = config.acceleration_max;
+  acceleration_limits_.power_bound = config.power_bound;
+}
+
+void PathScaler::reset(const ScalingFilterState& state) {
+  filter_.reset(state);
+}
+
+void PathScaler::update(const JointVector& q, const PathGeometry& geometry,
+                        const PathScalerInput& in, PathScalerOutput& out) {
+  const double sdot = filter_.state().sdot;
+
+  // Velocity-level limits, uniform along the path.
+  path_speed_limits(model_, geometry, config_.flow_reserve, out.speed);
+  terms_.path_terms(q, geometry.f1, geometry.f2, sdot, out.terms);
+  path_acceleration_bounds(model_, geometry, out.terms, sdot, acceleration_limits_, out.bounds);
+
+  struct Candidate {
+    double value;
+    ActiveLimit kind;
+  };
+  const Candidate candidates[] = {
+      {in.sdot_request * in.tracking_factor,
+       in.tracking_factor < 1.0 ? ActiveLimit::kTrackingError : ActiveLimit::kNone},
+      {out.speed.sdot_flow, ActiveLimit::kFlow},
+      {out.speed.sdot_cylinder, ActiveLimit::kCylinderSpeed},
+      {in.sdot_joint_limit, ActiveLimit::kJointLimit},
+      {out.bounds.sdot_power, ActiveLimit::kPower},
+      {out.bounds.sdot_acceleration, ActiveLimit::kCylinderAcceleration},
+  };
+  Candidate lowest = candidates[0];
+  for (const auto& c : candidates) {
+    if (c.value < lowest.value) lowest = c;
+  }
+  out.sdot_d = std::max(lowest.value, 0.0);
+  if (in.stale_input) out.sdot_d = 0.0;
+
+  // No constraint may force the path to speed up: slowing down always lowers the pump flow, so a
+  // lower bound above zero (the actuator-power-sum bound gives one when over-running loads make
+  // the power sum strongly negative) is lowered to zero.
+  const ScalingFilterInput filter_in{out.sdot_d, std::min(out.bounds.sddot_min, 0.0),
+                                     out.bounds.sddot_max};
+  out.filter_status = filter_.update(filter_in, out.state);
+
+  // What holds the motion back: the stale input, a power bound the filter is pressed against,
+  // or the lowest velocity-level limit when it is below what the operator asks for.
+  out.limit = ActiveLimit::kNone;
+  if (in.stale_input) {
+    out.limit = ActiveLimit::kStaleInput;
+  } else if (out.filter_status == ScalingFilterStatus::kAccelerationLimited &&
+             out.bounds.limit_max == ActiveLimit::kPower &&
+             out.state.sddot >= out.bounds.sddot_max - 1e-9) {
+    out.limit = ActiveLimit::kPower;
+  } else if (lowest.kind != ActiveLimit::kNone && lowest.value < in.sdot_request) {
+    out.limit = lowest.kind;
+  }
+}
+
+}  // namespace craneassist::scaling

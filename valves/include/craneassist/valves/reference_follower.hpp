@@ -1,0 +1,40 @@
+// Valve commands that make the machine follow a joint reference: the cylinder velocity
+// reference through the dead-zone inverse, plus P feedback on the cylinder position error
+// measured against the reference of one valve delay ago (transport delay plus spool lag), so the
+// valve's own dead time is not mistaken for a tracking error (a Smith-predictor-style
+// compensation). Preallocated history; update() allocates nothing.
+#pragma once
+
+#include <vector>
+
+#include "craneassist/dynamics/model.hpp"
+#include "craneassist/valves/machine_interface.hpp"
+#include "craneassist/valves/proportional_valves.hpp"
+
+namespace craneassist::valves {
+
+class ReferenceFollower {
+ public:
+  ReferenceFollower(const dynamics::CraneModel& model, double position_gain_1_s, double period_s);
+
+  // Fills the history with q (the machine at rest at q).
+  void reset(const JointVector& q);
+
+  // q_ref, qdot_ref: this cycle's joint reference; q_meas: the measurement, or nullptr when
+  // there is none (feed-forward only).
+  void update(const JointVector& q_ref, const JointVector& qdot_ref, const JointVector* q_meas,
+              ValveCommand& out);
+
+  // Cylinder-position reference of one valve delay ago (for tracking-error measures).
+  const JointVector& delayed_reference_q() const { return q_ref_history_[head_]; }
+
+ private:
+  const dynamics::CraneModel& model_;
+  ProportionalValves valves_;
+  ProportionalValvesInput in_;
+  JointVector dc_dq_, c_ref_, c_meas_;
+  std::vector<JointVector> q_ref_history_;
+  std::size_t head_ = 0;
+};
+
+}  // namespace craneassist::valves
