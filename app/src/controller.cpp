@@ -55,7 +55,7 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
     scaler_ = std::make_unique<scaling::PathScaler>(
         model_,
         scaling::PathScalerConfig{period_s_, sc.jerk_max_m_s3, sc.acceleration_max_m_s2,
-                                  flow_reserve_, to_power_bound(sc.power_bound)},
+                                  flow_reserve_, to_power_bound(sc.power_bound), sc.power_reserve},
         *terms_);
   }
 }
@@ -94,7 +94,7 @@ ControllerStatus Controller::update(const valves::MachineState& state, const Eig
 
   const bool at_rest = out.qdot_ref.isZero(0.0) && out.sddot == 0.0;
   if (stale && at_rest) {
-    out.valves.spool.setZero(n);  // stopped: valves neutral
+    follower_.neutral(out.valves);  // stopped: valves neutral
     return ControllerStatus::kStopped;
   }
   follower_.update(q_ref_, out.qdot_ref, state_ok ? &state.q : nullptr, out.valves);

@@ -34,10 +34,11 @@ SinePathSummary run_sine_path(const config::CraneConfig& config, const SinePathO
   if (model.dof() != 2) throw std::invalid_argument("the sine path needs a two-joint model");
   const double period = 1.0 / config.control.rate_hz;
   dynamics::RigidBodyTerms terms(model);
-  scaling::PathScaler scaler(model,
-                             {period, options.jerk_max, options.acceleration_max,
-                              config.control.flow_reserve, options.power_bound},
-                             terms);
+  scaling::PathScaler scaler(
+      model,
+      {period, options.jerk_max, options.acceleration_max, config.control.flow_reserve,
+       options.power_bound, config.scaling.power_reserve},
+      terms);
   valves::ReferenceFollower follower(model, config.control.position_gain_1_s, period);
 
   scaling::PathGeometry geometry;

@@ -362,7 +362,7 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   const std::string sp = "scaling";
   r.check_keys(scaling, sp,
                {"jerk_max", "acceleration_max", "direction_change_acceleration",
-                "tracking_error_ok", "tracking_error_filter", "power_bound"});
+                "tracking_error_ok", "tracking_error_filter", "power_bound", "power_reserve"});
   auto& sc = cfg.scaling;
   sc.jerk_max_m_s3 =
       r.value_in(scaling, "jerk_max", sp, Dimension::kJerk, 1e-3, 1e4, "between 0.001 and 10000");
@@ -375,6 +375,8 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
                                       10.0, "between 0.1 mm and 10 m");
   sc.tracking_error_filter_s = r.value_in(scaling, "tracking_error_filter", sp, Dimension::kTime,
                                           0.0, 10.0, "between 0 and 10 s");
+  sc.power_reserve = r.value_in(scaling, "power_reserve", sp, Dimension::kDimensionless, 0.0, 0.5,
+                                "between 0 and 0.5");
   const std::string bound = r.text(scaling, "power_bound", sp);
   if (bound == "load_sensing") {
     sc.power_bound = PowerBoundSetting::kLoadSensing;

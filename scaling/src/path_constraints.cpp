@@ -98,6 +98,7 @@ void path_acceleration_bounds(const dynamics::CraneModel& model, const PathGeome
   }
 
   const auto& pump = model.pump;
+  const double p_max_w = pump.prime_mover_power_w * (1.0 - limits.power_reserve);
   if (limits.power_bound == PowerBound::kLoadSensing) {
     double flow_per_speed = 0.0;
     double max_static_pressure = -kInf;
@@ -111,7 +112,7 @@ void path_acceleration_bounds(const dynamics::CraneModel& model, const PathGeome
       max_static_pressure = std::max(max_static_pressure, scale * terms.b[i]);
     }
     const double flow = flow_per_speed * speed;
-    const double p_power = flow > 0.0 ? pump.prime_mover_power_w / flow - pump.ls_margin_pa : kInf;
+    const double p_power = flow > 0.0 ? p_max_w / flow - pump.ls_margin_pa : kInf;
     const double p_relief = pump.max_pressure_pa - pump.ls_margin_pa;
     b.pressure_limit_pa = std::min(p_power, p_relief);
     for (int i = 0; i < n; ++i) {
@@ -126,19 +127,18 @@ void path_acceleration_bounds(const dynamics::CraneModel& model, const PathGeome
     // Quasi-static limit: the speed at which the current loads take exactly P_max at sddot = 0.
     if (flow_per_speed > 0.0) {
       const double p_supply = std::max(max_static_pressure, 0.0) + pump.ls_margin_pa;
-      b.sdot_power = p_supply > p_relief + pump.ls_margin_pa
-                         ? 0.0
-                         : pump.prime_mover_power_w / (p_supply * flow_per_speed);
+      b.sdot_power =
+          p_supply > p_relief + pump.ls_margin_pa ? 0.0 : p_max_w / (p_supply * flow_per_speed);
     }
   } else if (limits.power_bound == PowerBound::kActuatorPowerSum) {
     // |sdot f1 . (m sddot + b)| <= P_max
     const double k = speed * path.f1.dot(terms.m);
     const double c = speed * path.f1.dot(terms.b);
-    apply_upper(k, c, pump.prime_mover_power_w, ActiveLimit::kPower, b);
-    apply_upper(-k, -c, pump.prime_mover_power_w, ActiveLimit::kPower, b);
+    apply_upper(k, c, p_max_w, ActiveLimit::kPower, b);
+    apply_upper(-k, -c, p_max_w, ActiveLimit::kPower, b);
     const double static_power_per_speed = std::abs(path.f1.dot(terms.b));
     if (static_power_per_speed > 0.0) {
-      b.sdot_power = pump.prime_mover_power_w / static_power_per_speed;
+      b.sdot_power = p_max_w / static_power_per_speed;
     }
   }
 }

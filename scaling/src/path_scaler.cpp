@@ -18,6 +18,7 @@ PathScaler::PathScaler(const dynamics::CraneModel& model, const PathScalerConfig
       filter_(ScalingFilterConfig{config.period_s, config.jerk_max}) {
   acceleration_limits_.path_acceleration_max = config.acceleration_max;
   acceleration_limits_.power_bound = config.power_bound;
+  acceleration_limits_.power_reserve = config.power_reserve;
 }
 
 void PathScaler::reset(const ScalingFilterState& state) {

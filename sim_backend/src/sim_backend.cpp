@@ -113,9 +113,14 @@ struct SimBackend::Impl {
       const auto& cyl = model.cylinders[static_cast<std::size_t>(i)];
       const double arm = dynamics::cylinder_arm(cyl, q[i]);
       const double v = hold ? 0.0 : requested_velocity[i] * pump_result.delivered_fraction[i];
-      // Relief pressure on the pressurised area caps the force; a held cylinder can push or pull
-      // up to its larger area at relief (load-holding valves).
-      const double area = v > 0.0 ? cyl.area_a_m2 : (v < 0.0 ? cyl.area_b_m2 : cyl.area_a_m2);
+      // Relief pressure caps the force. A resistive load (force along the motion) is pushed by
+      // the pump on the pressurised chamber; an over-running load (force against the motion,
+      // e.g. a boom being lowered) and a held one are carried by the opposite chamber through
+      // its load-holding valve, set at relief too.
+      const bool resistive = v * force[i] > 0.0;
+      const double area = v > 0.0 ? (resistive ? cyl.area_a_m2 : cyl.area_b_m2)
+                                  : (v < 0.0 ? (resistive ? cyl.area_b_m2 : cyl.area_a_m2)
+                                             : std::max(cyl.area_a_m2, cyl.area_b_m2));
       const double f_max = model.pump.max_pressure_pa * area * std::abs(arm);
       const dJointID j = crane->joint(i + 1);
       if (model.joints[static_cast<std::size_t>(i)].type == dynamics::JointType::kPrismatic) {

@@ -1,5 +1,6 @@
 #include "craneassist/valves/reference_follower.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "craneassist/dynamics/cylinders.hpp"
@@ -8,13 +9,18 @@ namespace craneassist::valves {
 
 ReferenceFollower::ReferenceFollower(const dynamics::CraneModel& model, double position_gain_1_s,
                                      double period_s)
-    : model_(model), valves_(model, position_gain_1_s) {
+    : model_(model),
+      valves_(model, position_gain_1_s),
+      lag_alpha_(model.valves.time_constant_s > 0.0
+                     ? 1.0 - std::exp(-period_s / model.valves.time_constant_s)
+                     : 1.0) {
   const int n = model.dof();
   in_.velocity_ref_m_s.setZero(n);
   in_.position_error_m.setZero(n);
   dc_dq_.setZero(n);
   c_ref_.setZero(n);
   c_meas_.setZero(n);
+  spool_estimate_.setZero(n);
   const double lag_s = model.valves.delay_s + model.valves.time_constant_s;
   q_ref_history_.assign(static_cast<std::size_t>(std::lround(lag_s / period_s)) + 1,
                         JointVector::Zero(n));
@@ -23,6 +29,12 @@ ReferenceFollower::ReferenceFollower(const dynamics::CraneModel& model, double p
 void ReferenceFollower::reset(const JointVector& q) {
   for (auto& h : q_ref_history_) h = q;
   head_ = 0;
+  spool_estimate_.setZero();
+}
+
+void ReferenceFollower::neutral(ValveCommand& out) {
+  out.spool.setZero(model_.dof());
+  spool_estimate_ += lag_alpha_ * (out.spool - spool_estimate_);
 }
 
 void ReferenceFollower::update(const JointVector& q_ref, const JointVector& qdot_ref,
@@ -40,6 +52,20 @@ void ReferenceFollower::update(const JointVector& q_ref, const JointVector& qdot
     in_.position_error_m.setZero(n);
   }
   valves_.update(in_, out);
+  // Deadbeat compensation of the spool lag while a spool still has to cross the dead zone to the
+  // side it is wanted on (no flow passes there, so a fast crossing costs nothing); outside it
+  // the wanted position goes through unchanged, so feedback corrections are not amplified.
+  const double dead_zone = model_.valves.dead_zone;
+  for (int i = 0; i < n; ++i) {
+    const double wanted = out.spool[i];
+    const double estimate = spool_estimate_[i];
+    const bool crossing =
+        wanted != 0.0 && (estimate * wanted <= 0.0 || std::abs(estimate) < dead_zone);
+    const double command =
+        crossing ? std::clamp(estimate + (wanted - estimate) / lag_alpha_, -1.0, 1.0) : wanted;
+    spool_estimate_[i] += lag_alpha_ * (command - spool_estimate_[i]);
+    out.spool[i] = command;
+  }
 }
 
 }  // namespace craneassist::valves

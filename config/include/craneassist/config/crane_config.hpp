@@ -27,6 +27,7 @@ struct ScalingSettings {
   double tracking_error_ok_m = 0.05;                // slow-down threshold e_ok
   double tracking_error_filter_s = 0.05;            // first-order filter on the tip error
   PowerBoundSetting power_bound = PowerBoundSetting::kLoadSensing;
+  double power_reserve = 0.0;  // share of P_max kept for feedback corrections
 };
 
 struct SimulationSettings {

@@ -66,6 +66,7 @@ struct AccelerationBounds {
 struct AccelerationLimits {
   double path_acceleration_max = 1.0;  // |sddot| bound of the path itself
   PowerBound power_bound = PowerBound::kLoadSensing;
+  double power_reserve = 0.0;  // the bound uses P_max (1 - power_reserve)
 };
 
 // Intersection of the acceleration-level constraints at the current sdot (>= 0).

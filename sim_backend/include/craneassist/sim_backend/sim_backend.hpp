@@ -5,7 +5,8 @@
 //   1. every valve section turns its (delayed, lagged) spool into a requested cylinder velocity;
 //   2. the LS pump shares what it can deliver by load pressure (ls_pump.hpp);
 //   3. each joint is driven as an ODE velocity motor at the delivered cylinder velocity, its force
-//      capped at the relief pressure on the pressurised area (a stalled cylinder stays put);
+//      capped at the relief pressure on the chamber that carries the load (the pressurised one for
+//      a resistive load, the load-holding one for an over-running or held load);
 //   4. the joint stops are the cylinder end stops;
 //   5. the motor reaction gives the cylinder force and, through a 5 ms first-order filter standing
 //      in for oil compressibility, the load pressures for the next step.

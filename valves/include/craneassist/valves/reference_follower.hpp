@@ -2,7 +2,13 @@
 // reference through the dead-zone inverse, plus P feedback on the cylinder position error
 // measured against the reference of one valve delay ago (transport delay plus spool lag), so the
 // valve's own dead time is not mistaken for a tracking error (a Smith-predictor-style
-// compensation). Preallocated history; update() allocates nothing.
+// compensation). The spool's first-order lag is compensated through the dead zone: the
+// follower keeps an estimate of every spool position and, while a spool still has to cross the
+// dead zone, commands what brings it to the wanted position within one period (deadbeat,
+// clipped to the spool range). All sections then cross together when a motion starts or
+// reverses, instead of the small commands lagging behind the large ones and bending the tip
+// path; beyond the dead zone the wanted position passes unchanged. Preallocated history; update()
+// allocates nothing.
 #pragma once
 
 #include <vector>
@@ -25,6 +31,9 @@ class ReferenceFollower {
   void update(const JointVector& q_ref, const JointVector& qdot_ref, const JointVector* q_meas,
               ValveCommand& out);
 
+  // Neutral valves (the estimate follows).
+  void neutral(ValveCommand& out);
+
   // Cylinder-position reference of one valve delay ago (for tracking-error measures).
   const JointVector& delayed_reference_q() const { return q_ref_history_[head_]; }
 
@@ -33,6 +42,8 @@ class ReferenceFollower {
   ProportionalValves valves_;
   ProportionalValvesInput in_;
   JointVector dc_dq_, c_ref_, c_meas_;
+  JointVector spool_estimate_;
+  double lag_alpha_;  // share of the remaining spool travel the lag covers in one period
   std::vector<JointVector> q_ref_history_;
   std::size_t head_ = 0;
 };
