@@ -1,17 +1,19 @@
 #!/usr/bin/python3
-"""Plot what flow prescaling does on a saturating move, from two craneassist logs.
+"""Plot a baseline run against a scaled run of the same replay, from two craneassist logs:
+the tip path seen from the front, the direction error, pump flow and pump power.
 
-    craneassist replay examples/replays/combined_move.csv --pump-max-flow "100 L/min" \
-        --prime-mover-power "200 kW" --log scaled.csv
-    craneassist replay examples/replays/combined_move.csv --pump-max-flow "100 L/min" \
-        --prime-mover-power "200 kW" --no-scaling --log unscaled.csv
-    tools/plot_direction.py unscaled.csv scaled.csv docs/img/combined_move.png
+    craneassist replay examples/replays/combined_move.csv --pump-max-flow "100 L/min" \\
+        --prime-mover-power "200 kW" --scaling none --log unscaled.csv
+    craneassist replay examples/replays/combined_move.csv --pump-max-flow "100 L/min" \\
+        --prime-mover-power "200 kW" --scaling flow --log scaled.csv
+    tools/plot_direction.py unscaled.csv scaled.csv docs/img/combined_move.png \\
+        --labels "no scaling" "flow prescaling" --flow-limit 100
 
 Needs python3-matplotlib (Debian package).
 """
+import argparse
 import csv
 import math
-import sys
 
 import matplotlib
 
@@ -22,7 +24,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 def load(path):
     with open(path, newline="") as f:
         rows = list(csv.DictReader(f))
-    cols = {k: [float(r[k]) for r in rows] for k in rows[0] if k not in ("active_limit", "pump_limit")}
+    skip = ("active_limit", "pump_limit")
+    cols = {k: [float(r[k]) for r in rows] for k in rows[0] if k not in skip}
     cols["pump_limit"] = [r["pump_limit"] for r in rows]
     return cols
 
@@ -42,30 +45,46 @@ def direction_error(c):
 
 
 def main():
-    if len(sys.argv) != 4:
-        sys.exit(__doc__)
-    unscaled, scaled, out = load(sys.argv[1]), load(sys.argv[2]), sys.argv[3]
-    fig = plt.figure(figsize=(8, 8.5))
-    ax = [fig.add_subplot(3, 1, 1)]
-    ax.append(fig.add_subplot(3, 1, 2))
-    ax.append(fig.add_subplot(3, 1, 3, sharex=ax[1]))
-    for c, name, style in ((unscaled, "no scaling", "tab:red"), (scaled, "flow prescaling", "tab:blue")):
-        ax[0].plot(c["tip_z"], c["tip_y"], color=style, label=name)
-        ax[1].plot(c["t"], direction_error(c), color=style, label=name)
-        ax[2].plot(c["t"], [q * 60e3 for q in c["pump_flow_m3s"]], color=style, label=name)
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("baseline")
+    parser.add_argument("scaled")
+    parser.add_argument("output")
+    parser.add_argument("--labels", nargs=2, default=["no scaling", "flow prescaling"])
+    parser.add_argument("--flow-limit", type=float, help="pump flow limit to draw, L/min")
+    parser.add_argument("--power-limit", type=float, help="prime-mover power to draw, kW")
+    args = parser.parse_args()
+    runs = ((load(args.baseline), args.labels[0], "tab:red"),
+            (load(args.scaled), args.labels[1], "tab:blue"))
+
+    fig = plt.figure(figsize=(8, 11))
+    ax = [fig.add_subplot(4, 1, 1)]
+    for i in range(2, 5):
+        ax.append(fig.add_subplot(4, 1, i, sharex=ax[1] if i > 2 else None))
+    for c, name, color in runs:
+        ax[0].plot(c["tip_z"], c["tip_y"], color=color, label=name)
+        ax[1].plot(c["t"], direction_error(c), color=color, label=name)
+        ax[2].plot(c["t"], [q * 60e3 for q in c["pump_flow_m3s"]], color=color, label=name)
+        ax[3].plot(c["t"], [p / 1e3 for p in c["pump_power_w"]], color=color, label=name)
+    if args.flow_limit:
+        ax[2].axhline(args.flow_limit, color="black", linestyle=":", label="pump maximum")
+    if args.power_limit:
+        ax[3].axhline(args.power_limit, color="black", linestyle=":", label="P_max")
     ax[0].set_xlabel("lateral tip position z [m]")
-    ax[0].set_title("Tip path seen from the front (commanded: straight, up and sideways)")
     ax[0].set_ylabel("tip height y [m]")
+    ax[0].set_title("Tip path seen from the front (the command is a straight line)")
     ax[1].set_ylabel("direction error [deg]")
-    ax[1].set_title("Angle between commanded and measured tip velocity")
+    ax[1].set_title("Angle between commanded and measured tip velocity (tip faster than 0.05 m/s)")
     ax[2].set_ylabel("pump flow [L/min]")
-    ax[2].set_xlabel("time [s]")
-    ax[2].set_title("Pump flow (limit 100 L/min)")
+    ax[2].set_title("Pump flow")
+    ax[3].set_ylabel("pump power [kW]")
+    ax[3].set_xlabel("time [s]")
+    ax[3].set_title("Pump power")
     for a in ax:
         a.grid(True, alpha=0.3)
-        a.legend(loc="upper right")
+        a.legend(loc="upper right", fontsize=8)
     fig.tight_layout()
-    fig.savefig(out, dpi=110)
+    fig.savefig(args.output, dpi=100)
 
 
 if __name__ == "__main__":

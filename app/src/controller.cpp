@@ -51,11 +51,12 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
     terms_ = std::make_unique<dynamics::RigidBodyTerms>(model_);
     tip_path_ = std::make_unique<scaling::TipPath>(
         model_, scaling::TipPathConfig{period_s_, sc.direction_change_acceleration_m_s2,
-                                       sc.jerk_max_m_s3, sc.acceleration_max_m_s2});
+                                       sc.jerk_max_m_s3, sc.deceleration_max_m_s2});
     scaler_ = std::make_unique<scaling::PathScaler>(
         model_,
         scaling::PathScalerConfig{period_s_, sc.jerk_max_m_s3, sc.acceleration_max_m_s2,
-                                  flow_reserve_, to_power_bound(sc.power_bound), sc.power_reserve},
+                                  flow_reserve_, to_power_bound(sc.power_bound), sc.power_reserve,
+                                  sc.deceleration_max_m_s2},
         *terms_);
   }
 }

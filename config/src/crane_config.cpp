@@ -361,12 +361,14 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   const YAML::Node scaling = r.child(root, "scaling", "");
   const std::string sp = "scaling";
   r.check_keys(scaling, sp,
-               {"jerk_max", "acceleration_max", "direction_change_acceleration",
+               {"jerk_max", "acceleration_max", "deceleration_max", "direction_change_acceleration",
                 "tracking_error_ok", "tracking_error_filter", "power_bound", "power_reserve"});
   auto& sc = cfg.scaling;
   sc.jerk_max_m_s3 =
       r.value_in(scaling, "jerk_max", sp, Dimension::kJerk, 1e-3, 1e4, "between 0.001 and 10000");
   sc.acceleration_max_m_s2 = r.value_in(scaling, "acceleration_max", sp, Dimension::kAcceleration,
+                                        1e-3, 100.0, "between 0.001 and 100");
+  sc.deceleration_max_m_s2 = r.value_in(scaling, "deceleration_max", sp, Dimension::kAcceleration,
                                         1e-3, 100.0, "between 0.001 and 100");
   sc.direction_change_acceleration_m_s2 =
       r.value_in(scaling, "direction_change_acceleration", sp, Dimension::kAcceleration, 1e-3,

@@ -62,8 +62,11 @@ void path_speed_limits(const dynamics::CraneModel& model, const PathGeometry& pa
     const auto& cyl = model.cylinders[static_cast<std::size_t>(i)];
     const double v = path.dc_dq[i] * path.f1[i];  // cylinder velocity per unit path speed
     flow += dynamics::flow_area_m2(cyl, v) * std::abs(v);
-    if (std::abs(v) > kTinyRate && cyl.v_max_m_s / std::abs(v) < out.sdot_cylinder) {
-      out.sdot_cylinder = cyl.v_max_m_s / std::abs(v);
+    // The reserve keeps room above the reference for the valves' feedback corrections, here as
+    // for the pump flow: a fully open valve cannot correct anything.
+    const double v_max = cyl.v_max_m_s * (1.0 - flow_reserve);
+    if (std::abs(v) > kTinyRate && v_max / std::abs(v) < out.sdot_cylinder) {
+      out.sdot_cylinder = v_max / std::abs(v);
       out.cylinder = i;
     }
   }
@@ -75,7 +78,7 @@ void path_acceleration_bounds(const dynamics::CraneModel& model, const PathGeome
                               const dynamics::PathTerms& terms, double sdot,
                               const AccelerationLimits& limits, AccelerationBounds& b) {
   const int n = model.dof();
-  b.sddot_min = -limits.path_acceleration_max;
+  b.sddot_min = -limits.path_deceleration_max;
   b.sddot_max = limits.path_acceleration_max;
   b.limit_min = ActiveLimit::kNone;
   b.limit_max = ActiveLimit::kNone;

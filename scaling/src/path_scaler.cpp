@@ -19,6 +19,7 @@ PathScaler::PathScaler(const dynamics::CraneModel& model, const PathScalerConfig
   acceleration_limits_.path_acceleration_max = config.acceleration_max;
   acceleration_limits_.power_bound = config.power_bound;
   acceleration_limits_.power_reserve = config.power_reserve;
+  acceleration_limits_.path_deceleration_max = config.deceleration_max;
 }
 
 void PathScaler::reset(const ScalingFilterState& state) {

@@ -106,7 +106,7 @@ void TipPath::update(const JointVector& q, const Eigen::Vector3d& v_cmd, double 
     const double distance = rate > 0.0 ? joint.q_max - q[i] : q[i] - joint.q_min;
     const double decel =
         kEndDecelerationShare *
-        std::min(cyl.a_max_m_s2 / std::abs(g.dc_dq[i]), std::abs(rate) * config_.acceleration_max);
+        std::min(cyl.a_max_m_s2 / std::abs(g.dc_dq[i]), std::abs(rate) * config_.deceleration_max);
     const double jerk = std::abs(rate) * config_.jerk_max;
     const double margin = 2.0 * std::abs(rate) * sdot * config_.period_s;
     const double joint_speed =

@@ -64,9 +64,10 @@ struct AccelerationBounds {
 };
 
 struct AccelerationLimits {
-  double path_acceleration_max = 1.0;  // |sddot| bound of the path itself
+  double path_acceleration_max = 1.0;  // sddot <= this (the path itself)
   PowerBound power_bound = PowerBound::kLoadSensing;
   double power_reserve = 0.0;  // the bound uses P_max (1 - power_reserve)
+  double path_deceleration_max = 1.0;  // sddot >= -this (the path itself)
 };
 
 // Intersection of the acceleration-level constraints at the current sdot (>= 0).

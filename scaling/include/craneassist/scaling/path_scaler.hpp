@@ -28,6 +28,7 @@ struct PathScalerConfig {
   double flow_reserve = 0.0;      // share of the pump flow kept for feedback corrections
   PowerBound power_bound = PowerBound::kLoadSensing;
   double power_reserve = 0.0;  // share of P_max kept for feedback corrections
+  double deceleration_max = 1.0;  // path deceleration bound
 };
 
 struct PathScalerInput {

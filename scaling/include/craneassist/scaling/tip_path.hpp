@@ -28,7 +28,7 @@ struct TipPathConfig {
   double period_s = 0.01;
   double direction_change_acceleration = 0.5;  // m/s^2, tip normal acceleration when turning
   double jerk_max = 5.0;                       // path jerk, m/s^3 (for the end-damping curve)
-  double acceleration_max = 1.0;               // path acceleration, m/s^2
+  double deceleration_max = 1.0;               // path deceleration, m/s^2 (end damping)
 };
 
 struct TipPathOutput {

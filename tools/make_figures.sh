@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Regenerates every figure in docs/img/ from fresh runs of the simulator (build first:
+# cmake --build build). Needs python3-matplotlib.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bin=build/app/craneassist
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+
+# README: flow prescaling on a flow-limited pump.
+small=(--pump-max-flow "100 L/min" --prime-mover-power "200 kW")
+$bin replay examples/replays/combined_move.csv "${small[@]}" --scaling none --log "$out/cm_none.csv" >/dev/null
+$bin replay examples/replays/combined_move.csv "${small[@]}" --scaling flow --log "$out/cm_flow.csv" >/dev/null
+tools/plot_direction.py "$out/cm_none.csv" "$out/cm_flow.csv" docs/img/combined_move.png \
+  --labels "no scaling" "flow prescaling" --flow-limit 100
+
+# docs/scaling.md: the heavy lift, flow prescaling only against full scaling.
+$bin replay examples/replays/heavy_lift.csv --payload 650 --settle 1.5 --scaling flow --log "$out/hl_flow.csv" >/dev/null
+$bin replay examples/replays/heavy_lift.csv --payload 650 --settle 1.5 --scaling full --log "$out/hl_full.csv" >/dev/null
+tools/plot_direction.py "$out/hl_flow.csv" "$out/hl_full.csv" docs/img/heavy_lift.png \
+  --labels "flow prescaling only" "full scaling (LS power bound)" --power-limit 35
+
+# docs/scaling.md: the 2R experiment of the power-limited scaling paper.
+$bin experiment-2r --power-bound actuator_sum --log "$out/2r_sum.csv" >/dev/null
+$bin experiment-2r --power-bound load_sensing --log "$out/2r_ls.csv" >/dev/null
+tools/plot_power.py "$out/2r_sum.csv" "$out/2r_ls.csv" 5000 docs/img/scaling_2r.png
+echo "figures written to docs/img/"
