@@ -8,28 +8,12 @@
 #include <new>
 #include <vector>
 
+#include "allocation_counter.hpp"
 #include "craneassist/app/controller.hpp"
 #include "craneassist/app/csv_log.hpp"
 #include "craneassist/config/crane_config.hpp"
 
 using namespace craneassist;
-
-// Counting global allocator: lets a test prove a code path performs no heap allocation.
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-[[gnu::noinline]] void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-[[gnu::noinline]] void operator delete(void* p) noexcept {
-  std::free(p);
-}
-[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace {
 
@@ -100,16 +84,16 @@ TEST(Controller, CycleDoesNotAllocate) {
   controller.reset(state);
   app::ControllerOutput out;
   controller.update(state, Eigen::Vector3d(0.1, 0.1, 0.1), out);  // first call sizes the output
-  const long before = g_allocations.load();
+  const long before = craneassist::test::heap_allocations();
   for (int k = 0; k < 200; ++k) {
     controller.update(state, Eigen::Vector3d(0.3, 0.2 * (k % 3), -0.4), out);
     state.q = out.q_ref;
   }
   controller.update(state, Eigen::Vector3d(NAN, 0, 0), out);
-  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(craneassist::test::heap_allocations() - before, 0);
   // The counter does count.
   auto* probe = new int(3);
-  EXPECT_GT(g_allocations.load() - before, 0);
+  EXPECT_GT(craneassist::test::heap_allocations() - before, 0);
   delete probe;
 }
 
@@ -178,7 +162,7 @@ TEST(CsvLog, PushDoesNotAllocateAndEveryRowArrives) {
   app::LogRow row;
   row.active_limit = "none";
   row.pump_limit = "none";
-  const long before = g_allocations.load();
+  const long before = craneassist::test::heap_allocations();
   std::size_t refused = 0;
   for (int k = 0; k < 1000; ++k) {
     row.t = k * 0.01;
@@ -189,7 +173,7 @@ TEST(CsvLog, PushDoesNotAllocateAndEveryRowArrives) {
       std::this_thread::yield();
     }
   }
-  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(craneassist::test::heap_allocations() - before, 0);
   EXPECT_EQ(log.close(), refused);
   std::ifstream in(path);
   std::string line;

@@ -12,29 +12,16 @@
 #include <random>
 #include <vector>
 
+#include "allocation_counter.hpp"
 #include "craneassist/dynamics/model.hpp"
 #include "craneassist/dynamics/rigid_body_terms.hpp"
 #include "rnea_reference.hpp"
 
-// Counting global allocator (as in test_rigid_body.cpp), to check that path_terms() does not
-// allocate. Not inlined, so that GCC does not pair the malloc/free inside with operator
-// new/delete at call sites.
+// ODE's own allocations (counted through its allocation handler); operator new is counted by
+// allocation_counter.hpp.
 namespace {
-std::atomic<long> g_new_calls{0};
 std::atomic<long> g_ode_allocs{0};
 }  // namespace
-
-[[gnu::noinline]] void* operator new(std::size_t size) {
-  g_new_calls.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-[[gnu::noinline]] void operator delete(void* p) noexcept {
-  std::free(p);
-}
-[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace {
 
@@ -228,13 +215,13 @@ TEST(PathTerms, DoesNotAllocate) {
   out.b.resize(4);
   DynamicsTerms full;
   full.mass.resize(4, 4);
-  const long new_before = g_new_calls.load();
+  const long new_before = craneassist::test::heap_allocations();
   const long ode_before = g_ode_allocs.load();
   for (int k = 0; k < 20; ++k) {
     terms.path_terms(qs[k], f1s[k], f2s[k], k % 5 == 0 ? 0.0 : 0.1 * k, out);
     if (k % 7 == 0) terms.compute(qs[k], f1s[k], full);  // motors off and on again
   }
-  const long new_calls = g_new_calls.load() - new_before;
+  const long new_calls = craneassist::test::heap_allocations() - new_before;
   const long ode_allocs = g_ode_allocs.load() - ode_before;
 
   // A fresh world's first step must go through the handler, or the check above proves nothing.

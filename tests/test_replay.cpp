@@ -15,25 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "allocation_counter.hpp"
 #include "craneassist/input/replay.hpp"
-
-// Counts heap allocations, to check that the real-time cursor does not allocate.
-namespace {
-std::atomic<std::size_t> g_allocations{0};
-}  // namespace
-
-// noinline: otherwise GCC's -Wmismatched-new-delete sees free() of operator new's result.
-[[gnu::noinline]] void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-[[gnu::noinline]] void operator delete(void* p) noexcept {
-  std::free(p);
-}
-[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace craneassist::input {
 namespace {
@@ -383,15 +366,15 @@ TEST(ReplayZeroOrderHold, NoAllocationAndNoexcept) {
   const Replay r = three_rows();
   ReplayCursor c(r);
   double sum = 0.0;
-  const std::size_t before = g_allocations.load();
+  const std::size_t before = static_cast<std::size_t>(craneassist::test::heap_allocations());
   for (int i = 0; i < 10000; ++i) sum += c.command_at(i * 0.001).sum();
   for (int i = 10000; i > 0; --i) sum += c.command_at(i * 0.001).sum();
-  EXPECT_EQ(g_allocations.load(), before);
+  EXPECT_EQ(static_cast<std::size_t>(craneassist::test::heap_allocations()), before);
   EXPECT_GT(sum, 0.0);
   // The counter does see allocations.
   std::ostringstream os;
   os << std::string(1000, 'x');
-  EXPECT_GT(g_allocations.load(), before);
+  EXPECT_GT(static_cast<std::size_t>(craneassist::test::heap_allocations()), before);
 }
 
 // ---- writer ------------------------------------------------------------------------------------

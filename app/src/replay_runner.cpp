@@ -97,12 +97,8 @@ RunSummary run_replay(const config::CraneConfig& config, const input::Replay& re
         row.spool[s] = out.valves.spool[i];
         row.load_pressure[s] = state.valid ? state.load_pressure_pa[i] : NAN;
       }
-      row.pump_flow_m3s = state.pump.flow_m3_s;
-      row.pump_pressure_pa = state.pump.pressure_pa;
-      row.pump_power_w = state.pump.power_w;
-      row.energy_j = state.pump.energy_j;
+      row.set_pump(state.pump);
       row.active_limit = scaling::to_string(out.limit);
-      row.pump_limit = valves::to_string(state.pump.limit);
       row.scale = out.scale;
       row.s = out.s;
       row.sdot = out.sdot;

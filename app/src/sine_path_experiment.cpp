@@ -99,12 +99,8 @@ SinePathSummary run_sine_path(const config::CraneConfig& config, const SinePathO
         row.spool[i] = command.spool[e];
         row.load_pressure[i] = state.load_pressure_pa[e];
       }
-      row.pump_flow_m3s = state.pump.flow_m3_s;
-      row.pump_pressure_pa = state.pump.pressure_pa;
-      row.pump_power_w = state.pump.power_w;
-      row.energy_j = state.pump.energy_j;
+      row.set_pump(state.pump);
       row.active_limit = scaling::to_string(out.limit);
-      row.pump_limit = valves::to_string(state.pump.limit);
       row.scale = out.state.sdot / options.sdot_request;
       row.flow_demand_m3s = out.speed.flow_per_speed_m3 * options.sdot_request;
       row.s = out.state.s;

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "craneassist/dynamics/model.hpp"
+#include "craneassist/valves/machine_interface.hpp"
 
 namespace craneassist::app {
 
@@ -31,6 +32,15 @@ struct LogRow {
   double ref_power_w = 0.0;       // LS pump power the model predicts for the reference
   const char* active_limit = "";  // static strings only (to_string of the enums)
   const char* pump_limit = "";
+
+  // The pump columns from a measurement.
+  void set_pump(const valves::PumpMeasurement& pump) {
+    pump_flow_m3s = pump.flow_m3_s;
+    pump_pressure_pa = pump.pressure_pa;
+    pump_power_w = pump.power_w;
+    energy_j = pump.energy_j;
+    pump_limit = valves::to_string(pump.limit);
+  }
 };
 
 class CsvLog {
