@@ -156,6 +156,47 @@ TEST(Controller, FullScalingStaleInputIsAJerkLimitedStop) {
   EXPECT_EQ(out.valves.spool.cwiseAbs().maxCoeff(), 0.0);
 }
 
+// Largest joint acceleration of the reference while the operator swings the stick from one
+// direction to a nearly opposite one, for a machine that follows the reference.
+double peak_joint_acceleration_when_swinging(app::ScalingMode mode, int* turn_cycles = nullptr) {
+  const auto cfg = config::default_crane_config();
+  app::Controller controller(cfg, {mode});
+  auto state = still_state(cfg);
+  controller.reset(state);
+  app::ControllerOutput out;
+  dynamics::JointVector previous = dynamics::JointVector::Zero(4);
+  double peak = 0.0;
+  for (int k = 0; k < 400; ++k) {
+    const Eigen::Vector3d v =
+        k < 200 ? Eigen::Vector3d(0.5, 0.0, 0.2) : Eigen::Vector3d(-0.4, 0.2, -0.1);
+    controller.update(state, v, out);
+    if (k > 0) {
+      peak =
+          std::max(peak, ((out.qdot_ref - previous) / controller.period_s()).cwiseAbs().maxCoeff());
+    }
+    if (turn_cycles != nullptr && k >= 200 && angle_deg(out.ref_tip_velocity_m_s, v) > 0.5) {
+      ++*turn_cycles;
+    }
+    previous = out.qdot_ref;
+    state.q = out.q_ref;
+  }
+  return peak;
+}
+
+TEST(Controller, SwingingTheStickKeepsJointAccelerationsBounded) {
+  int turn_cycles = 0;
+  const double blended =
+      peak_joint_acceleration_when_swinging(app::ScalingMode::kFull, &turn_cycles);
+  const double stepped = peak_joint_acceleration_when_swinging(app::ScalingMode::kFlowOnly);
+  std::printf(
+      "[ figures  ] stick reversal: peak joint acceleration %.3f (blended) vs %.3f "
+      "(velocity steps), direction turned over %d cycles\n",
+      blended, stepped, turn_cycles);
+  EXPECT_LT(blended, 2.0) << "rad/s^2 or m/s^2";
+  EXPECT_GT(stepped, 10.0 * blended);
+  EXPECT_GT(turn_cycles, 10) << "the direction turns over time, not in one cycle";
+}
+
 TEST(CsvLog, PushDoesNotAllocateAndEveryRowArrives) {
   const auto path = std::filesystem::temp_directory_path() / "craneassist_test_log.csv";
   app::CsvLog log(path, 4, 64);
