@@ -23,7 +23,7 @@ enum class PowerBoundSetting { kLoadSensing, kActuatorSum, kNone };
 struct ScalingSettings {
   double jerk_max_m_s3 = 4.0;                       // path jerk bound
   double acceleration_max_m_s2 = 1.0;               // path acceleration bound
-  double deceleration_max_m_s2 = 1.0;  // path deceleration bound
+  double deceleration_max_m_s2 = 1.0;               // path deceleration bound
   double direction_change_acceleration_m_s2 = 0.6;  // tip normal acceleration when turning
   double tracking_error_ok_m = 0.05;                // slow-down threshold e_ok
   double tracking_error_filter_s = 0.05;            // first-order filter on the tip error

@@ -66,7 +66,7 @@ struct AccelerationBounds {
 struct AccelerationLimits {
   double path_acceleration_max = 1.0;  // sddot <= this (the path itself)
   PowerBound power_bound = PowerBound::kLoadSensing;
-  double power_reserve = 0.0;  // the bound uses P_max (1 - power_reserve)
+  double power_reserve = 0.0;          // the bound uses P_max (1 - power_reserve)
   double path_deceleration_max = 1.0;  // sddot >= -this (the path itself)
 };
 

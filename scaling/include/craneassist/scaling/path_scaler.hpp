@@ -27,7 +27,7 @@ struct PathScalerConfig {
   double acceleration_max = 1.0;  // path acceleration bound
   double flow_reserve = 0.0;      // share of the pump flow kept for feedback corrections
   PowerBound power_bound = PowerBound::kLoadSensing;
-  double power_reserve = 0.0;  // share of P_max kept for feedback corrections
+  double power_reserve = 0.0;     // share of P_max kept for feedback corrections
   double deceleration_max = 1.0;  // path deceleration bound
 };
 
