@@ -15,13 +15,8 @@
 #include "allocation_counter.hpp"
 #include "craneassist/dynamics/model.hpp"
 #include "craneassist/dynamics/rigid_body_terms.hpp"
+#include "ode_allocation_counter.hpp"
 #include "rnea_reference.hpp"
-
-// ODE's own allocations (counted through its allocation handler); operator new is counted by
-// allocation_counter.hpp.
-namespace {
-std::atomic<long> g_ode_allocs{0};
-}  // namespace
 
 namespace {
 
@@ -192,16 +187,7 @@ TEST(PathTerms, AgreesWithComputeFormula) {
 TEST(PathTerms, DoesNotAllocate) {
   const CraneModel model = k70m();
   RigidBodyTerms terms(model);
-  // Count ODE's own allocations too (it uses malloc unless a handler is installed).
-  dSetAllocHandler([](dsizeint size) -> void* {
-    g_ode_allocs.fetch_add(1, std::memory_order_relaxed);
-    return std::malloc(size);
-  });
-  dSetReallocHandler([](void* p, dsizeint, dsizeint size) -> void* {
-    g_ode_allocs.fetch_add(1, std::memory_order_relaxed);
-    return std::realloc(p, size);
-  });
-  dSetFreeHandler([](void* p, dsizeint) { std::free(p); });
+  craneassist::test::count_ode_allocations();  // ODE's own allocations too
 
   std::mt19937 rng(7);
   std::vector<JointVector> qs, f1s, f2s;
@@ -216,18 +202,18 @@ TEST(PathTerms, DoesNotAllocate) {
   DynamicsTerms full;
   full.mass.resize(4, 4);
   const long new_before = craneassist::test::heap_allocations();
-  const long ode_before = g_ode_allocs.load();
+  const long ode_before = craneassist::test::ode_allocations();
   for (int k = 0; k < 20; ++k) {
     terms.path_terms(qs[k], f1s[k], f2s[k], k % 5 == 0 ? 0.0 : 0.1 * k, out);
     if (k % 7 == 0) terms.compute(qs[k], f1s[k], full);  // motors off and on again
   }
   const long new_calls = craneassist::test::heap_allocations() - new_before;
-  const long ode_allocs = g_ode_allocs.load() - ode_before;
+  const long ode_allocs = craneassist::test::ode_allocations() - ode_before;
 
   // A fresh world's first step must go through the handler, or the check above proves nothing.
-  const long before_fresh = g_ode_allocs.load();
+  const long before_fresh = craneassist::test::ode_allocations();
   { RigidBodyTerms fresh(model); }
-  const long fresh_allocs = g_ode_allocs.load() - before_fresh;
+  const long fresh_allocs = craneassist::test::ode_allocations() - before_fresh;
 
   dSetAllocHandler(nullptr);
   dSetReallocHandler(nullptr);
