@@ -12,7 +12,6 @@ the tip path seen from the front, the direction error, pump flow and pump power.
 Needs python3-matplotlib (Debian package).
 """
 import argparse
-import csv
 import math
 
 import matplotlib
@@ -20,14 +19,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-
-def load(path):
-    with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
-    skip = ("active_limit", "pump_limit")
-    cols = {k: [float(r[k]) for r in rows] for k in rows[0] if k not in skip}
-    cols["pump_limit"] = [r["pump_limit"] for r in rows]
-    return cols
+from craneassist_log import load  # noqa: E402
 
 
 def direction_error(c):

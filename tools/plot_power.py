@@ -9,7 +9,6 @@ The 2R experiment of docs/scaling.md:
 Arguments: the baseline log, the load-sensing log, P_max in W, the output PNG.
 Needs python3-matplotlib (Debian package).
 """
-import csv
 import sys
 
 import matplotlib
@@ -17,12 +16,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-
-def load(path):
-    with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
-    skip = ("active_limit", "pump_limit")
-    return {k: [float(r[k]) for r in rows] for k in rows[0] if k not in skip}
+from craneassist_log import load  # noqa: E402
 
 
 def main():
