@@ -12,6 +12,7 @@
 #include "craneassist/app/controller.hpp"
 #include "craneassist/app/csv_log.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/dynamics/kinematics.hpp"
 
 using namespace craneassist;
 
@@ -195,6 +196,34 @@ TEST(Controller, SwingingTheStickKeepsJointAccelerationsBounded) {
   EXPECT_LT(blended, 2.0) << "rad/s^2 or m/s^2";
   EXPECT_GT(stepped, 10.0 * blended);
   EXPECT_GT(turn_cycles, 10) << "the direction turns over time, not in one cycle";
+}
+
+TEST(Controller, EveryResolutionDrivesTheReferenceAlongTheCommand) {
+  for (auto r : {dynamics::Resolution::kPinvJoint, dynamics::Resolution::kPinvActuator,
+                 dynamics::Resolution::kMinFlow, dynamics::Resolution::kMinLsPower}) {
+    auto cfg = config::default_crane_config();
+    cfg.redundancy.resolution = r;
+    app::Controller controller(cfg, {app::ScalingMode::kFull});
+    auto state = still_state(cfg);
+    controller.reset(state);
+    app::ControllerOutput out;
+    const Eigen::Vector3d v(0.3, 0.3, 0.4);
+    const long before = craneassist::test::heap_allocations();
+    for (int k = 0; k < 200; ++k) {
+      ASSERT_EQ(controller.update(state, v, out), app::ControllerStatus::kRunning);
+      if (out.sdot > 0.0) {
+        // The reference tip velocity is J(q_ref) f' sdot: check it against the Jacobian.
+        dynamics::KinematicsData kin;
+        dynamics::TaskJacobian jac;
+        dynamics::tip_jacobian(cfg.model, kin, state.q, jac);
+        EXPECT_LT(angle_deg(jac * out.qdot_ref, v), 0.5) << dynamics::to_string(r);
+      }
+      state.q = out.q_ref;
+    }
+    EXPECT_GT(out.sdot, 0.3) << dynamics::to_string(r);
+    EXPECT_EQ(craneassist::test::heap_allocations() - before, 0)
+        << dynamics::to_string(r) << ": the control cycle allocated";
+  }
 }
 
 TEST(CsvLog, PushDoesNotAllocateAndEveryRowArrives) {

@@ -50,8 +50,9 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
     const auto& sc = config.scaling;
     terms_ = std::make_unique<dynamics::RigidBodyTerms>(model_);
     tip_path_ = std::make_unique<scaling::TipPath>(
-        model_, scaling::TipPathConfig{period_s_, sc.direction_change_acceleration_m_s2,
-                                       sc.jerk_max_m_s3, sc.deceleration_max_m_s2});
+        model_,
+        scaling::TipPathConfig{period_s_, sc.direction_change_acceleration_m_s2, sc.jerk_max_m_s3,
+                               sc.deceleration_max_m_s2, config.redundancy.resolution});
     scaler_ = std::make_unique<scaling::PathScaler>(
         model_,
         scaling::PathScalerConfig{period_s_, sc.jerk_max_m_s3, sc.acceleration_max_m_s2,
@@ -114,8 +115,16 @@ void Controller::update_full(const valves::MachineState& state, const Eigen::Vec
     tip_error_filtered_m_ += tracking_alpha_ * (error - tip_error_filtered_m_);
   }
 
+  // The present cylinder forces, from last cycle's dynamics terms (min-ls-power resolves the
+  // redundancy at the current loads).
+  const JointVector* forces = nullptr;
+  if (scaler_out_.terms.b.size() == model_.dof()) {
+    dynamics::cylinder_arms(model_, q_ref_, dc_dq_);
+    cylinder_force_ = scaler_out_.terms.b.cwiseQuotient(dc_dq_);
+    forces = &cylinder_force_;
+  }
   const double s_before = scaler_->state().s;
-  tip_path_->update(q_ref_, v_cmd, scaler_->state().sdot, tip_out_);
+  tip_path_->update(q_ref_, v_cmd, scaler_->state().sdot, tip_out_, forces);
   scaling::PathScalerInput in;
   in.sdot_request = tip_out_.sdot_request;
   in.tracking_factor = scaling::tracking_factor(tip_error_filtered_m_, tracking_error_ok_m_);

@@ -14,6 +14,8 @@
 #include "craneassist/app/sine_path_experiment.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/config/quantity.hpp"
+#include "craneassist/dynamics/inverse_kinematics.hpp"
+#include "craneassist/dynamics/resolutions.hpp"
 #include "craneassist/input/replay.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
 
@@ -34,6 +36,7 @@ struct ReplayArgs {
   bool no_scaling = false;
   std::string scaling = "full";
   std::string power_bound;  // empty: the config's
+  std::string resolution;   // empty: the config's
   bool realtime = false;
   double settle_s = 1.0;
   std::optional<double> payload_kg;
@@ -67,7 +70,8 @@ void print_summary(const app::RunSummary& s, const config::CraneConfig& cfg,
                    const std::string& replay_name, app::ScalingMode mode, const app::CsvLog* log) {
   const double speedup = s.wall_time_s > 0.0 ? s.duration_s / s.wall_time_s : 0.0;
   std::printf("craneassist replay: %s on %s\n", replay_name.c_str(), cfg.model.name.c_str());
-  std::printf("  backend sim, scaling %s, control %.0f Hz, payload %.0f kg\n",
+  std::printf("  backend sim, resolution %s, scaling %s, control %.0f Hz, payload %.0f kg\n",
+              dynamics::to_string(cfg.redundancy.resolution),
               mode == app::ScalingMode::kFull ? (std::string("full (power bound: ") +
                                                  power_bound_name(cfg.scaling.power_bound) + ")")
                                                     .c_str()
@@ -111,6 +115,15 @@ int run_replay_command(const ReplayArgs& args) {
     cfg = args.config_file.empty() ? config::default_crane_config()
                                    : config::load_crane_config(args.config_file);
     if (args.payload_kg) config::set_payload_mass(cfg.model, *args.payload_kg);
+    if (!args.resolution.empty() &&
+        !dynamics::parse_resolution(args.resolution.c_str(), cfg.redundancy.resolution)) {
+      throw CLI::ValidationError("--resolution", "unknown resolution '" + args.resolution + "'");
+    }
+    if (cfg.redundancy.resolution != dynamics::Resolution::kPinvJoint &&
+        !dynamics::is_loader_structure(cfg.model)) {
+      throw CLI::ValidationError("--resolution",
+                                 "the extension-rate resolutions need a loader crane");
+    }
     if (args.power_bound == "load_sensing") {
       cfg.scaling.power_bound = config::PowerBoundSetting::kLoadSensing;
     } else if (args.power_bound == "actuator_sum") {
@@ -273,6 +286,11 @@ int main(int argc, char** argv) {
                    "Override the config's power bound: load_sensing, actuator_sum (the older "
                    "baseline) or none")
       ->check(CLI::IsMember({"load_sensing", "actuator_sum", "none"}));
+  replay
+      ->add_option("--resolution", args.resolution,
+                   "Override the config's redundancy resolution: pinv-joint, pinv-actuator, "
+                   "min-flow or min-ls-power")
+      ->check(CLI::IsMember({"pinv-joint", "pinv-actuator", "min-flow", "min-ls-power"}));
   replay->add_flag("--realtime", args.realtime,
                    "Pace the loop at real time (default: as fast as possible)");
   replay->add_option("--settle", args.settle_s, "Seconds to keep running after the last replay row")

@@ -9,6 +9,7 @@
 
 #include "craneassist/config/quantity.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
+#include "craneassist/dynamics/inverse_kinematics.hpp"
 #include "embedded_configs.hpp"
 
 namespace craneassist::config {
@@ -330,7 +331,7 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   if (!root.IsMap()) r.fail(root, "", "expected a mapping at the top level");
   r.check_keys(root, "",
                {"format", "name", "frames", "joints", "bodies", "payload", "hydraulics", "control",
-                "scaling", "simulation"});
+                "scaling", "redundancy", "simulation"});
   const std::string format = r.text(root, "format", "");
   if (format != kFormat) {
     r.fail(root["format"], "format",
@@ -389,6 +390,19 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   } else {
     r.fail(scaling["power_bound"], sp + ".power_bound",
            "expected load_sensing, actuator_sum or none, got '" + bound + "'");
+  }
+
+  const YAML::Node redundancy = r.child(root, "redundancy", "");
+  r.check_keys(redundancy, "redundancy", {"resolution"});
+  const std::string resolution = r.text(redundancy, "resolution", "redundancy");
+  if (!dynamics::parse_resolution(resolution.c_str(), cfg.redundancy.resolution)) {
+    r.fail(redundancy["resolution"], "redundancy.resolution",
+           "expected pinv-joint, pinv-actuator, min-flow or min-ls-power, got '" + resolution + "'");
+  }
+  if (cfg.redundancy.resolution != dynamics::Resolution::kPinvJoint &&
+      !dynamics::is_loader_structure(model)) {
+    r.fail(redundancy["resolution"], "redundancy.resolution",
+           "the extension-rate resolutions need a loader crane (slew, lift, tilt, extension)");
   }
 
   const YAML::Node sim = r.child(root, "simulation", "");

@@ -40,6 +40,8 @@ TipPath::TipPath(const dynamics::CraneModel& model, const TipPathConfig& config)
   q_shift_.setZero(n);
   f1_plus_.setZero(n);
   f1_minus_.setZero(n);
+  arms_.setZero(n);
+  force_.setZero(n);  // no loads known: min-ls-power then minimises flow at the margin
 }
 
 void TipPath::reset() {
@@ -55,13 +57,28 @@ void TipPath::resolve(const JointVector& q, const Eigen::Vector3d& u, JointVecto
     bounds_.lower[i] = q[i] <= joint.q_min + kAtLimit ? 0.0 : -kFreeRate;
   }
   dynamics::tip_jacobian(model_, kin_, q, jacobian_);
+  if (config_.resolution != dynamics::Resolution::kPinvJoint) {
+    dynamics::cylinder_arms(model_, q, arms_);
+    dynamics::ExtensionResolutionInput in;
+    in.jacobian = &jacobian_;
+    in.v_tip = u;
+    in.dc_dq = &arms_;
+    in.bounds = &bounds_;
+    in.cylinder_force = cylinder_force_ != nullptr ? cylinder_force_ : &force_;
+    dynamics::resolve_by_extension(model_, config_.resolution, in, extension_);
+    if (extension_.feasible) {
+      f1 = extension_.qdot;  // J f1 = u exactly
+      return;
+    }
+  }
   dynamics::sns_velocity_ik(jacobian_, u, bounds_, sns_);
   // J f1 = u exactly when the saturated resolution can do the task at all.
   f1 = sns_.task_scale > 1e-6 ? JointVector(sns_.qdot / sns_.task_scale) : JointVector::Zero(n);
 }
 
 void TipPath::update(const JointVector& q, const Eigen::Vector3d& v_cmd, double sdot,
-                     TipPathOutput& out) {
+                     TipPathOutput& out, const JointVector* cylinder_force) {
+  cylinder_force_ = cylinder_force;
   const int n = model_.dof();
   const double speed_cmd = v_cmd.norm();
   if (speed_cmd > 0.0) {

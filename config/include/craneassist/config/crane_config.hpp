@@ -7,6 +7,7 @@
 
 #include "craneassist/config/config_error.hpp"
 #include "craneassist/dynamics/model.hpp"
+#include "craneassist/dynamics/resolutions.hpp"
 
 namespace craneassist::config {
 
@@ -31,6 +32,10 @@ struct ScalingSettings {
   double power_reserve = 0.0;  // share of P_max kept for feedback corrections
 };
 
+struct RedundancySettings {
+  dynamics::Resolution resolution = dynamics::Resolution::kPinvJoint;
+};
+
 struct SimulationSettings {
   double step_s = 1e-3;
   dynamics::JointVector q_initial;
@@ -40,6 +45,7 @@ struct CraneConfig {
   dynamics::CraneModel model;
   ControlSettings control;
   ScalingSettings scaling;
+  RedundancySettings redundancy;
   SimulationSettings simulation;
   std::string source_name;  // file the config came from, or "<embedded k70m.yaml>"
   // Number of quantities in the file that do not state where they come from.

@@ -20,6 +20,7 @@
 
 #include "craneassist/dynamics/kinematics.hpp"
 #include "craneassist/dynamics/redundancy.hpp"
+#include "craneassist/dynamics/resolutions.hpp"
 #include "craneassist/scaling/path_constraints.hpp"
 
 namespace craneassist::scaling {
@@ -29,6 +30,9 @@ struct TipPathConfig {
   double direction_change_acceleration = 0.5;  // m/s^2, tip normal acceleration when turning
   double jerk_max = 5.0;                       // path jerk, m/s^3 (for the end-damping curve)
   double deceleration_max = 1.0;               // path deceleration, m/s^2 (end damping)
+  // How the redundancy is resolved; the extension-rate resolutions fall back to the SNS when
+  // no extension rate meets the bounds.
+  dynamics::Resolution resolution = dynamics::Resolution::kPinvJoint;
 };
 
 struct TipPathOutput {
@@ -45,8 +49,10 @@ class TipPath {
 
   void reset();
 
-  // q: the reference configuration; v_cmd: the command (finite); sdot: the current path speed.
-  void update(const JointVector& q, const Eigen::Vector3d& v_cmd, double sdot, TipPathOutput& out);
+  // q: the reference configuration; v_cmd: the command (finite); sdot: the current path speed;
+  // cylinder_force: the present cylinder forces (for min-ls-power; nullptr: none known).
+  void update(const JointVector& q, const Eigen::Vector3d& v_cmd, double sdot, TipPathOutput& out,
+              const JointVector* cylinder_force = nullptr);
 
  private:
   void resolve(const JointVector& q, const Eigen::Vector3d& u, JointVector& f1);
@@ -60,6 +66,9 @@ class TipPath {
   dynamics::TaskJacobian jacobian_;
   dynamics::JointRateBounds bounds_;
   dynamics::SnsResult sns_;
+  dynamics::ExtensionResolutionResult extension_;
+  JointVector arms_, force_;
+  const JointVector* cylinder_force_ = nullptr;
   JointVector q_shift_, f1_plus_, f1_minus_;
 };
 
