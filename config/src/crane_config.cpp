@@ -396,8 +396,9 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   r.check_keys(redundancy, "redundancy", {"resolution"});
   const std::string resolution = r.text(redundancy, "resolution", "redundancy");
   if (!dynamics::parse_resolution(resolution.c_str(), cfg.redundancy.resolution)) {
-    r.fail(redundancy["resolution"], "redundancy.resolution",
-           "expected pinv-joint, pinv-actuator, min-flow or min-ls-power, got '" + resolution + "'");
+    r.fail(
+        redundancy["resolution"], "redundancy.resolution",
+        "expected pinv-joint, pinv-actuator, min-flow or min-ls-power, got '" + resolution + "'");
   }
   if (cfg.redundancy.resolution != dynamics::Resolution::kPinvJoint &&
       !dynamics::is_loader_structure(model)) {
