@@ -29,4 +29,11 @@ inline void count_ode_allocations() {
   dSetFreeHandler([](void* p, dsizeint) { std::free(p); });
 }
 
+// Restores ODE's own allocation (plain malloc, realloc and free).
+inline void stop_counting_ode_allocations() {
+  dSetAllocHandler(nullptr);
+  dSetReallocHandler(nullptr);
+  dSetFreeHandler(nullptr);
+}
+
 }  // namespace craneassist::test
