@@ -1,0 +1,70 @@
+// Joint trajectories: a planned motion as joint positions, rates and accelerations over time
+// (what `craneassist plan` writes and `craneassist replay --trajectory` executes). CSV in the
+// style of the replay format; specified in docs/trajectory-format.md.
+#pragma once
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "craneassist/input/replay.hpp"
+
+namespace craneassist::input {
+
+// Errors name file, line and column exactly as for replays.
+using TrajectoryError = ReplayError;
+
+class JointTrajectory {
+ public:
+  static constexpr int kMaxJoints = 6;
+  static constexpr std::size_t kMaxRows = 1'000'000;
+
+  explicit JointTrajectory(int joints = 0);
+
+  // Reads and validates a file (header t,q_1..q_n,qdot_1..qdot_n,qddot_1..qddot_n with n in
+  // 1..kMaxJoints, time >= 0 and strictly increasing, every value finite). Throws TrajectoryError.
+  static JointTrajectory load_file(const std::filesystem::path& path);
+  static JointTrajectory parse(std::string_view text, std::string_view source_name);
+
+  // Appends a sample; t must exceed the last one and the vectors have joints() entries (else
+  // std::invalid_argument).
+  void append(double t_s, const Eigen::Ref<const Eigen::VectorXd>& q,
+              const Eigen::Ref<const Eigen::VectorXd>& qdot,
+              const Eigen::Ref<const Eigen::VectorXd>& qddot);
+
+  int joints() const { return joints_; }
+  std::size_t size() const { return t_s_.size(); }
+  bool empty() const { return t_s_.empty(); }
+  double t_s(std::size_t i) const { return t_s_[i]; }
+  double start_time_s() const { return t_s_.front(); }
+  double end_time_s() const { return t_s_.back(); }
+  Eigen::Map<const Eigen::VectorXd> q(std::size_t i) const { return column(0, i); }
+  Eigen::Map<const Eigen::VectorXd> qdot(std::size_t i) const { return column(1, i); }
+  Eigen::Map<const Eigen::VectorXd> qddot(std::size_t i) const { return column(2, i); }
+
+  // Position and rate at time t: quintic Hermite interpolation between samples (position, rate
+  // and acceleration continuous); held at the first and last sample outside the time range.
+  // q and qdot must have joints() entries. No allocation.
+  void sample(double t_s, Eigen::Ref<Eigen::VectorXd> q, Eigen::Ref<Eigen::VectorXd> qdot) const;
+
+  // The comment lines of the file (without '#'), e.g. the planner's summary.
+  std::vector<std::string> comments;
+
+ private:
+  Eigen::Map<const Eigen::VectorXd> column(int block, std::size_t i) const {
+    return {values_.data() + i * 3 * static_cast<std::size_t>(joints_) +
+                static_cast<std::size_t>(block * joints_),
+            joints_};
+  }
+
+  int joints_ = 0;
+  std::vector<double> t_s_;
+  std::vector<double> values_;  // per sample: q, qdot, qddot
+};
+
+void write_joint_trajectory(std::ostream& out, const JointTrajectory& trajectory);
+
+}  // namespace craneassist::input

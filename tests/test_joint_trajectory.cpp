@@ -1,0 +1,143 @@
+// Joint trajectory files (read, write, interpolate) and executing a plan in the simulator.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <sstream>
+
+#include "craneassist/app/planning.hpp"
+#include "craneassist/app/trajectory_runner.hpp"
+#include "craneassist/config/crane_config.hpp"
+#include "craneassist/dynamics/kinematics.hpp"
+#include "craneassist/input/joint_trajectory.hpp"
+#include "craneassist/sim_backend/sim_backend.hpp"
+
+namespace {
+
+using namespace craneassist;
+
+constexpr const char* kTwoJoints =
+    "# a comment\n"
+    "t,q_1,q_2,qdot_1,qdot_2,qddot_1,qddot_2\n"
+    "0, 0, 1, 0, 0, 0, 0\n"
+    "\n"
+    "1, 1, 1, 2, 0, 0, 0\r\n"
+    "2, 2, 0.5, 0, 0, 0, 0\n";
+
+std::string error_of(std::string_view text) {
+  try {
+    input::JointTrajectory::parse(text, "traj.csv");
+  } catch (const input::TrajectoryError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(JointTrajectory, ParsesAndKeepsComments) {
+  const auto t = input::JointTrajectory::parse(kTwoJoints, "traj.csv");
+  EXPECT_EQ(t.joints(), 2);
+  ASSERT_EQ(t.size(), 3u);
+  EXPECT_EQ(t.t_s(1), 1.0);
+  EXPECT_EQ(t.q(2)[1], 0.5);
+  EXPECT_EQ(t.qdot(1)[0], 2.0);
+  ASSERT_EQ(t.comments.size(), 1u);
+  EXPECT_EQ(t.comments[0], "a comment");
+}
+
+TEST(JointTrajectory, ErrorsNameFileLineAndColumn) {
+  EXPECT_EQ(error_of("t,q_1,qdot_1,qddot_1\n0,0,0,0\n1,x,0,0\n"),
+            "traj.csv:3: field 'q_1': not a number: 'x'");
+  EXPECT_EQ(error_of("t,q_1,qdot_1,qddot_1\n0,0,0,0\n0,1,0,0\n"),
+            "traj.csv:3: field 't': time not strictly increasing: 0 s follows 0 s (line 2)");
+  EXPECT_EQ(error_of("t,q_1,qdot_1,qddot_1\n0,0,0\n"),
+            "traj.csv:2: expected 4 fields (t,q_1,qdot_1,qddot_1), got 3");
+  EXPECT_EQ(error_of("t,q_1,qdot_1,qddot_1\n0,0,nan,0\n"),
+            "traj.csv:2: field 'qdot_1': not a finite number: 'nan'");
+  EXPECT_EQ(error_of("t,x,y\n"),
+            "traj.csv:1: expected the header 't,q_1,qdot_1,qddot_1', got 't,x,y'");
+  EXPECT_EQ(error_of("# nothing\n"),
+            "traj.csv:1: missing header 't,q_1,qdot_1,qddot_1' (no line other than comments and "
+            "blank lines)");
+}
+
+TEST(JointTrajectory, WriteThenReadIsExact) {
+  auto t = input::JointTrajectory::parse(kTwoJoints, "traj.csv");
+  t.comments = {"written", "twice"};
+  std::ostringstream out;
+  input::write_joint_trajectory(out, t);
+  const auto back = input::JointTrajectory::parse(out.str(), "again.csv");
+  ASSERT_EQ(back.size(), t.size());
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    EXPECT_EQ(back.t_s(i), t.t_s(i));
+    EXPECT_EQ(back.q(i), t.q(i));
+    EXPECT_EQ(back.qdot(i), t.qdot(i));
+    EXPECT_EQ(back.qddot(i), t.qddot(i));
+  }
+  EXPECT_EQ(back.comments, t.comments);
+}
+
+TEST(JointTrajectory, SamplingReproducesAQuintic) {
+  // Quintic Hermite interpolation is exact for a quintic polynomial.
+  const auto p = [](double t) {
+    return 0.3 - t + 0.5 * t * t + 0.2 * std::pow(t, 3) - 0.05 * std::pow(t, 5);
+  };
+  const auto pd = [](double t) { return -1 + t + 0.6 * t * t - 0.25 * std::pow(t, 4); };
+  const auto pdd = [](double t) { return 1 + 1.2 * t - std::pow(t, 3); };
+  input::JointTrajectory traj(1);
+  for (double t : {0.0, 0.4, 1.0, 1.7}) {
+    traj.append(t, Eigen::VectorXd::Constant(1, p(t)), Eigen::VectorXd::Constant(1, pd(t)),
+                Eigen::VectorXd::Constant(1, pdd(t)));
+  }
+  Eigen::VectorXd q(1), qd(1);
+  for (double t = 0.0; t <= 1.7; t += 0.013) {
+    traj.sample(t, q, qd);
+    EXPECT_NEAR(q[0], p(t), 1e-12) << t;
+    EXPECT_NEAR(qd[0], pd(t), 1e-11) << t;
+  }
+  traj.sample(5.0, q, qd);  // held at the end, at rest
+  EXPECT_NEAR(q[0], p(1.7), 1e-15);
+  EXPECT_EQ(qd[0], 0.0);
+}
+
+TEST(TrajectoryRunner, SimulatedCraneFollowsAPlan) {
+  auto cfg = config::default_crane_config();
+  const auto& m = cfg.model;
+  // A 4 s horizontal quintic move planned by the DP on a small grid.
+  planner::TipSamples s;
+  s.dt_s = 0.05;
+  const Eigen::Vector3d a(3.2, 1.5, 1.0), b(4.8, 1.5, 1.0);
+  for (int k = 0; k <= 80; ++k) {
+    const double x = k / 80.0, x2 = x * x, x3 = x2 * x;
+    s.p_m.push_back(a + (b - a) * x3 * (10 - 15 * x + 6 * x2));
+    s.v_m_s.push_back((b - a) * 30 * x2 * (1 - 2 * x + x2) / 4.0);
+    s.a_m_s2.push_back((b - a) * 60 * x * (1 - 3 * x + 2 * x2) / 16.0);
+  }
+  planner::StageModel stages(m, s, {});
+  planner::DpOptions options;
+  options.grid = {80, 31, 41};
+  options.refinement.passes = 1;
+  const auto plan = planner::plan_dp(stages, 0.3, options);
+  ASSERT_TRUE(plan.ok);
+  const auto traj = app::to_joint_trajectory(plan, "test");
+  ASSERT_EQ(traj.size(), 81u);
+  EXPECT_EQ(traj.comments.size(), 3u);
+
+  sim_backend::SimBackend machine(m, {cfg.simulation.step_s, dynamics::JointVector(traj.q(0))});
+  const auto summary = app::run_trajectory(cfg, traj, machine, {}, nullptr);
+  EXPECT_LT(summary.start_error_m, 1e-6);
+  EXPECT_LT(summary.max_tip_error_m, 0.02);
+  EXPECT_LT(summary.rms_tip_error_m, 0.01);
+  EXPECT_GT(summary.energy_j, 0.9 * plan.total_cost);  // the model predicts the machine
+  EXPECT_LT(summary.energy_j, 1.1 * plan.total_cost);
+  EXPECT_EQ(summary.invalid_state_cycles, 0);
+  std::printf("tip error max %.4f rms %.4f m, energy %.0f J (plan %.0f J)\n",
+              summary.max_tip_error_m, summary.rms_tip_error_m, summary.energy_j, plan.total_cost);
+
+  // Without the preview the machine lags the plan by its valve delay: a larger error.
+  sim_backend::SimBackend lagging(m, {cfg.simulation.step_s, dynamics::JointVector(traj.q(0))});
+  app::TrajectoryRunOptions no_preview;
+  no_preview.preview = false;
+  const auto late = app::run_trajectory(cfg, traj, lagging, no_preview, nullptr);
+  EXPECT_GT(late.rms_tip_error_m, summary.rms_tip_error_m);
+}
+
+}  // namespace
