@@ -5,7 +5,7 @@
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
-#include "craneassist/sim_backend/ls_pump.hpp"
+#include "craneassist/sim_backend/pump_model.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
 #include "craneassist/sim_backend/valve_section.hpp"
 
@@ -34,8 +34,8 @@ JointVector vec(std::initializer_list<double> values) {
 }  // namespace
 
 TEST(LsPump, UnsaturatedServesEverySectionAtHighestLoadPlusMargin) {
-  const sim_backend::LsPump pump(test_pump());
-  sim_backend::LsPumpResult r;
+  const sim_backend::PumpModel pump(test_pump());
+  sim_backend::PumpResult r;
   pump.solve(vec({1e-3, 1e-3, 0.0}), vec({5e6, 8e6, 15e6}), r);
   EXPECT_EQ(r.limit, valves::PumpLimit::kNone);
   EXPECT_DOUBLE_EQ(r.supply_pressure_pa, 10e6) << "closed section's load does not count";
@@ -46,8 +46,8 @@ TEST(LsPump, UnsaturatedServesEverySectionAtHighestLoadPlusMargin) {
 }
 
 TEST(LsPump, PowerSaturationStarvesTheMostLoadedSectionFirst) {
-  const sim_backend::LsPump pump(test_pump());
-  sim_backend::LsPumpResult r;
+  const sim_backend::PumpModel pump(test_pump());
+  sim_backend::PumpResult r;
   // Demand 3.5e-3 m^3/s at 17 MPa would need 60 kW; 40 kW are available.
   pump.solve(vec({1e-3, 1e-3, 1.5e-3}), vec({3e6, 6e6, 15e6}), r);
   EXPECT_EQ(r.limit, valves::PumpLimit::kPower);
@@ -69,8 +69,8 @@ TEST(LsPump, PowerSaturationStarvesTheMostLoadedSectionFirst) {
 }
 
 TEST(LsPump, FlowSaturationAtLowPressureIsFlowLimited) {
-  const sim_backend::LsPump pump(test_pump());
-  sim_backend::LsPumpResult r;
+  const sim_backend::PumpModel pump(test_pump());
+  sim_backend::PumpResult r;
   pump.solve(vec({3e-3, 3e-3}), vec({1e6, 2e6}), r);
   EXPECT_EQ(r.limit, valves::PumpLimit::kMaxFlow);
   EXPECT_NEAR(r.flow_m3_s, 5e-3, 1e-9);
@@ -78,15 +78,15 @@ TEST(LsPump, FlowSaturationAtLowPressureIsFlowLimited) {
 }
 
 TEST(LsPump, OverrunningLoadDoesNotSetThePressure) {
-  const sim_backend::LsPump pump(test_pump());
-  sim_backend::LsPumpResult r;
+  const sim_backend::PumpModel pump(test_pump());
+  sim_backend::PumpResult r;
   pump.solve(vec({1e-3, 1e-3}), vec({-8e6, 1e6}), r);
   EXPECT_DOUBLE_EQ(r.supply_pressure_pa, 3e6);
 }
 
 TEST(LsPump, LoadAboveReliefStalls) {
-  const sim_backend::LsPump pump(test_pump());
-  sim_backend::LsPumpResult r;
+  const sim_backend::PumpModel pump(test_pump());
+  sim_backend::PumpResult r;
   pump.solve(vec({1e-3, 1e-3}), vec({25e6, 1e6}), r);
   EXPECT_EQ(r.limit, valves::PumpLimit::kRelief);
   EXPECT_DOUBLE_EQ(r.supply_pressure_pa, 21e6);

@@ -8,7 +8,7 @@
 
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/ode_crane.hpp"
-#include "craneassist/sim_backend/ls_pump.hpp"
+#include "craneassist/sim_backend/pump_model.hpp"
 #include "craneassist/sim_backend/valve_section.hpp"
 
 namespace craneassist::sim_backend {
@@ -152,14 +152,14 @@ struct SimBackend::Impl {
 
   dynamics::CraneModel model;
   SimSettings settings;
-  LsPump pump;
+  PumpModel pump;
   dWorldID world;
   dThreadingImplementationID threading = nullptr;
   std::unique_ptr<dynamics::OdeCrane> crane;
   std::vector<dJointFeedback> feedback;
   std::vector<ValveSection> sections;
   JointVector spool_command, requested_velocity, demand, load_pressure, force, q, qdot;
-  LsPumpResult pump_result;
+  PumpResult pump_result;
   double load_alpha = 1.0;
   double t_s = 0.0;
   double energy_j = 0.0;

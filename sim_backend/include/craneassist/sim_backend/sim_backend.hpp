@@ -3,7 +3,7 @@
 //
 // Each simulation step (config simulation.step, 1 ms by default):
 //   1. every valve section turns its (delayed, lagged) spool into a requested cylinder velocity;
-//   2. the LS pump shares what it can deliver by load pressure (ls_pump.hpp);
+//   2. the LS pump shares what it can deliver by load pressure (pump_model.hpp);
 //   3. each joint is driven as an ODE velocity motor at the delivered cylinder velocity, its force
 //      capped at the relief pressure on the chamber that carries the load (the pressurised one for
 //      a resistive load, the load-holding one for an over-running or held load);

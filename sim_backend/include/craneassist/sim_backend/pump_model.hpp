@@ -18,7 +18,7 @@ namespace craneassist::sim_backend {
 
 using dynamics::JointVector;
 
-struct LsPumpResult {
+struct PumpResult {
   JointVector delivered_fraction;  // Q_k(p) / Q_k per section, in [0, 1]
   double supply_pressure_pa = 0.0;
   double flow_m3_s = 0.0;
@@ -26,14 +26,14 @@ struct LsPumpResult {
   valves::PumpLimit limit = valves::PumpLimit::kNone;
 };
 
-class LsPump {
+class PumpModel {
  public:
-  explicit LsPump(const dynamics::Pump& pump) : pump_(pump) {}
+  explicit PumpModel(const dynamics::Pump& pump) : pump_(pump) {}
 
   // demand_m3_s: flow each section asks for (>= 0); load_pressure_pa: its load pressure
   // (negative for an over-running load). Bounded work (fixed bisection count), no allocation.
   void solve(const JointVector& demand_m3_s, const JointVector& load_pressure_pa,
-             LsPumpResult& out) const;
+             PumpResult& out) const;
 
   // Most the pump can deliver at supply pressure p.
   double deliverable_flow(double pressure_pa) const;

@@ -1,17 +1,17 @@
-#include "craneassist/sim_backend/ls_pump.hpp"
+#include "craneassist/sim_backend/pump_model.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 namespace craneassist::sim_backend {
 
-double LsPump::deliverable_flow(double p) const {
+double PumpModel::deliverable_flow(double p) const {
   if (p <= 0.0) return pump_.max_flow_m3_s;
   return std::min(pump_.max_flow_m3_s, pump_.prime_mover_power_w / p);
 }
 
-double LsPump::section_flows(const JointVector& demand, const JointVector& load, double p,
-                             JointVector* fraction) const {
+double PumpModel::section_flows(const JointVector& demand, const JointVector& load, double p,
+                                JointVector* fraction) const {
   double total = 0.0;
   for (int k = 0; k < demand.size(); ++k) {
     const double f =
@@ -22,7 +22,7 @@ double LsPump::section_flows(const JointVector& demand, const JointVector& load,
   return total;
 }
 
-void LsPump::solve(const JointVector& demand, const JointVector& load, LsPumpResult& out) const {
+void PumpModel::solve(const JointVector& demand, const JointVector& load, PumpResult& out) const {
   const int n = static_cast<int>(demand.size());
   out.delivered_fraction.setZero(n);
   double max_load = 0.0;
