@@ -35,6 +35,15 @@ ConfigError error_after_edit(const std::string& from, const std::string& to) {
   return ConfigError("", 0, "", "");
 }
 
+// Replaces the first occurrence of `from` in the K70M file and parses the result.
+craneassist::config::CraneConfig config_after_edit(const std::string& from, const std::string& to) {
+  std::string text = read_file(kK70mPath);
+  const auto pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  text.replace(pos, from.size(), to);
+  return craneassist::config::parse_crane_config(text, "edited.yaml");
+}
+
 int line_of(const std::string& needle) {
   const std::string text = read_file(kK70mPath);
   const auto pos = text.find(needle);
@@ -81,6 +90,8 @@ TEST(CraneConfig, ReferenceCraneMatchesTheSpec) {
   EXPECT_TRUE(m.cylinders[3].differential_spool);
   EXPECT_NEAR(m.pump.max_flow_m3_s, 325e-3 / 60, 1e-12);
   EXPECT_NEAR(m.pump.prime_mover_power_w, 35e3, 1e-9);
+  EXPECT_EQ(m.pump.mode, craneassist::dynamics::PumpMode::kLoadSensing);
+  EXPECT_NEAR(m.pump.supply_pressure_pa, 20e6, 1e-6);
   EXPECT_NEAR(m.valves.dead_zone, 0.53, 1e-12);
   EXPECT_NEAR(m.joints[1].q_max, 1.097, 1e-12);
   EXPECT_NEAR(m.joints[2].theta_rad, M_PI_2, 1e-12);
@@ -135,6 +146,68 @@ TEST(CraneConfig, OutOfRangeValuesAreRejected) {
       "payload.mass");
   EXPECT_EQ(error_after_edit("lift: 20 deg", "lift: 80 deg").field(), "simulation.initial.lift");
   EXPECT_EQ(error_after_edit("step: 1 ms", "step: 3 ms").field(), "simulation.step");
+}
+
+TEST(CraneConfig, ConstantPressurePumpIsParsed) {
+  using craneassist::dynamics::PumpMode;
+  const auto cp = config_after_edit("mode: load-sensing", "mode: constant-pressure");
+  EXPECT_EQ(cp.model.pump.mode, PumpMode::kConstantPressure);
+  EXPECT_NEAR(cp.model.pump.supply_pressure_pa, 20e6, 1e-6);
+  EXPECT_EQ(cp.unsourced_quantities, 0);
+  const auto bar = config_after_edit("supply_pressure: 20 MPa, paper", "supply_pressure: 180 bar");
+  EXPECT_NEAR(bar.model.pump.supply_pressure_pa, 18e6, 1e-6);
+  EXPECT_EQ(bar.unsourced_quantities, 1);
+  // Both fields are optional in load-sensing mode; the mode defaults to load sensing.
+  auto text = read_file(kK70mPath);
+  for (const std::string line : {"    mode: load-sensing", "    supply_pressure: 20 MPa"}) {
+    const auto pos = text.find(line);
+    ASSERT_NE(pos, std::string::npos) << line;
+    text.erase(pos, text.find('\n', pos) + 1 - pos);
+  }
+  const auto bare = craneassist::config::parse_crane_config(text, "bare.yaml");
+  EXPECT_EQ(bare.model.pump.mode, PumpMode::kLoadSensing);
+  EXPECT_EQ(bare.model.pump.supply_pressure_pa, 0.0);
+}
+
+TEST(CraneConfig, BadPumpModeNamesLineFieldAndTheAcceptedValues) {
+  const auto e = error_after_edit("mode: load-sensing", "mode: load_sensing");
+  EXPECT_EQ(e.file(), "edited.yaml");
+  EXPECT_EQ(e.line(), line_of("mode: load-sensing"));
+  EXPECT_EQ(e.field(), "hydraulics.pump.mode");
+  EXPECT_NE(e.reason().find("expected load-sensing or constant-pressure, got 'load_sensing'"),
+            std::string::npos)
+      << e.reason();
+}
+
+TEST(CraneConfig, SupplyPressureMustBePositiveAndWithinTheRelief) {
+  const auto above = error_after_edit("supply_pressure: 20 MPa", "supply_pressure: 22 MPa");
+  EXPECT_EQ(above.field(), "hydraulics.pump.supply_pressure");
+  EXPECT_EQ(above.line(), line_of("supply_pressure: 20 MPa"));
+  EXPECT_NE(above.reason().find("at most max_pressure"), std::string::npos) << above.reason();
+  EXPECT_NE(std::string(above.what()).find("edited.yaml:"), std::string::npos);
+  EXPECT_EQ(error_after_edit("supply_pressure: 20 MPa", "supply_pressure: 0 MPa").field(),
+            "hydraulics.pump.supply_pressure");
+  EXPECT_EQ(error_after_edit("supply_pressure: 20 MPa", "supply_pressure: 20 L/min").field(),
+            "hydraulics.pump.supply_pressure");
+  // At the relief setting exactly is allowed.
+  EXPECT_NEAR(config_after_edit("supply_pressure: 20 MPa", "supply_pressure: 21.5 MPa")
+                  .model.pump.supply_pressure_pa,
+              21.5e6, 1e-6);
+}
+
+TEST(CraneConfig, ConstantPressureModeNeedsTheSupplyPressure) {
+  std::string text = read_file(kK70mPath);
+  text.replace(text.find("mode: load-sensing"), 18, "mode: constant-pressure");
+  const auto pos = text.find("    supply_pressure: 20 MPa");
+  text.erase(pos, text.find('\n', pos) + 1 - pos);
+  try {
+    craneassist::config::parse_crane_config(text, "edited.yaml");
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.field(), "hydraulics.pump.supply_pressure");
+    EXPECT_GT(e.line(), 0);
+    EXPECT_NE(e.reason().find("missing"), std::string::npos) << e.reason();
+  }
 }
 
 TEST(CraneConfig, JointRangeMustFitTheStroke) {

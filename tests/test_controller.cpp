@@ -98,6 +98,26 @@ TEST(Controller, CycleDoesNotAllocate) {
   delete probe;
 }
 
+TEST(Controller, CycleWithAConstantPressurePumpDoesNotAllocate) {
+  auto cfg = config::default_crane_config();
+  cfg.model.pump.mode = dynamics::PumpMode::kConstantPressure;
+  cfg.model.pump.prime_mover_power_w = 10e3;  // make the p_s Q bound bind
+  app::Controller controller(cfg, {app::ScalingMode::kFull});
+  auto state = still_state(cfg);
+  controller.reset(state);
+  app::ControllerOutput out;
+  controller.update(state, Eigen::Vector3d(0.1, 0.1, 0.1), out);  // first call sizes the output
+  int power_limited = 0;
+  const long before = craneassist::test::heap_allocations();
+  for (int k = 0; k < 200; ++k) {
+    controller.update(state, Eigen::Vector3d(0.6, 0.4, -0.4), out);
+    power_limited += out.limit == scaling::ActiveLimit::kPower;
+    state.q = out.q_ref;
+  }
+  EXPECT_EQ(craneassist::test::heap_allocations() - before, 0);
+  EXPECT_GT(power_limited, 20);
+}
+
 TEST(Controller, FullScalingKeepsDirectionAndJerkBound) {
   auto cfg = config::default_crane_config();
   config::set_payload_mass(cfg.model, 650.0);

@@ -251,3 +251,46 @@ TEST(ScalingEndToEnd, EndDampingStopsBeforeTheEndAndLetsTheOperatorBackOff) {
   // Backing off is never limited by the end: the extension comes back in.
   EXPECT_LT(log["q4"][log.rows() - 1], q4_at_reverse - 0.2);
 }
+
+TEST(ScalingEndToEnd, ConstantPressurePumpNeedsItsOwnPowerBound) {
+  // A fast reach up and out on the K70M with a constant-pressure pump at 20 MPa and a 20 kW
+  // prime mover. A controller that bounds the load-sensing power ((max load + 3 MPa) Q) lets
+  // the CP pump (20 MPa Q) run into its power limiter for most of the move; with the pump's own
+  // bound, p_s Q, the reference power settles on P_max (1 - reserve). The jerk-bounded filter
+  // follows a falling speed limit with a lag, so the limiter still engages while the limit falls
+  // fastest (docs/scaling.md).
+  auto cp_cfg = config::default_crane_config();
+  cp_cfg.model.pump.mode = dynamics::PumpMode::kConstantPressure;
+  auto ls_cfg = config::default_crane_config();  // the controller's belief only
+  cp_cfg.model.pump.prime_mover_power_w = ls_cfg.model.pump.prime_mover_power_w = 20e3;
+  const auto replay =
+      input::Replay::parse("t,v_x,v_y,v_z\n0,1.0,1.0,0.6\n3,0,0,0\n", "up_and_out.csv");
+  const Log own = run_replay_logged(cp_cfg, replay, app::ScalingMode::kFull, "cp_own");
+  const Log ls_belief =
+      run_replay_logged(ls_cfg, replay, app::ScalingMode::kFull, "cp_ls_belief", &cp_cfg.model);
+  const double p_bound = 20e3 * (1.0 - cp_cfg.scaling.power_reserve);
+  const DirectionStats d_own = direction_stats(own);
+  const DirectionStats d_ls = direction_stats(ls_belief);
+  std::printf(
+      "[ figures  ] CP pump, LS power bound: power limiter engaged %d cycles, max direction "
+      "error %.2f deg, energy %.1f kJ; p_s Q bound: limiter engaged %d cycles, power limit "
+      "active %d cycles, peak reference power %.2f kW (bound %.2f kW), max direction error "
+      "%.2f deg, energy %.1f kJ\n",
+      count(ls_belief.pump_limit, "power"), d_ls.max_deg, ls_belief["energy_j"].back() / 1e3,
+      count(own.pump_limit, "power"), count(own.active_limit, "power"),
+      max_of(own["ref_power_w"]) / 1e3, p_bound / 1e3, d_own.max_deg, own["energy_j"].back() / 1e3);
+  EXPECT_GT(count(ls_belief.pump_limit, "power"), 120);
+  EXPECT_LT(count(own.pump_limit, "power"), count(ls_belief.pump_limit, "power") / 2);
+  EXPECT_GT(count(own.active_limit, "power"), 200);
+  EXPECT_LE(max_of(own["pump_power_w"]), 20e3 * 1.001);
+  EXPECT_LT(d_own.max_deg, 2.0);
+  // Once the limit falls slowly (2 s to 2.9 s) the reference power is p_s Q at the bound.
+  int settled = 0;
+  for (std::size_t k = 0; k < own.rows(); ++k) {
+    if (own["t"][k] < 2.0 || own["t"][k] > 2.9) continue;
+    EXPECT_LT(own["ref_power_w"][k], 1.01 * p_bound) << "t " << own["t"][k];
+    EXPECT_GT(own["ref_power_w"][k], 0.99 * p_bound) << "t " << own["t"][k];
+    ++settled;
+  }
+  EXPECT_GT(settled, 80);
+}

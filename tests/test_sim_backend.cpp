@@ -1,11 +1,11 @@
-// The simulated crane: LS pump sharing without flow sharing, valve sections, and the ODE crane
-// under valve control.
+// The simulated crane: the LS and constant-pressure pump without flow sharing, valve sections,
+// and the ODE crane under valve control.
 #include <gtest/gtest.h>
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
-#include "craneassist/sim_backend/ls_pump.hpp"
+#include "craneassist/sim_backend/pump_model.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
 #include "craneassist/sim_backend/valve_section.hpp"
 
@@ -24,6 +24,15 @@ dynamics::Pump test_pump() {
   return p;
 }
 
+// The same pump in constant-pressure mode at p_s = 15 MPa: it delivers up to
+// min(5e-3, 40e3 / 15e6) = 2.67e-3 m^3/s at p_s.
+dynamics::Pump cp_pump(double supply_pressure_pa = 15e6) {
+  dynamics::Pump p = test_pump();
+  p.mode = dynamics::PumpMode::kConstantPressure;
+  p.supply_pressure_pa = supply_pressure_pa;
+  return p;
+}
+
 JointVector vec(std::initializer_list<double> values) {
   JointVector v(static_cast<Eigen::Index>(values.size()));
   Eigen::Index i = 0;
@@ -34,8 +43,8 @@ JointVector vec(std::initializer_list<double> values) {
 }  // namespace
 
 TEST(LsPump, UnsaturatedServesEverySectionAtHighestLoadPlusMargin) {
-  const sim_backend::LsPump pump(test_pump());
-  sim_backend::LsPumpResult r;
+  const sim_backend::PumpModel pump(test_pump());
+  sim_backend::PumpResult r;
   pump.solve(vec({1e-3, 1e-3, 0.0}), vec({5e6, 8e6, 15e6}), r);
   EXPECT_EQ(r.limit, valves::PumpLimit::kNone);
   EXPECT_DOUBLE_EQ(r.supply_pressure_pa, 10e6) << "closed section's load does not count";
@@ -46,8 +55,8 @@ TEST(LsPump, UnsaturatedServesEverySectionAtHighestLoadPlusMargin) {
 }
 
 TEST(LsPump, PowerSaturationStarvesTheMostLoadedSectionFirst) {
-  const sim_backend::LsPump pump(test_pump());
-  sim_backend::LsPumpResult r;
+  const sim_backend::PumpModel pump(test_pump());
+  sim_backend::PumpResult r;
   // Demand 3.5e-3 m^3/s at 17 MPa would need 60 kW; 40 kW are available.
   pump.solve(vec({1e-3, 1e-3, 1.5e-3}), vec({3e6, 6e6, 15e6}), r);
   EXPECT_EQ(r.limit, valves::PumpLimit::kPower);
@@ -69,8 +78,8 @@ TEST(LsPump, PowerSaturationStarvesTheMostLoadedSectionFirst) {
 }
 
 TEST(LsPump, FlowSaturationAtLowPressureIsFlowLimited) {
-  const sim_backend::LsPump pump(test_pump());
-  sim_backend::LsPumpResult r;
+  const sim_backend::PumpModel pump(test_pump());
+  sim_backend::PumpResult r;
   pump.solve(vec({3e-3, 3e-3}), vec({1e6, 2e6}), r);
   EXPECT_EQ(r.limit, valves::PumpLimit::kMaxFlow);
   EXPECT_NEAR(r.flow_m3_s, 5e-3, 1e-9);
@@ -78,20 +87,118 @@ TEST(LsPump, FlowSaturationAtLowPressureIsFlowLimited) {
 }
 
 TEST(LsPump, OverrunningLoadDoesNotSetThePressure) {
-  const sim_backend::LsPump pump(test_pump());
-  sim_backend::LsPumpResult r;
+  const sim_backend::PumpModel pump(test_pump());
+  sim_backend::PumpResult r;
   pump.solve(vec({1e-3, 1e-3}), vec({-8e6, 1e6}), r);
   EXPECT_DOUBLE_EQ(r.supply_pressure_pa, 3e6);
 }
 
 TEST(LsPump, LoadAboveReliefStalls) {
-  const sim_backend::LsPump pump(test_pump());
-  sim_backend::LsPumpResult r;
+  const sim_backend::PumpModel pump(test_pump());
+  sim_backend::PumpResult r;
   pump.solve(vec({1e-3, 1e-3}), vec({25e6, 1e6}), r);
   EXPECT_EQ(r.limit, valves::PumpLimit::kRelief);
   EXPECT_DOUBLE_EQ(r.supply_pressure_pa, 21e6);
   EXPECT_DOUBLE_EQ(r.delivered_fraction[0], 0.0);
   EXPECT_DOUBLE_EQ(r.delivered_fraction[1], 1.0);
+}
+
+TEST(LsPump, IgnoresTheConstantPressureSetpoint) {
+  dynamics::Pump p = test_pump();
+  p.supply_pressure_pa = 15e6;  // only used in constant-pressure mode
+  const sim_backend::PumpModel pump(p);
+  sim_backend::PumpResult r;
+  pump.solve(vec({1e-3, 1e-3, 0.0}), vec({5e6, 8e6, 15e6}), r);
+  EXPECT_DOUBLE_EQ(r.supply_pressure_pa, 10e6);
+  EXPECT_DOUBLE_EQ(r.power_w, 10e6 * 2e-3);
+  pump.solve(vec({0.0, 0.0}), vec({5e6, 8e6}), r);
+  EXPECT_DOUBLE_EQ(r.supply_pressure_pa, 2e6) << "idle LS pump at standby";
+}
+
+TEST(CpPump, HoldsTheSetpointWhateverTheLoads) {
+  const sim_backend::PumpModel pump(cp_pump());
+  sim_backend::PumpResult light, heavy, idle;
+  pump.solve(vec({1e-3, 0.5e-3, 0.0}), vec({1e6, 3e6, 14e6}), light);
+  pump.solve(vec({1e-3, 0.5e-3, 0.0}), vec({8e6, 12e6, 1e6}), heavy);
+  for (const auto* r : {&light, &heavy}) {
+    EXPECT_EQ(r->limit, valves::PumpLimit::kNone);
+    EXPECT_DOUBLE_EQ(r->supply_pressure_pa, 15e6);
+    EXPECT_DOUBLE_EQ(r->flow_m3_s, 1.5e-3);
+    EXPECT_DOUBLE_EQ(r->delivered_fraction[0], 1.0);
+    EXPECT_DOUBLE_EQ(r->delivered_fraction[1], 1.0);
+    EXPECT_DOUBLE_EQ(r->power_w, 15e6 * 1.5e-3) << "p_s Q, not (max load + margin) Q";
+  }
+  // Nothing open: the pump holds p_s at zero displacement and (ideal) takes no power.
+  pump.solve(vec({0.0, 0.0, 0.0}), vec({8e6, 12e6, 1e6}), idle);
+  EXPECT_DOUBLE_EQ(idle.supply_pressure_pa, 15e6);
+  EXPECT_DOUBLE_EQ(idle.flow_m3_s, 0.0);
+  EXPECT_DOUBLE_EQ(idle.power_w, 0.0);
+  EXPECT_EQ(idle.limit, valves::PumpLimit::kNone);
+}
+
+TEST(CpPump, SectionNearOrAboveTheSetpointStarves) {
+  const sim_backend::PumpModel pump(cp_pump());
+  sim_backend::PumpResult r;
+  // dp_c = 2 MPa: 14 MPa is 1 MPa below p_s (sqrt(1/2) of its flow), 16 MPa is above it.
+  pump.solve(vec({0.5e-3, 0.5e-3, 0.5e-3}), vec({2e6, 14e6, 16e6}), r);
+  EXPECT_EQ(r.limit, valves::PumpLimit::kRelief) << "the pressure ceiling held a section back";
+  EXPECT_DOUBLE_EQ(r.supply_pressure_pa, 15e6);
+  EXPECT_DOUBLE_EQ(r.delivered_fraction[0], 1.0);
+  EXPECT_NEAR(r.delivered_fraction[1], std::sqrt(0.5), 1e-12);
+  EXPECT_DOUBLE_EQ(r.delivered_fraction[2], 0.0);
+  EXPECT_NEAR(r.flow_m3_s, 0.5e-3 * (1.0 + std::sqrt(0.5)), 1e-15);
+  EXPECT_NEAR(r.power_w, 15e6 * r.flow_m3_s, 1e-9);
+  // The same loads on a load-sensing pump get their full flow at 18 MPa.
+  const sim_backend::PumpModel ls(test_pump());
+  ls.solve(vec({0.5e-3, 0.5e-3, 0.5e-3}), vec({2e6, 14e6, 16e6}), r);
+  EXPECT_DOUBLE_EQ(r.delivered_fraction[2], 1.0);
+}
+
+TEST(CpPump, PowerLimitLowersThePressureAndStarvesTheMostLoadedSection) {
+  const sim_backend::PumpModel pump(cp_pump());
+  EXPECT_DOUBLE_EQ(pump.deliverable_flow(15e6), 40e3 / 15e6);
+  sim_backend::PumpResult r;
+  // 3e-3 m^3/s at 15 MPa would need 45 kW; 40 kW are available. The power limiter cuts the
+  // displacement and the supply pressure falls to 40 kW / 3e-3 = 13.3 MPa, still above both
+  // loads + dp_c: every section keeps its flow.
+  pump.solve(vec({1.5e-3, 1.5e-3}), vec({3e6, 9e6}), r);
+  EXPECT_EQ(r.limit, valves::PumpLimit::kPower);
+  EXPECT_NEAR(r.supply_pressure_pa, 40e3 / 3e-3, 1e-3);
+  EXPECT_DOUBLE_EQ(r.flow_m3_s, 3e-3);
+  // With a 12 MPa load the pressure cannot fall that far without starving that section: it
+  // settles between 12 and 14 MPa, the light section fully served, the heavy one not.
+  pump.solve(vec({1.5e-3, 1.5e-3}), vec({3e6, 12e6}), r);
+  EXPECT_EQ(r.limit, valves::PumpLimit::kPower);
+  EXPECT_GT(r.supply_pressure_pa, 12e6);
+  EXPECT_LT(r.supply_pressure_pa, 14e6);
+  EXPECT_LE(r.power_w, 40e3 * (1 + 1e-9));
+  EXPECT_NEAR(r.power_w, 40e3, 40.0);
+  EXPECT_NEAR(r.power_w, r.supply_pressure_pa * r.flow_m3_s, 1e-9);
+  EXPECT_DOUBLE_EQ(r.delivered_fraction[0], 1.0);
+  EXPECT_GT(r.delivered_fraction[1], 0.0);
+  EXPECT_LT(r.delivered_fraction[1], 1.0);
+}
+
+TEST(CpPump, FlowLimitAtALowSetpoint) {
+  // At 5 MPa the 40 kW would allow 8e-3 m^3/s; the displacement stops at 5e-3.
+  const sim_backend::PumpModel pump(cp_pump(5e6));
+  sim_backend::PumpResult r;
+  pump.solve(vec({2e-3, 2e-3}), vec({0.5e6, 1e6}), r);
+  EXPECT_EQ(r.limit, valves::PumpLimit::kNone);
+  EXPECT_DOUBLE_EQ(r.supply_pressure_pa, 5e6);
+  pump.solve(vec({3e-3, 3e-3}), vec({0.5e6, 1e6}), r);
+  EXPECT_EQ(r.limit, valves::PumpLimit::kMaxFlow);
+  EXPECT_NEAR(r.flow_m3_s, 5e-3, 1e-9);
+  EXPECT_LT(r.supply_pressure_pa, 5e6);
+  EXPECT_GT(r.delivered_fraction[0], r.delivered_fraction[1]);
+}
+
+TEST(CpPump, SetpointAboveReliefIsCappedByTheRelief) {
+  const sim_backend::PumpModel pump(cp_pump(30e6));
+  sim_backend::PumpResult r;
+  pump.solve(vec({1e-3, 0.0}), vec({5e6, 0.0}), r);
+  EXPECT_DOUBLE_EQ(r.supply_pressure_pa, 21e6);
+  EXPECT_DOUBLE_EQ(r.power_w, 21e6 * 1e-3);
 }
 
 TEST(ValveSection, DelayLagAndDeadZone) {
@@ -186,4 +293,72 @@ TEST_F(SimCrane, PowerNeverExceedsThePrimeMoverWhenSaturated) {
   }
   EXPECT_GT(power_limited, 10);
   EXPECT_LE(peak, cfg_.model.pump.prime_mover_power_w * 1.001);
+}
+
+// The same slew-and-lift move on the LS and the CP crane: the CP pump holds 20 MPa throughout and
+// its energy is p_s times the delivered volume; once the slew has accelerated (its start is
+// pressure limited, at 20 MPa on the CP crane, at relief on the LS one) the compensated sections
+// move alike on both.
+TEST_F(SimCrane, ConstantPressureEnergyIsSupplyPressureTimesVolume) {
+  ASSERT_EQ(cfg_.model.pump.mode, dynamics::PumpMode::kLoadSensing);
+  ASSERT_DOUBLE_EQ(cfg_.model.pump.supply_pressure_pa, 20e6);
+  auto ls = make();
+  cfg_.model.pump.mode = dynamics::PumpMode::kConstantPressure;
+  auto cp = make();
+  valves::ValveCommand cmd;
+  cmd.spool = vec({0.9, 0.7, 0.0, 0.0});  // about 1.4e-3 m^3/s: 29 kW at 20 MPa, unsaturated
+  ls.write(cmd);
+  cp.write(cmd);
+  valves::MachineState s_ls, s_cp;
+  double volume_m3 = 0.0;
+  int pressure_limited = 0;
+  for (int k = 0; k < 1500; ++k) {  // 1.5 s, one simulation step at a time
+    ls.advance(cfg_.simulation.step_s);
+    cp.advance(cfg_.simulation.step_s);
+    ls.read(s_ls);
+    cp.read(s_cp);
+    ASSERT_NE(s_cp.pump.limit, valves::PumpLimit::kPower) << "step " << k;
+    ASSERT_DOUBLE_EQ(s_cp.pump.pressure_pa, 20e6) << "step " << k;
+    ASSERT_DOUBLE_EQ(s_cp.pump.power_w, 20e6 * s_cp.pump.flow_m3_s) << "step " << k;
+    volume_m3 += s_cp.pump.flow_m3_s * cfg_.simulation.step_s;
+    pressure_limited += s_cp.pump.limit == valves::PumpLimit::kRelief;
+  }
+  EXPECT_GT(volume_m3, 1e-3) << "the sections opened (after the 0.15 s valve delay)";
+  EXPECT_NEAR(s_cp.pump.energy_j, 20e6 * volume_m3, 1e-9 * s_cp.pump.energy_j);
+  EXPECT_GT(pressure_limited, 10) << "the slew's start is limited by p_s - dp_c";
+  EXPECT_EQ(s_cp.pump.limit, valves::PumpLimit::kNone);
+  // Load independent, compensated sections: the same speeds and the same flow on both pumps.
+  EXPECT_LT((s_cp.qdot - s_ls.qdot).norm(), 1e-6);
+  EXPECT_NEAR(s_cp.pump.flow_m3_s, s_ls.pump.flow_m3_s, 1e-9);
+  EXPECT_GT(s_cp.pump.flow_m3_s, 1.2e-3);
+  // The LS pump runs at the lift's load + 3 MPa, far below 20 MPa: less energy for the volume.
+  EXPECT_LT(s_ls.pump.pressure_pa, 15e6);
+  EXPECT_LT(s_ls.pump.energy_j, 0.8 * s_cp.pump.energy_j);
+}
+
+TEST_F(SimCrane, ConstantPressurePowerNeverExceedsThePrimeMover) {
+  config::set_payload_mass(cfg_.model, 650.0);
+  cfg_.model.pump.mode = dynamics::PumpMode::kConstantPressure;
+  auto sim = make();
+  valves::MachineState s;
+  valves::ValveCommand cmd;
+  cmd.spool = JointVector::Constant(4, 1.0);  // everything open at once
+  sim.write(cmd);
+  double peak = 0.0;
+  int power_limited = 0;
+  for (int k = 0; k < 200; ++k) {
+    sim.advance(0.01);
+    sim.read(s);
+    peak = std::max(peak, s.pump.power_w);
+    power_limited += s.pump.limit == valves::PumpLimit::kPower;
+    EXPECT_LE(s.pump.pressure_pa, 20e6);
+  }
+  EXPECT_GT(power_limited, 10);
+  EXPECT_LE(peak, cfg_.model.pump.prime_mover_power_w * 1.001);
+}
+
+TEST_F(SimCrane, ConstantPressureNeedsASupplyPressure) {
+  cfg_.model.pump.mode = dynamics::PumpMode::kConstantPressure;
+  cfg_.model.pump.supply_pressure_pa = 0.0;
+  EXPECT_THROW(make(), std::invalid_argument);
 }

@@ -153,7 +153,7 @@ void Controller::update_full(const valves::MachineState& state, const Eigen::Vec
   out.sddot_min = scaler_out_.bounds.sddot_min;
   out.sddot_max = scaler_out_.bounds.sddot_max;
   out.tip_error_m = tip_error_filtered_m_;
-  out.ref_power_w = scaling::load_sensing_power(model_, g, scaler_out_.terms, st.sdot, st.sddot);
+  out.ref_power_w = scaling::pump_power(model_, g, scaler_out_.terms, st.sdot, st.sddot);
 }
 
 void Controller::update_rate_prescaled(const Eigen::Vector3d& v_cmd, ControllerOutput& out) {

@@ -3,9 +3,12 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include "craneassist/app/csv_log.hpp"
@@ -42,6 +45,8 @@ struct ReplayArgs {
   std::optional<double> payload_kg;
   std::string pump_max_flow;      // quantity text, e.g. "120 L/min"
   std::string prime_mover_power;  // quantity text, e.g. "60 kW"
+  std::string pump_mode;          // empty: the config's; ls or cp
+  std::string supply_pressure;    // quantity text, e.g. "20 MPa", or a bare number in MPa
 };
 
 // Applies a quantity given on the command line ("120 L/min") or throws CLI-style.
@@ -54,10 +59,19 @@ double cli_quantity(const std::string& option, const std::string& text, config::
   return q->si_values[0];
 }
 
-const char* power_bound_name(config::PowerBoundSetting b) {
+// A pressure given on the command line: a quantity ("200 bar", "20 MPa") or a bare number in MPa.
+double cli_pressure(const std::string& option, const std::string& text) {
+  char* end = nullptr;
+  const double mpa = std::strtod(text.c_str(), &end);
+  if (end != text.c_str() && *end == '\0' && std::isfinite(mpa) && mpa > 0.0) return mpa * 1e6;
+  return cli_quantity(option, text, config::Dimension::kPressure);
+}
+
+const char* power_bound_name(config::PowerBoundSetting b, dynamics::PumpMode mode) {
   switch (b) {
     case config::PowerBoundSetting::kLoadSensing:
-      return "load-sensing";
+      return mode == dynamics::PumpMode::kConstantPressure ? "constant-pressure, p_s Q"
+                                                           : "load-sensing";
     case config::PowerBoundSetting::kActuatorSum:
       return "actuator power sum (baseline)";
     case config::PowerBoundSetting::kNone:
@@ -72,9 +86,10 @@ void print_summary(const app::RunSummary& s, const config::CraneConfig& cfg,
   std::printf("craneassist replay: %s on %s\n", replay_name.c_str(), cfg.model.name.c_str());
   std::printf("  backend sim, resolution %s, scaling %s, control %.0f Hz, payload %.0f kg\n",
               dynamics::to_string(cfg.redundancy.resolution),
-              mode == app::ScalingMode::kFull ? (std::string("full (power bound: ") +
-                                                 power_bound_name(cfg.scaling.power_bound) + ")")
-                                                    .c_str()
+              mode == app::ScalingMode::kFull
+                  ? (std::string("full (power bound: ") +
+                     power_bound_name(cfg.scaling.power_bound, cfg.model.pump.mode) + ")")
+                        .c_str()
               : mode == app::ScalingMode::kFlowOnly ? "flow prescaling only"
                                                     : "none",
               cfg.control.rate_hz, cfg.model.bodies.back().mass_kg);
@@ -85,10 +100,18 @@ void print_summary(const app::RunSummary& s, const config::CraneConfig& cfg,
       "  tip direction error, commanded vs measured (steady, > 0.05 m/s): max %.2f deg, "
       "rms %.2f deg over %d cycles\n",
       s.max_direction_error_deg, s.rms_direction_error_deg, s.direction_samples);
+  const auto& pump = cfg.model.pump;
+  char pump_name[64];
+  if (pump.mode == dynamics::PumpMode::kConstantPressure) {
+    std::snprintf(pump_name, sizeof pump_name, "constant-pressure %.1f MPa",
+                  dynamics::supply_pressure_ceiling_pa(pump) * 1e-6);
+  } else {
+    std::snprintf(pump_name, sizeof pump_name, "load-sensing");
+  }
   std::printf(
-      "  pump: energy %.1f kJ, peak power %.1f kW (limit %.1f kW), peak flow %.0f L/min, "
+      "  pump %s: energy %.1f kJ, peak power %.1f kW (limit %.1f kW), peak flow %.0f L/min, "
       "saturated in %d cycles\n",
-      s.energy_j / 1e3, s.peak_power_w / 1e3, cfg.model.pump.prime_mover_power_w / 1e3,
+      pump_name, s.energy_j / 1e3, s.peak_power_w / 1e3, cfg.model.pump.prime_mover_power_w / 1e3,
       s.peak_flow_m3_s * 60e3, s.pump_saturated_cycles);
   if (mode == app::ScalingMode::kFull) {
     std::printf("  path jerk: peak %.2f m/s^3 (bound %.2f)\n", s.peak_path_jerk,
@@ -138,6 +161,24 @@ int run_replay_command(const ReplayArgs& args) {
     if (!args.prime_mover_power.empty()) {
       cfg.model.pump.prime_mover_power_w =
           cli_quantity("--prime-mover-power", args.prime_mover_power, config::Dimension::kPower);
+    }
+    auto& pump = cfg.model.pump;
+    if (args.pump_mode == "ls") pump.mode = dynamics::PumpMode::kLoadSensing;
+    if (args.pump_mode == "cp") pump.mode = dynamics::PumpMode::kConstantPressure;
+    if (!args.supply_pressure.empty()) {
+      pump.supply_pressure_pa = cli_pressure("--supply-pressure", args.supply_pressure);
+      if (pump.supply_pressure_pa > pump.max_pressure_pa) {
+        std::ostringstream why;
+        why << "must be at most max_pressure (the relief setting, " << pump.max_pressure_pa * 1e-6
+            << " MPa)";
+        throw CLI::ValidationError("--supply-pressure", why.str());
+      }
+    }
+    if (pump.mode == dynamics::PumpMode::kConstantPressure && !(pump.supply_pressure_pa > 0.0)) {
+      throw CLI::ValidationError("--pump-mode",
+                                 "constant-pressure needs a supply pressure "
+                                 "(hydraulics.pump.supply_pressure or "
+                                 "--supply-pressure)");
     }
     if (args.replay_file.empty()) {
       loaded = input::Replay::parse(app::embedded::kDemoReplayCsv,
@@ -302,6 +343,14 @@ int main(int argc, char** argv) {
                      "Override the pump's maximum flow, e.g. \"120 L/min\"");
   replay->add_option("--prime-mover-power", args.prime_mover_power,
                      "Override the power available to the pump, e.g. \"60 kW\"");
+  replay
+      ->add_option("--pump-mode", args.pump_mode,
+                   "Override the config's pump mode: ls (load sensing) or cp (constant pressure "
+                   "at the supply pressure)")
+      ->check(CLI::IsMember({"ls", "cp"}));
+  replay->add_option("--supply-pressure", args.supply_pressure,
+                     "Override the constant-pressure setpoint, e.g. \"20 MPa\" (a bare number "
+                     "is MPa)");
 
   ExperimentArgs exp;
   auto* experiment = cli.add_subcommand(

@@ -302,7 +302,8 @@ void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& mo
   const YAML::Node pump = r.child(h, "pump", "hydraulics");
   const std::string pp = "hydraulics.pump";
   r.check_keys(pump, pp,
-               {"max_flow", "max_pressure", "ls_margin", "prime_mover_power", "standby_pressure"});
+               {"mode", "max_flow", "max_pressure", "ls_margin", "prime_mover_power",
+                "standby_pressure", "supply_pressure"});
   auto& p = model.pump;
   p.max_flow_m3_s = r.value_in(pump, "max_flow", pp, Dimension::kFlow, 1e-7, 1.0, "positive");
   p.max_pressure_pa = r.value_in(pump, "max_pressure", pp, Dimension::kPressure, 1e5, 1e8,
@@ -313,6 +314,31 @@ void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& mo
       r.value_in(pump, "prime_mover_power", pp, Dimension::kPower, 1.0, 1e7, "positive");
   p.standby_pressure_pa = r.value_in(pump, "standby_pressure", pp, Dimension::kPressure, 0.0,
                                      p.max_pressure_pa, "between 0 and max_pressure");
+  // Optional: the mode defaults to load sensing; the constant-pressure setpoint is needed in that
+  // mode only, but may be given in either (--pump-mode cp then uses it).
+  if (pump["mode"].IsDefined()) {
+    const std::string mode = r.text(pump, "mode", pp);
+    if (mode == "load-sensing") {
+      p.mode = dynamics::PumpMode::kLoadSensing;
+    } else if (mode == "constant-pressure") {
+      p.mode = dynamics::PumpMode::kConstantPressure;
+    } else {
+      r.fail(pump["mode"], pp + ".mode",
+             "expected load-sensing or constant-pressure, got '" + mode + "'");
+    }
+  }
+  if (pump["supply_pressure"].IsDefined()) {
+    p.supply_pressure_pa = r.value(pump, "supply_pressure", pp, Dimension::kPressure);
+    if (!(p.supply_pressure_pa > 0.0 && p.supply_pressure_pa <= p.max_pressure_pa)) {
+      std::ostringstream why;
+      why << "must be positive and at most max_pressure (the relief setting, "
+          << p.max_pressure_pa * 1e-6 << " MPa)";
+      r.fail(pump["supply_pressure"], pp + ".supply_pressure", why.str());
+    }
+  } else if (p.mode == dynamics::PumpMode::kConstantPressure) {
+    r.fail(pump, pp + ".supply_pressure",
+           "missing (the constant-pressure mode needs its setpoint)");
+  }
 
   const YAML::Node valves = r.child(h, "valves", "hydraulics");
   const std::string vp = "hydraulics.valves";

@@ -39,6 +39,31 @@ void apply_upper(double k, double c, double limit, ActiveLimit kind, Acceleratio
   }
 }
 
+// The pump-power bound for a constant-pressure pump: P = p_s Q(sdot) does not depend on the
+// acceleration, so it is a speed limit alone, sdot <= P_max / (p_s Q / sdot); and a cylinder
+// keeps its full flow while its load pressure stays dp_c below p_s, one inequality in sddot per
+// moving cylinder (above it the section starves, pump_model.hpp).
+void constant_pressure_bounds(const dynamics::CraneModel& model, const PathGeometry& path,
+                              const dynamics::PathTerms& terms, double flow_per_speed,
+                              double max_static_pressure, double p_max_w, AccelerationBounds& b) {
+  const auto& pump = model.pump;
+  const double p_supply = dynamics::supply_pressure_ceiling_pa(pump);
+  b.pressure_limit_pa = p_supply - pump.ls_margin_pa;
+  for (int i = 0; i < model.dof(); ++i) {
+    const double sign = motion_sign(path, i);
+    if (sign == 0.0) continue;
+    const double area = dynamics::flow_area_m2(model.cylinders[static_cast<std::size_t>(i)],
+                                               path.dc_dq[i] * path.f1[i]);
+    const double scale = sign / (path.dc_dq[i] * area);
+    apply_upper(scale * terms.m[i], scale * terms.b[i], b.pressure_limit_pa, ActiveLimit::kPower,
+                b);
+  }
+  if (flow_per_speed > 0.0 && p_supply > 0.0) {
+    b.sdot_power =
+        max_static_pressure > b.pressure_limit_pa ? 0.0 : p_max_w / (p_supply * flow_per_speed);
+  }
+}
+
 }  // namespace
 
 const char* to_string(PowerBound bound) {
@@ -114,6 +139,10 @@ void path_acceleration_bounds(const dynamics::CraneModel& model, const PathGeome
       const double scale = sign / (path.dc_dq[i] * dynamics::flow_area_m2(cyl, v));
       max_static_pressure = std::max(max_static_pressure, scale * terms.b[i]);
     }
+    if (pump.mode == dynamics::PumpMode::kConstantPressure) {
+      constant_pressure_bounds(model, path, terms, flow_per_speed, max_static_pressure, p_max_w, b);
+      return;
+    }
     const double flow = flow_per_speed * speed;
     const double p_power = flow > 0.0 ? p_max_w / flow - pump.ls_margin_pa : kInf;
     const double p_relief = pump.max_pressure_pa - pump.ls_margin_pa;
@@ -159,6 +188,21 @@ double load_sensing_power(const dynamics::CraneModel& model, const PathGeometry&
     p_max = std::max(p_max, sign * (terms.m[i] * sddot + terms.b[i]) / (path.dc_dq[i] * area));
   }
   return (p_max + model.pump.ls_margin_pa) * flow;
+}
+
+double pump_power(const dynamics::CraneModel& model, const PathGeometry& path,
+                  const dynamics::PathTerms& terms, double sdot, double sddot) {
+  if (model.pump.mode != dynamics::PumpMode::kConstantPressure) {
+    return load_sensing_power(model, path, terms, sdot, sddot);
+  }
+  double flow = 0.0;
+  for (int i = 0; i < model.dof(); ++i) {
+    if (motion_sign(path, i) == 0.0) continue;
+    const double v = path.dc_dq[i] * path.f1[i];
+    flow += dynamics::flow_area_m2(model.cylinders[static_cast<std::size_t>(i)], v) * std::abs(v) *
+            sdot;
+  }
+  return dynamics::supply_pressure_ceiling_pa(model.pump) * flow;
 }
 
 }  // namespace craneassist::scaling

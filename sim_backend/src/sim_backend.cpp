@@ -8,7 +8,7 @@
 
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/ode_crane.hpp"
-#include "craneassist/sim_backend/ls_pump.hpp"
+#include "craneassist/sim_backend/pump_model.hpp"
 #include "craneassist/sim_backend/valve_section.hpp"
 
 namespace craneassist::sim_backend {
@@ -121,7 +121,10 @@ struct SimBackend::Impl {
       const double area = v > 0.0 ? (resistive ? cyl.area_a_m2 : cyl.area_b_m2)
                                   : (v < 0.0 ? (resistive ? cyl.area_b_m2 : cyl.area_a_m2)
                                              : std::max(cyl.area_a_m2, cyl.area_b_m2));
-      const double f_max = model.pump.max_pressure_pa * area * std::abs(arm);
+      // The pump pushes at most at its pressure ceiling (relief; p_s for a constant-pressure
+      // pump); the load-holding valves hold up to relief.
+      const double p_cap = resistive ? supply_ceiling_pa : model.pump.max_pressure_pa;
+      const double f_max = p_cap * area * std::abs(arm);
       const dJointID j = crane->joint(i + 1);
       if (model.joints[static_cast<std::size_t>(i)].type == dynamics::JointType::kPrismatic) {
         dJointSetSliderParam(j, dParamVel, v / arm);
@@ -152,15 +155,16 @@ struct SimBackend::Impl {
 
   dynamics::CraneModel model;
   SimSettings settings;
-  LsPump pump;
+  PumpModel pump;
   dWorldID world;
   dThreadingImplementationID threading = nullptr;
   std::unique_ptr<dynamics::OdeCrane> crane;
   std::vector<dJointFeedback> feedback;
   std::vector<ValveSection> sections;
   JointVector spool_command, requested_velocity, demand, load_pressure, force, q, qdot;
-  LsPumpResult pump_result;
+  PumpResult pump_result;
   double load_alpha = 1.0;
+  double supply_ceiling_pa = dynamics::supply_pressure_ceiling_pa(model.pump);
   double t_s = 0.0;
   double energy_j = 0.0;
 };
@@ -171,6 +175,10 @@ SimBackend::SimBackend(const dynamics::CraneModel& model, const SimSettings& set
   }
   if (settings.q_initial.size() != model.dof()) {
     throw std::invalid_argument("initial configuration has the wrong number of joints");
+  }
+  if (model.pump.mode == dynamics::PumpMode::kConstantPressure &&
+      !(model.pump.supply_pressure_pa > 0.0)) {
+    throw std::invalid_argument("a constant-pressure pump needs a positive supply pressure");
   }
   impl_ = std::make_unique<Impl>(model, settings);
 }

@@ -54,7 +54,7 @@ struct ControllerOutput {
   double s = 0.0, sdot = 0.0, sddot = 0.0, sdddot = 0.0;
   double sddot_min = 0.0, sddot_max = 0.0;
   double tip_error_m = 0.0;  // filtered tracking error used for the slow-down
-  double ref_power_w = 0.0;  // LS pump power the model predicts for the reference
+  double ref_power_w = 0.0;  // pump power (LS, or p_s Q) the model predicts for the reference
 };
 
 enum class ControllerStatus { kRunning, kStopping, kStopped };

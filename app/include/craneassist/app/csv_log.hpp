@@ -29,7 +29,7 @@ struct LogRow {
   double scale = 0.0, flow_demand_m3s = 0.0;
   double s = 0.0, sdot = 0.0, sddot = 0.0, sdddot = 0.0, sddot_min = 0.0, sddot_max = 0.0;
   double tip_error_m = 0.0;
-  double ref_power_w = 0.0;       // LS pump power the model predicts for the reference
+  double ref_power_w = 0.0;       // pump power the model predicts for the reference
   const char* active_limit = "";  // static strings only (to_string of the enums)
   const char* pump_limit = "";
 

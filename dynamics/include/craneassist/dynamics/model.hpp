@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <string>
 #include <vector>
@@ -68,13 +69,33 @@ struct Cylinder {
   double a_max_m_s2 = 0.0;
 };
 
+// How the variable pump sets its supply pressure (paper 000 section 2.1, fig. 3).
+enum class PumpMode {
+  kLoadSensing,       // highest load pressure + ls_margin (standby_pressure when idle)
+  kConstantPressure,  // held at supply_pressure whatever the loads
+};
+
 struct Pump {
+  PumpMode mode = PumpMode::kLoadSensing;
   double max_flow_m3_s = 0.0;
   double max_pressure_pa = 0.0;  // relief setting
+  // Load-sensing margin; also the pressure compensators' margin dp_c in both modes.
   double ls_margin_pa = 0.0;
   double prime_mover_power_w = 0.0;
-  double standby_pressure_pa = 0.0;  // supply pressure with no section open
+  double standby_pressure_pa = 0.0;  // LS supply pressure with no section open
+  double supply_pressure_pa = 0.0;   // constant-pressure setpoint p_s; 0: not given
 };
+
+inline const char* to_string(PumpMode mode) {
+  return mode == PumpMode::kConstantPressure ? "constant-pressure" : "load-sensing";
+}
+
+// Highest supply pressure the pump gives: the relief setting, or in constant-pressure mode the
+// setpoint (capped by the relief).
+inline double supply_pressure_ceiling_pa(const Pump& p) {
+  return p.mode == PumpMode::kConstantPressure ? std::min(p.supply_pressure_pa, p.max_pressure_pa)
+                                               : p.max_pressure_pa;
+}
 
 struct ValveSections {
   double dead_zone = 0.0;  // fraction of the spool (current) range with no flow

@@ -12,6 +12,9 @@
 // for hydraulic manipulators subject to limited on-board power", eqs. 11-12, in actuator space).
 // The baseline bound of the same paper (eqs. 9-10, after Flores and Kecskemethy) limits the sum
 // of actuator powers instead, |sdot f'^T (m sddot + b)| <= P_max; it is kept for comparison.
+// With a constant-pressure pump (model.pump.mode) the kLoadSensing bound becomes that pump's own
+// power, P = p_s Q(sdot) <= P_max (a speed limit), and max_i p_i + dp_c <= p_s (the sections
+// keep their flow; paper 000 eq. 43).
 #pragma once
 
 #include "craneassist/dynamics/model.hpp"
@@ -23,7 +26,7 @@ namespace craneassist::scaling {
 using dynamics::JointVector;
 
 enum class PowerBound {
-  kLoadSensing,       // the correct LS definition (default)
+  kLoadSensing,       // the pump's power (default): LS, or p_s Q for a constant-pressure pump
   kActuatorPowerSum,  // the older sum-of-actuator-powers bound (baseline)
   kNone,              // no power limit
 };
@@ -53,7 +56,8 @@ struct AccelerationBounds {
   double sddot_max = 0.0;
   ActiveLimit limit_min = ActiveLimit::kNone;  // what sets each side
   ActiveLimit limit_max = ActiveLimit::kNone;
-  double pressure_limit_pa = 0.0;  // min(P_max / Q - dp_LS, p_relief - dp_LS) (LS bound)
+  // min(P_max / Q - dp_LS, p_relief - dp_LS) (LS bound); p_s - dp_c (constant pressure).
+  double pressure_limit_pa = 0.0;
   // Highest path speed at which the power bound still admits sddot = 0 (quasi-static power
   // limit), evaluated with the loads of this cycle; +inf when power does not limit.
   double sdot_power = 0.0;
@@ -79,5 +83,10 @@ void path_acceleration_bounds(const dynamics::CraneModel& model, const PathGeome
 // draw (max load pressure + margin) times flow. For tests and logs.
 double load_sensing_power(const dynamics::CraneModel& model, const PathGeometry& path,
                           const dynamics::PathTerms& terms, double sdot, double sddot);
+
+// The model's pump power at (sdot, sddot), W: load_sensing_power, or p_s Q for a
+// constant-pressure pump (model.pump.mode).
+double pump_power(const dynamics::CraneModel& model, const PathGeometry& path,
+                  const dynamics::PathTerms& terms, double sdot, double sddot);
 
 }  // namespace craneassist::scaling

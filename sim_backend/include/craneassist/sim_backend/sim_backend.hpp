@@ -1,12 +1,14 @@
 // The ODE-simulated crane behind the machine interface: rigid-body crane (dynamics::OdeCrane)
-// driven by pressure-compensated valve sections and a load-sensing pump without flow sharing.
+// driven by pressure-compensated valve sections and a load-sensing or constant-pressure pump
+// without flow sharing (dynamics::Pump::mode).
 //
 // Each simulation step (config simulation.step, 1 ms by default):
 //   1. every valve section turns its (delayed, lagged) spool into a requested cylinder velocity;
-//   2. the LS pump shares what it can deliver by load pressure (ls_pump.hpp);
+//   2. the pump shares what it can deliver by load pressure (pump_model.hpp);
 //   3. each joint is driven as an ODE velocity motor at the delivered cylinder velocity, its force
 //      capped at the relief pressure on the chamber that carries the load (the pressurised one for
-//      a resistive load, the load-holding one for an over-running or held load);
+//      a resistive load, at most p_s with a constant-pressure pump; the load-holding one for an
+//      over-running or held load);
 //   4. the joint stops are the cylinder end stops;
 //   5. the motor reaction gives the cylinder force and, through a 5 ms first-order filter standing
 //      in for oil compressibility, the load pressures for the next step.
@@ -29,7 +31,8 @@ struct SimSettings {
 
 class SimBackend final : public valves::MachineInterface {
  public:
-  // Throws std::invalid_argument on a bad step or initial configuration.
+  // Throws std::invalid_argument on a bad step or initial configuration, or a constant-pressure
+  // pump without a positive supply pressure.
   SimBackend(const dynamics::CraneModel& model, const SimSettings& settings);
   ~SimBackend() override;
   SimBackend(const SimBackend&) = delete;

@@ -1,17 +1,17 @@
-#include "craneassist/sim_backend/ls_pump.hpp"
+#include "craneassist/sim_backend/pump_model.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 namespace craneassist::sim_backend {
 
-double LsPump::deliverable_flow(double p) const {
+double PumpModel::deliverable_flow(double p) const {
   if (p <= 0.0) return pump_.max_flow_m3_s;
   return std::min(pump_.max_flow_m3_s, pump_.prime_mover_power_w / p);
 }
 
-double LsPump::section_flows(const JointVector& demand, const JointVector& load, double p,
-                             JointVector* fraction) const {
+double PumpModel::section_flows(const JointVector& demand, const JointVector& load, double p,
+                                JointVector* fraction) const {
   double total = 0.0;
   for (int k = 0; k < demand.size(); ++k) {
     const double f =
@@ -22,7 +22,7 @@ double LsPump::section_flows(const JointVector& demand, const JointVector& load,
   return total;
 }
 
-void LsPump::solve(const JointVector& demand, const JointVector& load, LsPumpResult& out) const {
+void PumpModel::solve(const JointVector& demand, const JointVector& load, PumpResult& out) const {
   const int n = static_cast<int>(demand.size());
   out.delivered_fraction.setZero(n);
   double max_load = 0.0;
@@ -33,17 +33,22 @@ void LsPump::solve(const JointVector& demand, const JointVector& load, LsPumpRes
       any = true;
     }
   }
+  const bool constant_pressure = pump_.mode == dynamics::PumpMode::kConstantPressure;
+  const double p_ceiling = dynamics::supply_pressure_ceiling_pa(pump_);
   out.limit = valves::PumpLimit::kNone;
   if (!any) {
-    out.supply_pressure_pa = pump_.standby_pressure_pa;
+    // An idle LS pump sits at standby; a CP pump holds its setpoint at zero displacement.
+    out.supply_pressure_pa = constant_pressure ? p_ceiling : pump_.standby_pressure_pa;
     out.flow_m3_s = 0.0;
     out.power_w = 0.0;
     return;
   }
-  // Unsaturated LS operation: supply = highest load + margin, every section fully served.
-  const double p_ls =
-      std::max(std::max(max_load, 0.0) + pump_.ls_margin_pa, pump_.standby_pressure_pa);
-  const double p_top = std::min(p_ls, pump_.max_pressure_pa);
+  // The pressure every open section needs for its full flow: highest load + margin. An
+  // unsaturated LS pump supplies just that (at least standby); a CP pump supplies p_s whatever
+  // it is. Either way at most the ceiling (relief, or p_s).
+  const double p_needed = std::max(max_load, 0.0) + pump_.ls_margin_pa;
+  const double p_ls = std::max(p_needed, pump_.standby_pressure_pa);
+  const double p_top = constant_pressure ? p_ceiling : std::min(p_ls, p_ceiling);
   double p = p_top;
   if (section_flows(demand, load, p_top, nullptr) > deliverable_flow(p_top)) {
     // Saturated: the balance sum Q_k(p) = Q_pump(p) has one root (left side rises with p, right
@@ -61,7 +66,7 @@ void LsPump::solve(const JointVector& demand, const JointVector& load, LsPumpRes
     out.limit = pump_.prime_mover_power_w / std::max(p, 1.0) < pump_.max_flow_m3_s
                     ? valves::PumpLimit::kPower
                     : valves::PumpLimit::kMaxFlow;
-  } else if (p_ls > pump_.max_pressure_pa) {
+  } else if ((constant_pressure ? p_needed : p_ls) > p_ceiling) {
     out.limit = valves::PumpLimit::kRelief;
   }
   out.flow_m3_s = section_flows(demand, load, p, &out.delivered_fraction);
