@@ -362,3 +362,23 @@ TEST_F(SimCrane, ConstantPressureNeedsASupplyPressure) {
   cfg_.model.pump.supply_pressure_pa = 0.0;
   EXPECT_THROW(make(), std::invalid_argument);
 }
+
+// A cylinder standing on its end stop is driven off it: the stop's reaction is not a load on the
+// oil (before, it read as a load pressure far beyond relief and starved the section for good).
+TEST(SimBackend, DrivesACylinderOffItsEndStop) {
+  const auto cfg = craneassist::config::default_crane_config();
+  craneassist::dynamics::JointVector q0(4);
+  q0 << 0.0, 0.44, -1.93, 0.0;  // extension fully retracted, on its stop
+  craneassist::sim_backend::SimBackend sim(cfg.model, {cfg.simulation.step_s, q0});
+  craneassist::valves::MachineState state;
+  sim.read(state);
+  EXPECT_LT(state.load_pressure_pa[3], cfg.model.pump.max_pressure_pa);
+  craneassist::valves::ValveCommand extend{craneassist::dynamics::JointVector::Zero(4)};
+  extend.spool[3] = 1.0;
+  for (int k = 0; k < 100; ++k) {
+    sim.write(extend);
+    sim.advance(0.01);
+  }
+  sim.read(state);
+  EXPECT_GT(state.q[3], 0.2);  // 1 s at up to 0.8 m/s of extension (0.4 m/s of cylinder)
+}

@@ -15,24 +15,28 @@
 #include "craneassist/app/embedded_replays.hpp"
 #include "craneassist/app/replay_runner.hpp"
 #include "craneassist/app/sine_path_experiment.hpp"
+#include "craneassist/app/trajectory_runner.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/config/quantity.hpp"
 #include "craneassist/dynamics/inverse_kinematics.hpp"
 #include "craneassist/dynamics/resolutions.hpp"
 #include "craneassist/input/replay.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
+#include "exit_codes.hpp"
+#include "plan_command.hpp"
 
 namespace {
 
 using namespace craneassist;
 
-constexpr int kExitOk = 0;
-constexpr int kExitUsage = 2;    // bad command line, config or replay file
-constexpr int kExitRuntime = 3;  // the run itself failed
+using cli::kExitOk;
+using cli::kExitRuntime;
+using cli::kExitUsage;
 
 struct ReplayArgs {
-  std::string replay_file;  // empty: the bundled demo
-  std::string config_file;  // empty: the embedded reference crane
+  std::string replay_file;      // empty: the bundled demo
+  std::string trajectory_file;  // a planned joint trajectory instead of a replay
+  std::string config_file;      // empty: the embedded reference crane
   std::string backend = "sim";
   std::string log_file = "craneassist-log.csv";
   bool no_log = false;
@@ -80,6 +84,24 @@ const char* power_bound_name(config::PowerBoundSetting b, dynamics::PumpMode mod
   return "?";
 }
 
+// The pump line of a run summary: mode, energy, peaks.
+void print_pump_line(double energy_j, double peak_power_w, double peak_flow_m3_s,
+                     int saturated_cycles, const config::CraneConfig& cfg) {
+  const auto& pump = cfg.model.pump;
+  char pump_name[64];
+  if (pump.mode == dynamics::PumpMode::kConstantPressure) {
+    std::snprintf(pump_name, sizeof pump_name, "constant-pressure %.1f MPa",
+                  dynamics::supply_pressure_ceiling_pa(pump) * 1e-6);
+  } else {
+    std::snprintf(pump_name, sizeof pump_name, "load-sensing");
+  }
+  std::printf(
+      "  pump %s: energy %.1f kJ, peak power %.1f kW (limit %.1f kW), peak flow %.0f L/min, "
+      "saturated in %d cycles\n",
+      pump_name, energy_j / 1e3, peak_power_w / 1e3, pump.prime_mover_power_w / 1e3,
+      peak_flow_m3_s * 60e3, saturated_cycles);
+}
+
 void print_summary(const app::RunSummary& s, const config::CraneConfig& cfg,
                    const std::string& replay_name, app::ScalingMode mode, const app::CsvLog* log) {
   const double speedup = s.wall_time_s > 0.0 ? s.duration_s / s.wall_time_s : 0.0;
@@ -100,19 +122,7 @@ void print_summary(const app::RunSummary& s, const config::CraneConfig& cfg,
       "  tip direction error, commanded vs measured (steady, > 0.05 m/s): max %.2f deg, "
       "rms %.2f deg over %d cycles\n",
       s.max_direction_error_deg, s.rms_direction_error_deg, s.direction_samples);
-  const auto& pump = cfg.model.pump;
-  char pump_name[64];
-  if (pump.mode == dynamics::PumpMode::kConstantPressure) {
-    std::snprintf(pump_name, sizeof pump_name, "constant-pressure %.1f MPa",
-                  dynamics::supply_pressure_ceiling_pa(pump) * 1e-6);
-  } else {
-    std::snprintf(pump_name, sizeof pump_name, "load-sensing");
-  }
-  std::printf(
-      "  pump %s: energy %.1f kJ, peak power %.1f kW (limit %.1f kW), peak flow %.0f L/min, "
-      "saturated in %d cycles\n",
-      pump_name, s.energy_j / 1e3, s.peak_power_w / 1e3, cfg.model.pump.prime_mover_power_w / 1e3,
-      s.peak_flow_m3_s * 60e3, s.pump_saturated_cycles);
+  print_pump_line(s.energy_j, s.peak_power_w, s.peak_flow_m3_s, s.pump_saturated_cycles, cfg);
   if (mode == app::ScalingMode::kFull) {
     std::printf("  path jerk: peak %.2f m/s^3 (bound %.2f)\n", s.peak_path_jerk,
                 cfg.scaling.jerk_max_m_s3);
@@ -129,6 +139,57 @@ void print_summary(const app::RunSummary& s, const config::CraneConfig& cfg,
     std::printf("  log: %s (%zu rows%s)\n", log->path().c_str(), log->rows_written(),
                 s.log_rows_dropped > 0 ? ", SOME DROPPED" : "");
   }
+}
+
+void print_trajectory_summary(const app::TrajectoryRunSummary& s, const config::CraneConfig& cfg,
+                              const input::JointTrajectory& traj, const std::string& name,
+                              const app::CsvLog* log) {
+  const double speedup = s.wall_time_s > 0.0 ? s.duration_s / s.wall_time_s : 0.0;
+  std::printf("craneassist replay --trajectory: %s on %s\n", name.c_str(), cfg.model.name.c_str());
+  for (const auto& c : traj.comments) std::printf("  | %s\n", c.c_str());
+  std::printf("  ran %.2f s of machine time in %.3f s (%.0fx real time), %d cycles\n", s.duration_s,
+              s.wall_time_s, speedup, s.cycles);
+  std::printf("  tip vs plan: max %.1f mm, rms %.1f mm (start %.1f mm)\n", s.max_tip_error_m * 1e3,
+              s.rms_tip_error_m * 1e3, s.start_error_m * 1e3);
+  print_pump_line(s.energy_j, s.peak_power_w, s.peak_flow_m3_s, s.pump_saturated_cycles, cfg);
+  if (s.invalid_state_cycles > 0) {
+    std::printf("  NO VALID MEASUREMENT in %d cycles (valves neutral)\n", s.invalid_state_cycles);
+  }
+  if (log != nullptr) {
+    std::printf("  log: %s (%zu rows%s)\n", log->path().c_str(), log->rows_written(),
+                s.log_rows_dropped > 0 ? ", SOME DROPPED" : "");
+  }
+}
+
+// replay --trajectory: execute a plan (craneassist plan) in the simulator, starting at its first
+// configuration.
+int run_trajectory_command(const ReplayArgs& args, const config::CraneConfig& cfg) {
+  std::optional<input::JointTrajectory> traj;
+  try {
+    traj = input::JointTrajectory::load_file(args.trajectory_file);
+    if (traj->joints() != cfg.model.dof()) {
+      spdlog::error("trajectory: {}: {} joints, but the crane {} has {}", args.trajectory_file,
+                    traj->joints(), cfg.model.name, cfg.model.dof());
+      return kExitUsage;
+    }
+  } catch (const input::TrajectoryError& e) {
+    spdlog::error("trajectory: {}", e.what());
+    return kExitUsage;
+  }
+  try {
+    sim_backend::SimBackend machine(cfg.model,
+                                    {cfg.simulation.step_s, dynamics::JointVector(traj->q(0))});
+    std::optional<app::CsvLog> log;
+    if (!args.no_log) log.emplace(args.log_file, cfg.model.dof());
+    app::TrajectoryRunOptions options;
+    options.settle_s = args.settle_s;
+    const auto summary = app::run_trajectory(cfg, *traj, machine, options, log ? &*log : nullptr);
+    print_trajectory_summary(summary, cfg, *traj, args.trajectory_file, log ? &*log : nullptr);
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return kExitRuntime;
+  }
+  return kExitOk;
 }
 
 int run_replay_command(const ReplayArgs& args) {
@@ -179,6 +240,12 @@ int run_replay_command(const ReplayArgs& args) {
                                  "constant-pressure needs a supply pressure "
                                  "(hydraulics.pump.supply_pressure or "
                                  "--supply-pressure)");
+    }
+    if (!args.trajectory_file.empty()) {
+      if (!args.replay_file.empty()) {
+        throw CLI::ValidationError("--trajectory", "give a replay file or --trajectory, not both");
+      }
+      return run_trajectory_command(args, cfg);
     }
     if (args.replay_file.empty()) {
       loaded = input::Replay::parse(app::embedded::kDemoReplayCsv,
@@ -305,6 +372,11 @@ int main(int argc, char** argv) {
                    "Replay CSV (t,v_x,v_y,v_z); see docs/replay-format.md")
       ->check(CLI::ExistingFile);
   replay
+      ->add_option("--trajectory", args.trajectory_file,
+                   "Execute a planned joint trajectory (craneassist plan; "
+                   "docs/trajectory-format.md) instead of a replay, from its first configuration")
+      ->check(CLI::ExistingFile);
+  replay
       ->add_option("--config", args.config_file,
                    "Crane config YAML (default: the embedded K70M reference crane)")
       ->check(CLI::ExistingFile);
@@ -379,6 +451,9 @@ int main(int argc, char** argv) {
                        "Keep the simulated pump's power limiter (default: off, so the measured "
                        "power shows what the trajectory demands)");
 
+  cli::PlanArgs plan_args;
+  auto* plan = cli::add_plan_command(cli, plan_args);
+
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -386,6 +461,14 @@ int main(int argc, char** argv) {
     return cli.exit(e) == 0 ? kExitOk : kExitUsage;
   }
   if (*experiment) return run_experiment_command(exp);
+  if (*plan) {
+    try {
+      return cli::run_plan_command(plan_args);
+    } catch (const CLI::Error& e) {
+      cli.exit(e);
+      return kExitUsage;
+    }
+  }
   if (*replay) {
     try {
       return run_replay_command(args);

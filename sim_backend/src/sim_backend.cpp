@@ -98,7 +98,18 @@ struct SimBackend::Impl {
     for (int i = 0; i < model.dof(); ++i) {
       const auto& cyl = model.cylinders[static_cast<std::size_t>(i)];
       const double arm = dynamics::cylinder_arm(cyl, q[i]);
-      force[i] = joint_effort(i + 1) / arm;
+      // At an end of its range the cylinder rests on its mechanical stop, and the joint's
+      // reaction includes the stop's push away from it: that part is steel, not oil. Without
+      // this, a cylinder standing on its stop would read a load pressure far beyond relief and
+      // its section would never open to drive it off the stop.
+      double effort = joint_effort(i + 1);
+      const auto& joint = model.joints[static_cast<std::size_t>(i)];
+      constexpr double kAtStop = 1e-4;  // rad or m
+      if (joint.q_max > joint.q_min) {
+        if (q[i] <= joint.q_min + kAtStop) effort = std::min(effort, 0.0);
+        if (q[i] >= joint.q_max - kAtStop) effort = std::max(effort, 0.0);
+      }
+      force[i] = effort / arm;
       // Direction of the requested motion decides which chamber is pressurised; a closed
       // section reports the chamber that holds the load.
       const double dir = requested_velocity[i] != 0.0 ? requested_velocity[i] : force[i];
