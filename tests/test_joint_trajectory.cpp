@@ -10,6 +10,7 @@
 #include "craneassist/dynamics/kinematics.hpp"
 #include "craneassist/input/joint_trajectory.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
+#include "craneassist/valves/proportional_valves.hpp"
 
 namespace {
 
@@ -138,6 +139,38 @@ TEST(TrajectoryRunner, SimulatedCraneFollowsAPlan) {
   no_preview.preview = false;
   const auto late = app::run_trajectory(cfg, traj, lagging, no_preview, nullptr);
   EXPECT_GT(late.rms_tip_error_m, summary.rms_tip_error_m);
+}
+
+}  // namespace
+
+namespace {
+
+// The valve activation rule (paper 000 appendix A) the trajectory follower applies: a cylinder at
+// rest within activation_error keeps its section closed; beyond it, or with a reference above
+// activation_speed, the section opens.
+TEST(ProportionalValves, ActivationRuleKeepsRestingSectionsClosed) {
+  const auto cfg = config::default_crane_config();
+  EXPECT_DOUBLE_EQ(cfg.control.activation_speed_m_s, 1e-4);
+  EXPECT_DOUBLE_EQ(cfg.control.activation_error_m, 1e-3);
+  const valves::ProportionalValves with_rule(cfg.model, 2.0, 1e-4, 1e-3);
+  const valves::ProportionalValves without_rule(cfg.model, 2.0);
+  valves::ProportionalValvesInput in;
+  in.velocity_ref_m_s = dynamics::JointVector::Zero(4);
+  in.position_error_m = dynamics::JointVector::Zero(4);
+  in.velocity_ref_m_s[1] = 5e-5;  // creeping: below activation_speed
+  in.position_error_m[1] = 5e-4;  // and within activation_error
+  in.velocity_ref_m_s[2] = 5e-5;  // creeping,
+  in.position_error_m[2] = 2e-3;  // but too far off
+  in.velocity_ref_m_s[3] = 0.05;  // moving
+  valves::ValveCommand a, b;
+  with_rule.update(in, a);
+  without_rule.update(in, b);
+  EXPECT_EQ(a.spool[0], 0.0);
+  EXPECT_EQ(a.spool[1], 0.0);
+  EXPECT_NE(b.spool[1], 0.0);  // without the rule the creeping section opens
+  EXPECT_EQ(a.spool[2], b.spool[2]);
+  EXPECT_GT(std::abs(a.spool[2]), cfg.model.valves.dead_zone);
+  EXPECT_EQ(a.spool[3], b.spool[3]);
 }
 
 }  // namespace

@@ -49,7 +49,7 @@ Log read_log(const std::filesystem::path& path) {
       } else if (names[c] == "pump_limit") {
         log.pump_limit.push_back(cell);
       } else {
-        log.columns[names[c]].push_back(std::stod(cell));
+        log.columns[names[c]].push_back(std::strtod(cell.c_str(), nullptr));  // denormals too
       }
     }
   }

@@ -41,6 +41,9 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
       flow_reserve_(config.control.flow_reserve),
       tracking_error_ok_m_(config.scaling.tracking_error_ok_m),
       tracking_alpha_(period_s_ / (config.scaling.tracking_error_filter_s + period_s_)),
+      // The live loop keeps every section under feedback: the activation rule is for executing
+      // planned trajectories (trajectory_runner.hpp), whose at-rest cylinders the planner counts
+      // as closed.
       follower_(config.model, config.control.position_gain_1_s, period_s_) {
   const int n = model_.dof();
   q_ref_ = config.simulation.q_initial;

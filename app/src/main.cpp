@@ -453,6 +453,8 @@ int main(int argc, char** argv) {
 
   cli::PlanArgs plan_args;
   auto* plan = cli::add_plan_command(cli, plan_args);
+  cli::EnergyArgs energy_args;
+  auto* energy = cli::add_energy_command(cli, energy_args);
 
   try {
     cli.parse(argc, argv);
@@ -461,6 +463,14 @@ int main(int argc, char** argv) {
     return cli.exit(e) == 0 ? kExitOk : kExitUsage;
   }
   if (*experiment) return run_experiment_command(exp);
+  if (*energy) {
+    try {
+      return cli::run_energy_command(energy_args);
+    } catch (const CLI::Error& e) {
+      cli.exit(e);
+      return kExitUsage;
+    }
+  }
   if (*plan) {
     try {
       return cli::run_plan_command(plan_args);

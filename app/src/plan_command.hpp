@@ -1,9 +1,11 @@
 // `craneassist plan`: plan the redundancy along a prescribed tip path and write the trajectory.
+// `craneassist energy`: paper 000's energy experiment in simulation (docs/energy.md).
 #pragma once
 
 #include <CLI/CLI.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace craneassist::cli {
 
@@ -24,5 +26,20 @@ struct PlanArgs {
 
 CLI::App* add_plan_command(CLI::App& cli, PlanArgs& args);
 int run_plan_command(const PlanArgs& args);
+
+struct EnergyArgs {
+  std::vector<std::string> path_files = {"examples/paths/horizontal.csv",
+                                         "examples/paths/vertical.csv",
+                                         "examples/paths/half_cycle.csv"};
+  std::string config_file;
+  std::string out_file = "energy-results.csv";
+  std::string grid = "356x101x151";
+  int refine = 3;
+  int threads = 0;
+  bool quiet = false;
+};
+
+CLI::App* add_energy_command(CLI::App& cli, EnergyArgs& args);
+int run_energy_command(const EnergyArgs& args);
 
 }  // namespace craneassist::cli

@@ -26,7 +26,9 @@ TrajectoryRunSummary run_trajectory(const config::CraneConfig& config,
   const int cycles =
       static_cast<int>(std::ceil((trajectory.end_time_s() - t0 + options.settle_s) / period)) + 1;
 
-  valves::ReferenceFollower follower(model, config.control.position_gain_1_s, period);
+  valves::ReferenceFollower follower(model, config.control.position_gain_1_s, period,
+                                     config.control.activation_speed_m_s,
+                                     config.control.activation_error_m);
   valves::MachineState state;
   valves::ValveCommand command;
   dynamics::KinematicsData kin;

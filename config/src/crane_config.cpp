@@ -377,13 +377,22 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   read_hydraulics(r, root, model);
 
   const YAML::Node control = r.child(root, "control", "");
-  r.check_keys(control, "control", {"rate", "position_gain", "flow_reserve"});
+  r.check_keys(control, "control",
+               {"rate", "position_gain", "flow_reserve", "activation_speed", "activation_error"});
   cfg.control.rate_hz =
       r.value_in(control, "rate", "control", Dimension::kFrequency, 1.0, 10000.0, "1 to 10000 Hz");
   cfg.control.position_gain_1_s = r.value_in(control, "position_gain", "control",
                                              Dimension::kInverseTime, 0.0, 1000.0, "0 to 1000 1/s");
   cfg.control.flow_reserve = r.value_in(control, "flow_reserve", "control",
                                         Dimension::kDimensionless, 0.0, 0.5, "between 0 and 0.5");
+  if (control["activation_speed"].IsDefined()) {
+    cfg.control.activation_speed_m_s = r.value_in(control, "activation_speed", "control",
+                                                  Dimension::kVelocity, 0.0, 0.1, "0 to 0.1 m/s");
+  }
+  if (control["activation_error"].IsDefined()) {
+    cfg.control.activation_error_m = r.value_in(control, "activation_error", "control",
+                                                Dimension::kLength, 0.0, 0.1, "0 to 0.1 m");
+  }
 
   const YAML::Node scaling = r.child(root, "scaling", "");
   const std::string sp = "scaling";

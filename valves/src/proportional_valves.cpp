@@ -31,8 +31,12 @@ const char* to_string(BackendStatus status) {
   return "?";
 }
 
-ProportionalValves::ProportionalValves(const dynamics::CraneModel& model, double position_gain_1_s)
-    : model_(model), position_gain_1_s_(position_gain_1_s) {}
+ProportionalValves::ProportionalValves(const dynamics::CraneModel& model, double position_gain_1_s,
+                                       double activation_speed_m_s, double activation_error_m)
+    : model_(model),
+      position_gain_1_s_(position_gain_1_s),
+      activation_speed_m_s_(activation_speed_m_s),
+      activation_error_m_(activation_error_m) {}
 
 double ProportionalValves::velocity_from_spool(double spool, double dead_zone, double v_max) {
   const double open = std::clamp((std::abs(spool) - dead_zone) / (1.0 - dead_zone), 0.0, 1.0);
@@ -51,6 +55,11 @@ void ProportionalValves::update(const ProportionalValvesInput& in, ValveCommand&
   const int n = model_.dof();
   out.spool.resize(n);
   for (int i = 0; i < n; ++i) {
+    if (std::abs(in.velocity_ref_m_s[i]) < activation_speed_m_s_ &&
+        std::abs(in.position_error_m[i]) < activation_error_m_) {
+      out.spool[i] = 0.0;  // at rest and close enough: the section stays closed
+      continue;
+    }
     const double v = in.velocity_ref_m_s[i] + position_gain_1_s_ * in.position_error_m[i];
     out.spool[i] = spool_from_velocity(v, model_.valves.dead_zone, model_.cylinders[i].v_max_m_s);
   }

@@ -8,9 +8,10 @@
 namespace craneassist::valves {
 
 ReferenceFollower::ReferenceFollower(const dynamics::CraneModel& model, double position_gain_1_s,
-                                     double period_s)
+                                     double period_s, double activation_speed_m_s,
+                                     double activation_error_m)
     : model_(model),
-      valves_(model, position_gain_1_s),
+      valves_(model, position_gain_1_s, activation_speed_m_s, activation_error_m),
       lag_alpha_(model.valves.time_constant_s > 0.0
                      ? 1.0 - std::exp(-period_s / model.valves.time_constant_s)
                      : 1.0) {

@@ -12,7 +12,6 @@
 namespace craneassist::planner {
 namespace {
 
-constexpr double kMovingThreshold_m_s = 1e-4;  // a cylinder slower than this is at rest
 constexpr double kUnreachablePenaltyFactor = 100.0;
 
 }  // namespace
@@ -180,7 +179,7 @@ void StageModel::velocity_terms(const PositionTerms& pos, double v, VelocityTerm
     out.force1[i] = pos.m[i] / (pos.arm[i] * arm4_);
     const double area = dynamics::flow_area_m2(cyl, vi);
     out.inv_area[i] = std::copysign(1.0, vi) / area;
-    if (std::abs(vi) > kMovingThreshold_m_s) out.moving |= 1u << i;
+    if (std::abs(vi) > options_.at_rest_speed_m_s) out.moving |= 1u << i;
     out.flow_m3_s += area * std::abs(vi);
     excess += std::max(std::abs(vi) / cyl.v_max_m_s - 1.0, 0.0);
   }

@@ -14,6 +14,11 @@ namespace craneassist::config {
 struct ControlSettings {
   double rate_hz = 100.0;
   double position_gain_1_s = 0.0;  // P feedback on cylinder position error
+  // Valve activation rule (paper 000 appendix A) when executing a planned trajectory: a section
+  // stays closed while its cylinder velocity reference is below activation_speed and its position
+  // error below activation_error. The planner counts such a cylinder as at rest. Zero: off.
+  double activation_speed_m_s = 0.0;
+  double activation_error_m = 0.0;
   // Fraction of the pump's maximum flow the prescaling leaves for the feedback corrections.
   double flow_reserve = 0.0;
 };

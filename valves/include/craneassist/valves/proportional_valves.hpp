@@ -1,7 +1,8 @@
 // Cylinder velocity references to spool commands: a linear dead-zone inverse with optional P
 // feedback on cylinder position, I = DZI(v_ref + Kp e) (paper 000 appendix A, here with a
-// straight-line velocity-vs-current table; the measured table and the eps_v/eps_p activation
-// rule come with the valve-control work).
+// straight-line velocity-vs-current table; the measured table comes with the valve-control work).
+// Activation rule (same appendix): a section stays closed while its velocity reference is below
+// eps_v and its position error below eps_p (both zero: the rule is off).
 #pragma once
 
 #include "craneassist/dynamics/model.hpp"
@@ -16,7 +17,8 @@ struct ProportionalValvesInput {
 
 class ProportionalValves {
  public:
-  ProportionalValves(const dynamics::CraneModel& model, double position_gain_1_s);
+  ProportionalValves(const dynamics::CraneModel& model, double position_gain_1_s,
+                     double activation_speed_m_s = 0.0, double activation_error_m = 0.0);
 
   // Spool commands in [-1, 1]; 0 for a reference below min_speed (stays in the dead zone).
   void update(const ProportionalValvesInput& in, ValveCommand& out) const;
@@ -28,6 +30,7 @@ class ProportionalValves {
  private:
   const dynamics::CraneModel& model_;
   double position_gain_1_s_;
+  double activation_speed_m_s_, activation_error_m_;
 };
 
 }  // namespace craneassist::valves

@@ -21,7 +21,8 @@ namespace craneassist::valves {
 
 class ReferenceFollower {
  public:
-  ReferenceFollower(const dynamics::CraneModel& model, double position_gain_1_s, double period_s);
+  ReferenceFollower(const dynamics::CraneModel& model, double position_gain_1_s, double period_s,
+                    double activation_speed_m_s = 0.0, double activation_error_m = 0.0);
 
   // Fills the history with q (the machine at rest at q).
   void reset(const JointVector& q);

@@ -55,6 +55,9 @@ struct StageModelOptions {
   PlanCost cost = PlanCost::kLoadSensing;
   double cp_supply_pressure_pa = 20e6;  // kConstantPressure (paper 000 section 6)
   double penalty_factor = 1e3;          // penalty constant over the cost's scale per stage
+  // A cylinder slower than this is at rest: its valve stays closed (the follower's activation
+  // rule), so its load pressure does not count.
+  double at_rest_speed_m_s = 1e-4;
 };
 
 // Per (stage, cylinder position): everything that does not depend on v or a.
