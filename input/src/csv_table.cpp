@@ -4,37 +4,15 @@
 #include <charconv>
 #include <cmath>
 
+#include "text_fields.hpp"
+
 namespace craneassist::input::detail {
 namespace {
 
 constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
 
-std::string_view trim(std::string_view s) {
-  const auto is_space = [](char c) { return c == ' ' || c == '\t'; };
-  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
-  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
-  return s;
-}
-
-// File text quoted for a message: control and non-ASCII bytes escaped, long text shortened.
-std::string quoted(std::string_view s) {
-  constexpr std::size_t kMaxShown = 40;
-  std::string out = "'";
-  for (std::size_t i = 0; i < s.size() && i < kMaxShown; ++i) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    if (c >= 0x20 && c < 0x7f) {
-      out += static_cast<char>(c);
-    } else {
-      constexpr std::string_view kHex = "0123456789abcdef";
-      out += "\\x";
-      out += kHex[c >> 4];
-      out += kHex[c & 0xf];
-    }
-  }
-  if (s.size() > kMaxShown) out += "...";
-  out += '\'';
-  return out;
-}
+using detail::quoted;
+using detail::trim;
 
 void split_fields(std::string_view line, std::vector<std::string_view>& fields) {
   fields.clear();
@@ -47,12 +25,6 @@ void split_fields(std::string_view line, std::vector<std::string_view>& fields) 
 }
 
 }  // namespace
-
-std::string format_number(double value) {
-  std::array<char, 32> buffer{};
-  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  return {buffer.data(), static_cast<std::size_t>(result.ptr - buffer.data())};
-}
 
 CsvTable read_csv_table(std::string_view text, std::string_view source_name,
                         const std::vector<std::string>& columns, std::size_t max_rows) {
@@ -97,20 +69,14 @@ CsvTable read_csv_table(std::string_view text, std::string_view source_name,
     }
     for (std::size_t i = 0; i < columns.size(); ++i) {
       const std::string_view f = fields[i];
-      if (f.empty()) throw error(line, columns[i], "missing value");
       double value = 0.0;
-      const auto [ptr, ec] = std::from_chars(f.data(), f.data() + f.size(), value);
-      if (ec == std::errc::invalid_argument || ptr != f.data() + f.size()) {
-        throw error(line, columns[i], "not a number: " + quoted(f));
-      }
-      if (ec == std::errc::result_out_of_range || !std::isfinite(value)) {
-        throw error(line, columns[i], "not a finite number: " + quoted(f));
-      }
+      std::string reason;
+      if (!detail::parse_number(f, value, reason)) throw error(line, columns[i], std::move(reason));
       if (i == 0 && value < 0.0) throw error(line, columns[i], "negative time: " + quoted(f));
       if (i == 0 && table.rows() > 0 && !(value > table.at(table.rows() - 1, 0))) {
         throw error(line, columns[i],
-                    "time not strictly increasing: " + format_number(value) + " s follows " +
-                        format_number(table.at(table.rows() - 1, 0)) + " s (line " +
+                    "time not strictly increasing: " + number(value) + " s follows " +
+                        number(table.at(table.rows() - 1, 0)) + " s (line " +
                         std::to_string(table.lines.back()) + ")");
       }
       table.values.push_back(value);

@@ -27,7 +27,4 @@ struct CsvTable {
 CsvTable read_csv_table(std::string_view text, std::string_view source_name,
                         const std::vector<std::string>& columns, std::size_t max_rows);
 
-// Shortest round-trip decimal form, locale-independent.
-std::string format_number(double value);
-
 }  // namespace craneassist::input::detail

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "csv_table.hpp"
+#include "text_fields.hpp"
 
 namespace craneassist::input {
 namespace {
@@ -143,9 +144,9 @@ void write_joint_trajectory(std::ostream& out, const JointTrajectory& traj) {
   for (std::size_t i = 0; i < columns.size(); ++i) out << (i ? "," : "") << columns[i];
   out << '\n';
   for (std::size_t r = 0; r < traj.size(); ++r) {
-    out << detail::format_number(traj.t_s(r));
+    out << detail::number(traj.t_s(r));
     for (const auto& v : {traj.q(r), traj.qdot(r), traj.qddot(r)}) {
-      for (Eigen::Index j = 0; j < v.size(); ++j) out << ',' << detail::format_number(v[j]);
+      for (Eigen::Index j = 0; j < v.size(); ++j) out << ',' << detail::number(v[j]);
     }
     out << '\n';
   }

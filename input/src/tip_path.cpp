@@ -10,6 +10,8 @@
 #include <system_error>
 #include <utility>
 
+#include "text_fields.hpp"
+
 namespace craneassist::input {
 namespace {
 
@@ -18,66 +20,19 @@ using Limits = PrescribedPathLimits;
 constexpr std::array<std::string_view, 4> kColumns = {"t", "x", "y", "z"};
 constexpr std::string_view kHeader = "t,x,y,z";
 constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
-// Shortest round-trip form of a double has at most 24 characters ("-2.2250738585072014e-308").
-constexpr std::size_t kMaxNumberChars = 32;
 // Quintic rest-to-rest s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5: peak of ds/dtau, at tau = 1/2.
 constexpr double kQuinticPeakRate = 1.875;
 // Samples per spline segment for the peak speed and the arc length (even, for Simpson's rule).
 constexpr int kSamplesPerSegment = 512;
 
-// ---- text helpers (the same rules as the replay reader, replay.cpp) --------------------------
+// ---- text helpers: text_fields.hpp (the replay reader's rules) --------------------------------
 
-std::string_view trim(std::string_view s) {
-  const auto is_space = [](char c) { return c == ' ' || c == '\t'; };
-  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
-  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
-  return s;
-}
-
-// Text from the file, quoted for an error message: control and non-ASCII bytes escaped, long text
-// shortened.
-std::string quoted(std::string_view s) {
-  constexpr std::size_t kMaxShown = 40;
-  std::string out = "'";
-  for (std::size_t i = 0; i < s.size() && i < kMaxShown; ++i) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    if (c >= 0x20 && c < 0x7f) {
-      out += static_cast<char>(c);
-    } else {
-      constexpr std::string_view kHex = "0123456789abcdef";
-      out += "\\x";
-      out += kHex[c >> 4];
-      out += kHex[c & 0xf];
-    }
-  }
-  if (s.size() > kMaxShown) out += "...";
-  out += '\'';
-  return out;
-}
-
-// Shortest round-trip decimal form, locale-independent.
-std::string_view format_number(double value, std::array<char, kMaxNumberChars>& buffer) {
-  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  return {buffer.data(), static_cast<std::size_t>(result.ptr - buffer.data())};
-}
-
-std::string number(double value) {
-  std::array<char, kMaxNumberChars> buffer{};
-  return std::string(format_number(value, buffer));
-}
-
-// Splits a line at commas into at most fields.size() trimmed fields; returns the total count.
-std::size_t split_fields(std::string_view line, std::array<std::string_view, 4>& fields) {
-  std::size_t count = 0;
-  while (true) {
-    const std::size_t comma = line.find(',');
-    const std::string_view field = line.substr(0, comma);
-    if (count < fields.size()) fields[count] = trim(field);
-    ++count;
-    if (comma == std::string_view::npos) return count;
-    line.remove_prefix(comma + 1);
-  }
-}
+using detail::format_number;
+using detail::kMaxNumberChars;
+using detail::number;
+using detail::quoted;
+using detail::split_fields;
+using detail::trim;
 
 // ---- via-point rules ---------------------------------------------------------------------------
 
@@ -131,17 +86,9 @@ class Parser {
 };
 
 double Parser::parse_field(std::string_view text, std::size_t line, std::string_view field) const {
-  if (text.empty()) throw error(line, field, "missing value");
   double value = 0.0;
-  const char* const last = text.data() + text.size();
-  const auto [ptr, ec] = std::from_chars(text.data(), last, value);
-  if (ec == std::errc::invalid_argument || ptr != last) {
-    throw error(line, field, "not a number: " + quoted(text));
-  }
-  if (ec == std::errc::result_out_of_range) {
-    throw error(line, field, "number out of range: " + quoted(text));
-  }
-  if (!std::isfinite(value)) throw error(line, field, "not a finite number: " + quoted(text));
+  std::string reason;
+  if (!detail::parse_number(text, value, reason)) throw error(line, field, std::move(reason));
   return value;
 }
 
