@@ -46,6 +46,7 @@ TipPath::TipPath(const dynamics::CraneModel& model, const TipPathConfig& config)
 
 void TipPath::reset() {
   has_direction_ = false;
+  has_extension_rate_ = false;
   direction_ = Eigen::Vector3d::UnitX();
 }
 
@@ -65,7 +66,21 @@ void TipPath::resolve(const JointVector& q, const Eigen::Vector3d& u, JointVecto
     in.dc_dq = &arms_;
     in.bounds = &bounds_;
     in.cylinder_force = cylinder_force_ != nullptr ? cylinder_force_ : &force_;
-    dynamics::resolve_by_extension(model_, config_.resolution, in, extension_);
+    // Within the window around the last cycle's extension rate, when that leaves any rate.
+    const double lower = bounds_.lower[3], upper = bounds_.upper[3];
+    const double lo = std::max(lower, extension_rate_ - extension_window_);
+    const double hi = std::min(upper, extension_rate_ + extension_window_);
+    if (std::isfinite(extension_window_) && lo <= hi) {
+      bounds_.lower[3] = lo;
+      bounds_.upper[3] = hi;
+      dynamics::resolve_by_extension(model_, config_.resolution, in, extension_);
+      bounds_.lower[3] = lower;
+      bounds_.upper[3] = upper;
+    } else {
+      extension_.feasible = false;
+    }
+    if (!extension_.feasible)
+      dynamics::resolve_by_extension(model_, config_.resolution, in, extension_);
     if (extension_.feasible) {
       f1 = extension_.qdot;  // J f1 = u exactly
       return;
@@ -96,6 +111,15 @@ void TipPath::update(const JointVector& q, const Eigen::Vector3d& v_cmd, double 
   }
   out.direction = direction_;
 
+  // The window for the extension rate (see the header).
+  extension_window_ = std::numeric_limits<double>::infinity();
+  const bool by_extension = config_.resolution != dynamics::Resolution::kPinvJoint && n == 4;
+  if (by_extension && has_extension_rate_ && sdot > kRestSpeed) {
+    const auto& cyl = model_.cylinders[3];
+    const double arm = std::abs(dynamics::cylinder_arm(cyl, q[3]));
+    extension_window_ = 0.25 * cyl.a_max_m_s2 / arm * config_.period_s / sdot;
+  }
+
   auto& g = out.geometry;
   resolve(q, direction_, g.f1);
   // f'' = d f'/ds = (df'/dq) f', central difference along the path.
@@ -105,6 +129,10 @@ void TipPath::update(const JointVector& q, const Eigen::Vector3d& v_cmd, double 
   resolve(q_shift_, direction_, f1_minus_);
   g.f2 = (f1_plus_ - f1_minus_) / (2.0 * kDifferenceStep);
   resolve(q, direction_, g.f1);  // restore the working data for q
+  if (by_extension) {
+    extension_rate_ = g.f1[3];
+    has_extension_rate_ = true;
+  }
   dynamics::cylinder_arms(model_, q, g.dc_dq);
   g.d2c_dq2.resize(n);
   for (int i = 0; i < n; ++i) {

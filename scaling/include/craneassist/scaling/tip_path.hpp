@@ -12,6 +12,12 @@
 // slows the motion down, turns it at low speed and speeds it up again, with bounded joint
 // accelerations throughout. At rest the direction follows the command at once.
 //
+// Extension-rate resolutions (pinv-actuator, min-flow, min-ls-power) are piecewise optimal: the
+// optimum jumps when another cylinder comes to rest first. At path speed sdot, the extension's
+// rate per unit path speed may change by at most a quarter of its acceleration limit times the
+// period over sdot from one cycle to the next, so such a switch ramps the extension cylinder
+// instead of stepping its velocity (the rest of the limit is the scaling's).
+//
 // End damping: a joint moving towards its limit caps the path speed at the speed from which a
 // stop within the joint's acceleration and the path jerk covers the remaining distance; a joint
 // at its limit is saturated in the redundancy resolution so the other joints carry on when they
@@ -69,6 +75,10 @@ class TipPath {
   dynamics::ExtensionResolutionResult extension_;
   JointVector arms_, force_;
   const JointVector* cylinder_force_ = nullptr;
+  // Extension rate per unit path speed of the last cycle, and this cycle's window around it.
+  bool has_extension_rate_ = false;
+  double extension_rate_ = 0.0;
+  double extension_window_ = 0.0;  // +inf: no window
   JointVector q_shift_, f1_plus_, f1_minus_;
 };
 
