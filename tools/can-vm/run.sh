@@ -48,11 +48,13 @@ missing=()
 for tool in qemu-system-x86_64 cpio candump cansend cangen; do
   command -v "$tool" >/dev/null || missing+=("$tool")
 done
+is_static() {
+  local out
+  out="$(LC_ALL=C ldd "$1" 2>&1 || true)"
+  [ -x "$1" ] && [[ "$out" == *"not a dynamic executable"* ]]
+}
 busybox=/bin/busybox
-if ! file -L "$busybox" 2>/dev/null | grep -q 'statically linked'; then
-  busybox="$(command -v busybox 2>/dev/null || true)"
-  { [ -n "$busybox" ] && file -L "$busybox" | grep -q 'statically linked'; } || missing+=("static busybox")
-fi
+is_static "$busybox" || missing+=("a static busybox (package busybox-static)")
 [ ${#missing[@]} -eq 0 ] || usage_error "missing ${missing[*]}: $prepare_hint"
 release="$(cat "$cache/current" 2>/dev/null || true)"
 kdir="$cache/$release"
@@ -84,14 +86,14 @@ cp "$guest_script" "$rootfs/tests/$script_name"
 for f in "$@"; do cp "$f" "$rootfs/tests/"; done
 copy_libraries() {  # copy_libraries BINARY: its shared libraries (and the loader) at their paths
   local lib
-  { ldd "$1" 2>/dev/null || true; } | grep -o '/[^ ]*' | sort -u | while read -r lib; do
+  { ldd "$1" 2>/dev/null || true; } | { grep -o '/[^ ]*' || true; } | sort -u | while read -r lib; do
     [ -e "$rootfs$lib" ] && continue
     mkdir -p "$rootfs$(dirname "$lib")"
     cp -L "$lib" "$rootfs$lib"
   done
 }
 for b in "$rootfs"/usr/bin/* "$rootfs"/tests/*; do
-  [ -x "$b" ] && file -L "$b" | grep -q 'dynamically linked' && copy_libraries "$b"
+  if [ -x "$b" ]; then copy_libraries "$b"; fi  # ldd lists nothing for scripts, static binaries
 done
 # /lib64/ld-linux-x86-64.so.2 is a symlink into /lib on Debian (cp -L copied the file itself).
 
