@@ -120,7 +120,7 @@ for m in "${modules[@]}"; do
   esac
 done
 
-# Boot time: under TCG, decompressing the ~8 MB bzImage takes the emulated CPU about 4 s of the
+# Boot time: under TCG, decompressing the ~8 MB bzImage takes the emulated CPU about 3.5 s of the
 # boot. The kernel inside it is an ELF with a PVH entry note (Debian sets CONFIG_PVH), which qemu
 # boots directly: keep it decompressed as vmlinux (~65 MB) and run.sh prefers it.
 extract_vmlinux() {  # extract_vmlinux BZIMAGE OUT: find the compressed payload, decompress it
@@ -141,7 +141,7 @@ extract_vmlinux() {  # extract_vmlinux BZIMAGE OUT: find the compressed payload,
   return 1
 }
 if command -v readelf >/dev/null && extract_vmlinux "$dest/vmlinuz" "$dest/vmlinux"; then
-  say "extracted the uncompressed kernel (PVH boot, about 4 s faster under emulation)"
+  say "extracted the uncompressed kernel (PVH boot, about 3.5 s faster under emulation)"
 else
   say "note: could not extract an uncompressed PVH kernel; booting the compressed one (slower)"
 fi
