@@ -7,6 +7,7 @@ packages=(
   libeigen3-dev libode-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib
+  qemu-system-x86 busybox-static can-utils cpio  # the SocketCAN test VM (tools/can-vm/)
 )
 
 missing=()

@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# Set up (Debian packages), build, and run the whole test suite twice: a release build, then a
-# build with AddressSanitizer and UndefinedBehaviorSanitizer. Also checks the formatting.
+# Set up (Debian packages, the SocketCAN test VM's kernel), build, and run the whole test suite
+# twice: a release build (with the SocketCAN tests in a qemu VM, label can_vm), then a build with
+# AddressSanitizer and UndefinedBehaviorSanitizer. Also checks the formatting.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/install-deps.sh
+tools/can-vm/prepare.sh  # Debian's stock kernel with CAN for the VM tests (cached in build/)
 jobs="$(nproc)"
 
 echo "== formatting (clang-format)"
