@@ -51,7 +51,9 @@ void put_le16(CanFrame& f, std::size_t i, std::uint32_t v) {
   f.data[i + 1] = static_cast<std::uint8_t>((v >> 8) & 0xFFu);
 }
 
-bool finite_or_nan(double v) { return std::isfinite(v) || std::isnan(v); }
+bool finite_or_nan(double v) {
+  return std::isfinite(v) || std::isnan(v);
+}
 
 // Identifier of PGN base + valve; false if priority or valve is out of range.
 bool make_frame(std::uint32_t pgn_base, std::uint8_t valve, std::uint8_t source,
@@ -82,7 +84,9 @@ CodecStatus check_frame(const CanFrame& frame, std::uint32_t pgn_base, std::uint
   return CodecStatus::kOk;
 }
 
-bool valid_state_code(std::uint8_t code) { return code <= 3 || code >= 14; }
+bool valid_state_code(std::uint8_t code) {
+  return code <= 3 || code >= 14;
+}
 
 }  // namespace
 
@@ -149,7 +153,8 @@ CodecStatus encode(const AuxValveCommand& command, std::uint8_t source_address,
     return CodecStatus::kInvalidArgument;
   }
   bool clamped = false;
-  out.data[0] = static_cast<std::uint8_t>(to_raw(command.flow, kStandardFlowPerBit, 0.0, 250, clamped));
+  out.data[0] =
+      static_cast<std::uint8_t>(to_raw(command.flow, kStandardFlowPerBit, 0.0, 250, clamped));
   const std::uint8_t resolution_mode = command.extended_resolution ? 0x1 : 0x0;
   out.data[1] = static_cast<std::uint8_t>(0xFC | resolution_mode);
   out.data[2] = static_cast<std::uint8_t>((fail_safe << 6) | 0x30 | state);
@@ -160,8 +165,7 @@ CodecStatus encode(const AuxValveCommand& command, std::uint8_t source_address,
   return clamped ? CodecStatus::kClamped : CodecStatus::kOk;
 }
 
-CodecStatus decode(const CanFrame& frame, AuxValveCommand& command,
-                   std::uint8_t& source_address) {
+CodecStatus decode(const CanFrame& frame, AuxValveCommand& command, std::uint8_t& source_address) {
   std::uint8_t valve = 0;
   std::uint8_t source = 0;
   const CodecStatus s = check_frame(frame, kPgnAuxValveCommand0, valve, source);
@@ -192,11 +196,14 @@ CodecStatus encode(const AuxValveMeasuredFlow& m, std::uint8_t source_address,
     return CodecStatus::kInvalidArgument;
   }
   bool clamped = false;
-  out.data[0] = static_cast<std::uint8_t>(to_raw_or_na(m.extend_flow, 0.01, -1.25, kMaxValid8, 0xFF, clamped));
-  out.data[1] = static_cast<std::uint8_t>(to_raw_or_na(m.retract_flow, 0.01, -1.25, kMaxValid8, 0xFF, clamped));
+  out.data[0] = static_cast<std::uint8_t>(
+      to_raw_or_na(m.extend_flow, 0.01, -1.25, kMaxValid8, 0xFF, clamped));
+  out.data[1] = static_cast<std::uint8_t>(
+      to_raw_or_na(m.retract_flow, 0.01, -1.25, kMaxValid8, 0xFF, clamped));
   put_le16(out, 2, to_raw_or_na(m.extend_pressure_pa, 5000.0, 0.0, kMaxValid16, 0xFFFF, clamped));
   put_le16(out, 4, to_raw_or_na(m.retract_pressure_pa, 5000.0, 0.0, kMaxValid16, 0xFFFF, clamped));
-  out.data[6] = static_cast<std::uint8_t>(to_raw_or_na(m.return_pressure_pa, 16000.0, 0.0, kMaxValid8, 0xFF, clamped));
+  out.data[6] = static_cast<std::uint8_t>(
+      to_raw_or_na(m.return_pressure_pa, 16000.0, 0.0, kMaxValid8, 0xFF, clamped));
   out.data[7] = static_cast<std::uint8_t>((static_cast<std::uint8_t>(m.limit) << 5) | 0x1F);
   frame = out;
   return clamped ? CodecStatus::kClamped : CodecStatus::kOk;
@@ -222,9 +229,8 @@ CodecStatus encode(const AuxValveEstimatedFlow& m, std::uint8_t source_address,
                    std::uint8_t priority, CanFrame& frame) {
   const auto state = static_cast<std::uint8_t>(m.state);
   const auto fail_safe = static_cast<std::uint8_t>(m.fail_safe);
-  if (!finite_or_nan(m.extend_flow) || !finite_or_nan(m.retract_flow) ||
-      !valid_state_code(state) || state > 15 || fail_safe > 3 ||
-      static_cast<std::uint8_t>(m.limit) > 7) {
+  if (!finite_or_nan(m.extend_flow) || !finite_or_nan(m.retract_flow) || !valid_state_code(state) ||
+      state > 15 || fail_safe > 3 || static_cast<std::uint8_t>(m.limit) > 7) {
     return CodecStatus::kInvalidArgument;
   }
   CanFrame out;
@@ -232,8 +238,10 @@ CodecStatus encode(const AuxValveEstimatedFlow& m, std::uint8_t source_address,
     return CodecStatus::kInvalidArgument;
   }
   bool clamped = false;
-  out.data[0] = static_cast<std::uint8_t>(to_raw_or_na(m.extend_flow, 0.01, -1.25, kMaxValid8, 0xFF, clamped));
-  out.data[1] = static_cast<std::uint8_t>(to_raw_or_na(m.retract_flow, 0.01, -1.25, kMaxValid8, 0xFF, clamped));
+  out.data[0] = static_cast<std::uint8_t>(
+      to_raw_or_na(m.extend_flow, 0.01, -1.25, kMaxValid8, 0xFF, clamped));
+  out.data[1] = static_cast<std::uint8_t>(
+      to_raw_or_na(m.retract_flow, 0.01, -1.25, kMaxValid8, 0xFF, clamped));
   out.data[2] = static_cast<std::uint8_t>((fail_safe << 6) | 0x30 | state);
   out.data[3] = static_cast<std::uint8_t>((static_cast<std::uint8_t>(m.limit) << 5) | 0x1F);
   frame = out;

@@ -143,11 +143,16 @@ bool unit_factor(const std::string& unit, SignalUse use, double& factor, Positio
       }
       return false;
     case SignalUse::kCommand:
-      if (unit == "A") factor = 1.0;
-      else if (unit == "mA") factor = 1e-3;
-      else if (unit == "%") factor = 1e-2;
-      else if (unit == "1") factor = 1.0;
-      else return false;
+      if (unit == "A")
+        factor = 1.0;
+      else if (unit == "mA")
+        factor = 1e-3;
+      else if (unit == "%")
+        factor = 1e-2;
+      else if (unit == "1")
+        factor = 1.0;
+      else
+        return false;
       return true;
   }
   return false;
@@ -211,8 +216,10 @@ SignalSpec read_signal(const Reader& r, const YAML::Node& node, const std::strin
   if (node["offset"].IsDefined()) {
     s.offset = r.number(node["offset"], Reader::join(path, "offset")) * factor;
   }
-  if (node["min"].IsDefined()) s.minimum = r.number(node["min"], Reader::join(path, "min")) * factor;
-  if (node["max"].IsDefined()) s.maximum = r.number(node["max"], Reader::join(path, "max")) * factor;
+  if (node["min"].IsDefined())
+    s.minimum = r.number(node["min"], Reader::join(path, "min")) * factor;
+  if (node["max"].IsDefined())
+    s.maximum = r.number(node["max"], Reader::join(path, "max")) * factor;
   if (s.minimum && s.maximum && *s.minimum > *s.maximum) {
     r.fail(node["min"], Reader::join(path, "min"), "must be at most max");
   }
@@ -222,8 +229,8 @@ SignalSpec read_signal(const Reader& r, const YAML::Node& node, const std::strin
 }
 
 constexpr std::initializer_list<const char*> kSignalKeys = {
-    "id", "extended", "start_bit", "length", "byte_order", "signed",
-    "scale", "offset", "unit", "min", "max"};
+    "id",    "extended", "start_bit", "length", "byte_order", "signed",
+    "scale", "offset",   "unit",      "min",    "max"};
 
 ValveOutput read_valve(const Reader& r, const YAML::Node& node, const std::string& path) {
   r.check_keys(node, path, {"iso11783_avc", "signal"});
@@ -236,11 +243,11 @@ ValveOutput read_valve(const Reader& r, const YAML::Node& node, const std::strin
   if (has_avc) {
     const std::string p = Reader::join(path, "iso11783_avc");
     const YAML::Node a = node["iso11783_avc"];
-    r.check_keys(a, p,
-                 {"valve", "source_address", "cycle", "priority", "fail_safe",
-                  "extended_resolution"});
+    r.check_keys(
+        a, p, {"valve", "source_address", "cycle", "priority", "fail_safe", "extended_resolution"});
     out.kind = ValveOutputKind::kIso11783Avc;
-    out.avc.valve = static_cast<std::uint8_t>(r.integer(a, "valve", p, iso11783::kAuxValveCount - 1));
+    out.avc.valve =
+        static_cast<std::uint8_t>(r.integer(a, "valve", p, iso11783::kAuxValveCount - 1));
     out.avc.source_address = static_cast<std::uint8_t>(r.integer(a, "source_address", p, 253));
     out.avc.cycle_s = r.time(a, "cycle", p, 0.001, 0.1, "between 1 ms and 100 ms");
     if (a["priority"].IsDefined()) {
@@ -261,9 +268,9 @@ ValveOutput read_valve(const Reader& r, const YAML::Node& node, const std::strin
   } else {
     const std::string p = Reader::join(path, "signal");
     const YAML::Node s = node["signal"];
-    std::initializer_list<const char*> keys = {
-        "id", "extended", "start_bit", "length", "byte_order", "signed",
-        "scale", "offset", "unit", "min", "max", "cycle"};
+    std::initializer_list<const char*> keys = {"id",         "extended", "start_bit", "length",
+                                               "byte_order", "signed",   "scale",     "offset",
+                                               "unit",       "min",      "max",       "cycle"};
     out.kind = ValveOutputKind::kSignal;
     out.signal.signal = read_signal(r, s, p, SignalUse::kCommand, keys, nullptr);
     out.signal.cycle_s = r.time(s, "cycle", p, 0.001, 0.1, "between 1 ms and 100 ms");
@@ -351,8 +358,9 @@ CanMapping read_mapping(const Reader& r, const YAML::Node& root) {
       const Occupancy& y = occupancy[b];
       if (x.id != y.id || x.extended != y.extended) continue;
       if (x.sent != y.sent) {
-        r.fail(x.node, x.field, "identifier is also used by " + y.field +
-                                    " in the other direction (sent vs received)");
+        r.fail(
+            x.node, x.field,
+            "identifier is also used by " + y.field + " in the other direction (sent vs received)");
       }
       if ((x.bits & y.bits) != 0) r.fail(x.node, x.field, "overlaps the bits of " + y.field);
     }

@@ -37,7 +37,9 @@ int bit_position(const SignalSpec& spec, const Layout& l, int i) {
   return (linear / 8) * 8 + (7 - linear % 8);
 }
 
-bool covers(const Layout& l, const CanFrame& frame) { return l.last < frame.dlc; }
+bool covers(const Layout& l, const CanFrame& frame) {
+  return l.last < frame.dlc;
+}
 
 std::uint64_t mask(std::uint16_t length) {
   return length >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << length) - 1;

@@ -40,8 +40,8 @@ bool same_frame(const CanFrame& a, const CanFrame& b);
 // The longest line format_candump writes: "(" 20 digits "." 6 digits ") " interface (at most
 // kMaxInterfaceLength) " " 8 id digits "#" 16 data digits, plus a terminating NUL.
 inline constexpr std::size_t kMaxInterfaceLength = 15;  // IFNAMSIZ - 1 on Linux
-inline constexpr std::size_t kCandumpLineCapacity = 1 + 20 + 1 + 6 + 2 + kMaxInterfaceLength + 1 +
-                                                    8 + 1 + 16 + 1;
+inline constexpr std::size_t kCandumpLineCapacity =
+    1 + 20 + 1 + 6 + 2 + kMaxInterfaceLength + 1 + 8 + 1 + 16 + 1;
 
 enum class CandumpStatus {
   kOk,

@@ -61,7 +61,7 @@ inline constexpr std::uint32_t kPgnAuxValveCommand0 = 65072;        // 0xFE30
 inline constexpr std::uint8_t kAuxValveCount = 16;
 inline constexpr std::uint8_t kDefaultPriority = 3;
 
-inline constexpr double kStandardFlowPerBit = 0.004;     // 0.4 %/bit as a fraction
+inline constexpr double kStandardFlowPerBit = 0.004;      // 0.4 %/bit as a fraction
 inline constexpr double kExtendedFlowPerBit = 1.5625e-5;  // 0.0015625 %/bit as a fraction
 
 enum class ValveState : std::uint8_t {
@@ -89,20 +89,20 @@ const char* to_string(FailSafeMode mode);
 
 enum class CodecStatus {
   kOk,
-  kClamped,         // encode: a value outside its range was clamped; the frame was written
-  kInvalidArgument, // encode: non-finite value, valve above 15, priority above 7, reserved enum
-  kWrongIdentifier, // decode: not a 29-bit identifier of this message
-  kBadLength,       // decode: dlc is not 8
-  kBadField,        // decode: a field holds an error/not-available/reserved code (see below)
+  kClamped,          // encode: a value outside its range was clamped; the frame was written
+  kInvalidArgument,  // encode: non-finite value, valve above 15, priority above 7, reserved enum
+  kWrongIdentifier,  // decode: not a 29-bit identifier of this message
+  kBadLength,        // decode: dlc is not 8
+  kBadField,         // decode: a field holds an error/not-available/reserved code (see below)
 };
 const char* to_string(CodecStatus status);
 
 struct AuxValveCommand {
-  std::uint8_t valve = 0;          // n, 0..15
-  double flow = 0.0;               // port flow, fraction of full flow, 0..1
+  std::uint8_t valve = 0;  // n, 0..15
+  double flow = 0.0;       // port flow, fraction of full flow, 0..1
   ValveState state = ValveState::kBlock;
   FailSafeMode fail_safe = FailSafeMode::kBlock;
-  bool extended_resolution = true; // send the 16-bit field as well (resolution mode 01)
+  bool extended_resolution = true;  // send the 16-bit field as well (resolution mode 01)
 };
 
 // Rounding: to nearest (half away from zero) for both fields, each from the commanded flow
@@ -116,12 +116,11 @@ CodecStatus encode(const AuxValveCommand& command, std::uint8_t source_address,
 // mode says it is valid and it holds 0..0xFAFF, else from the 8-bit field. kBadField: the 8-bit
 // flow is above 250 (flow is NaN) or the state is a reserved code; the other fields are still
 // filled. source_address receives the sender.
-CodecStatus decode(const CanFrame& frame, AuxValveCommand& command,
-                   std::uint8_t& source_address);
+CodecStatus decode(const CanFrame& frame, AuxValveCommand& command, std::uint8_t& source_address);
 
 struct AuxValveMeasuredFlow {
   std::uint8_t valve = 0;
-  double extend_flow = 0.0;   // fraction, -1.25..1.25; negative: flow returning through the port
+  double extend_flow = 0.0;  // fraction, -1.25..1.25; negative: flow returning through the port
   double retract_flow = 0.0;
   double extend_pressure_pa = 0.0;
   double retract_pressure_pa = 0.0;

@@ -30,7 +30,9 @@ struct Identifier {
   std::uint8_t source_address = kNullAddress;
 };
 
-constexpr bool is_pdu1(std::uint8_t pdu_format) { return pdu_format < 240; }
+constexpr bool is_pdu1(std::uint8_t pdu_format) {
+  return pdu_format < 240;
+}
 
 // The 29-bit identifier; priority is masked to 3 bits.
 constexpr std::uint32_t compose(const Identifier& id) {

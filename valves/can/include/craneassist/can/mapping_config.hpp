@@ -33,10 +33,10 @@ inline constexpr const char* kMappingFormat = "craneassist-can-map/1";
 
 // ISO 11783-7 Auxiliary Valve Command output (PGN 65072 + valve).
 struct AvcOutput {
-  std::uint8_t valve = 0;             // 0..15
-  std::uint8_t source_address = 0x80; // craneassist's address on the bus, 0..253
+  std::uint8_t valve = 0;              // 0..15
+  std::uint8_t source_address = 0x80;  // craneassist's address on the bus, 0..253
   std::uint8_t priority = iso11783::kDefaultPriority;
-  double cycle_s = 0.02;              // send period, 1..100 ms
+  double cycle_s = 0.02;  // send period, 1..100 ms
   iso11783::FailSafeMode fail_safe = iso11783::FailSafeMode::kBlock;
   bool extended_resolution = true;
 };
@@ -60,7 +60,7 @@ enum class PositionKind { kAngle, kLength };  // from the position signal's unit
 struct JointMapping {
   std::string name;
   ValveOutput valve;
-  SignalSpec position;                 // rad or m
+  SignalSpec position;  // rad or m
   PositionKind position_kind = PositionKind::kAngle;
   std::optional<SignalSpec> pressure_a;  // Pa, piston side
   std::optional<SignalSpec> pressure_b;  // Pa, rod side

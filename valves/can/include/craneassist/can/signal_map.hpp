@@ -55,13 +55,13 @@ const char* to_string(SignalStatus status);
 
 enum class SpecError {
   kNone,
-  kBadLength,       // not 1..64
-  kBadStartBit,     // above 63
-  kDoesNotFit,      // runs past byte 8
-  kBadIdentifier,   // above 11 bits (standard) or 29 bits (extended)
-  kBadScale,        // zero or not finite
-  kBadOffset,       // not finite
-  kBadRange,        // minimum above maximum, or not finite
+  kBadLength,      // not 1..64
+  kBadStartBit,    // above 63
+  kDoesNotFit,     // runs past byte 8
+  kBadIdentifier,  // above 11 bits (standard) or 29 bits (extended)
+  kBadScale,       // zero or not finite
+  kBadOffset,      // not finite
+  kBadRange,       // minimum above maximum, or not finite
 };
 const char* to_string(SpecError error);
 
