@@ -6,7 +6,12 @@
 // measured flow", SPNs 2263/2264/2268/2269/2270/5178; SPNs 1985/14307 estimated flow, 5181 the
 // estimated flow limit status), cross-checked against Open-SAE-J1939 (DanielMartensson,
 // Src/ISO_11783/ISO_11783-7_Application_Layer/Auxiliary_Valve_Command.c and
-// Auxiliary_Valve_Estimated_Flow.c), which puts the same fields at the same positions.
+// Auxiliary_Valve_Estimated_Flow.c). That library implements the older command layout: byte 1
+// flow, byte 3 state/fail-safe exactly as below, priority 3, but byte 2 and bytes 4-8 all
+// reserved (0xFF). The resolution mode (2.1) and the extended-resolution flow (bytes 4-5) are
+// database additions of 2015/2018; a valve of the older layout should ignore them (they were
+// reserved). extended_resolution = false leaves bytes 4-8 at 0xFF and sends resolution mode 00;
+// the older frame differs from that only in byte 2 bits 1-2 (11 there).
 //
 // Auxiliary Valve Command, PGN 65072 + n (0xFE30 + n), n = valve 0..15, 8 bytes, priority 3,
 // "100 ms when active" (the database's transmission rate; craneassist sends faster):
