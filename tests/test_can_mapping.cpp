@@ -1,0 +1,203 @@
+// The CAN mapping file: the shipped example loads with its values in SI, and every kind of
+// mistake is reported with file, line and field.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "craneassist/can/mapping_config.hpp"
+#include "craneassist/config/config_error.hpp"
+
+using namespace craneassist::can;
+using craneassist::config::ConfigError;
+
+namespace {
+
+const std::string kExample = std::string(CRANEASSIST_SOURCE_DIR) + "/config/can/k70m_can.yaml";
+
+// A minimal valid file; `joint` replaces the first joint's body.
+std::string file_with(const std::string& joint) {
+  return "format: craneassist-can-map/1\n"
+         "joints:\n"
+         "  - name: slew\n" +
+         joint;
+}
+
+const std::string kValve =
+    "    valve:\n"
+    "      iso11783_avc: {valve: 0, source_address: 0x80, cycle: 20 ms}\n";
+const std::string kPosition =
+    "    position: {id: 0x18FF1021, extended: true, start_bit: 0, length: 16,\n"
+    "               byte_order: intel, signed: true, scale: 0.01, unit: deg}\n";
+
+// Parses text expecting a ConfigError; returns it.
+ConfigError error_of(const std::string& text) {
+  try {
+    parse_can_mapping(text, "map.yaml");
+  } catch (const ConfigError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no error for:\n" << text;
+  return ConfigError("", 0, "", "");
+}
+
+}  // namespace
+
+TEST(CanMapping, ShippedExampleLoads) {
+  const CanMapping m = load_can_mapping(kExample);
+  ASSERT_EQ(m.joints.size(), 4u);
+  const JointMapping& slew = m.joints[0];
+  EXPECT_EQ(slew.name, "slew");
+  ASSERT_EQ(slew.valve.kind, ValveOutputKind::kIso11783Avc);
+  EXPECT_EQ(slew.valve.avc.valve, 0);
+  EXPECT_EQ(slew.valve.avc.source_address, 0x80);
+  EXPECT_EQ(slew.valve.avc.priority, 3);
+  EXPECT_DOUBLE_EQ(slew.valve.avc.cycle_s, 0.02);
+  EXPECT_EQ(slew.valve.avc.fail_safe, iso11783::FailSafeMode::kBlock);
+  EXPECT_TRUE(slew.position.extended);
+  EXPECT_EQ(slew.position.id, 0x18FF1021u);
+  EXPECT_EQ(slew.position_kind, PositionKind::kAngle);
+  EXPECT_NEAR(slew.position.scale, 0.01 * std::numbers::pi / 180.0, 1e-15);  // rad/bit
+  EXPECT_EQ(slew.position.unit, "deg");
+  ASSERT_TRUE(slew.pressure_a && slew.pressure_b);
+  EXPECT_NEAR(slew.pressure_a->scale, 1000.0, 1e-9);  // 0.01 bar = 1000 Pa
+  EXPECT_NEAR(*slew.pressure_a->maximum, 400e5, 1e-3);
+  EXPECT_EQ(m.joints[2].position.byte_order, ByteOrder::kBigEndian);
+
+  const JointMapping& ext = m.joints[3];
+  ASSERT_EQ(ext.valve.kind, ValveOutputKind::kSignal);
+  EXPECT_NEAR(ext.valve.signal.signal.scale, 1e-3, 1e-15);  // A/bit
+  EXPECT_NEAR(*ext.valve.signal.signal.minimum, -0.8, 1e-12);
+  EXPECT_EQ(ext.position_kind, PositionKind::kLength);
+  EXPECT_NEAR(ext.position.scale, 1e-4, 1e-15);  // m/bit
+  EXPECT_FALSE(ext.pressure_b.has_value());
+
+  // A decoded slew encoder frame comes out in rad.
+  CanFrame f;
+  f.id = 0x18FF1021;
+  f.extended = true;
+  f.dlc = 8;
+  f.data[0] = 0x28;  // 9000 = 0x2328 -> 90 deg
+  f.data[1] = 0x23;
+  double q = 0.0;
+  ASSERT_EQ(decode(slew.position, f, q), SignalStatus::kOk);
+  EXPECT_NEAR(q, std::numbers::pi / 2, 1e-12);
+}
+
+TEST(CanMapping, MinimalFileAndDefaults) {
+  const CanMapping m = parse_can_mapping(file_with(kValve + kPosition), "map.yaml");
+  ASSERT_EQ(m.joints.size(), 1u);
+  EXPECT_EQ(m.source, "map.yaml");
+  EXPECT_TRUE(m.joints[0].valve.avc.extended_resolution);
+  EXPECT_FALSE(m.joints[0].position.minimum.has_value());
+  EXPECT_FALSE(m.joints[0].pressure_a.has_value());
+}
+
+TEST(CanMapping, ErrorsNameFileLineAndField) {
+  struct Case {
+    std::string text;
+    int line;
+    std::string field;
+    std::string reason_part;
+  };
+  const std::string avc_head = "    valve:\n      iso11783_avc: ";
+  const Case cases[] = {
+      {"format: craneassist-can-map/2\njoints: []\n", 1, "format", "craneassist-can-map/1"},
+      {"format: craneassist-can-map/1\n", 1, "joints", "missing"},
+      {"format: craneassist-can-map/1\njoints: []\n", 2, "joints", "list of joints"},
+      {"format: craneassist-can-map/1\nbus: x\njoints: []\n", 2, "bus", "unknown field"},
+      {file_with(kPosition), 3, "joints[0].valve", "missing"},
+      {file_with(avc_head + "{valve: 16, source_address: 0x80, cycle: 20 ms}\n" + kPosition), 5,
+       "joints[0].valve.iso11783_avc.valve", "at most 15"},
+      {file_with(avc_head + "{valve: 1, source_address: 0xFE, cycle: 20 ms}\n" + kPosition), 5,
+       "joints[0].valve.iso11783_avc.source_address", "at most 253"},
+      {file_with(avc_head + "{valve: 1, source_address: 0x8G, cycle: 20 ms}\n" + kPosition), 5,
+       "joints[0].valve.iso11783_avc.source_address", "non-negative integer"},
+      {file_with(avc_head + "{valve: 1, source_address: 0x80, cycle: 200 ms}\n" + kPosition), 5,
+       "joints[0].valve.iso11783_avc.cycle", "between 1 ms and 100 ms"},
+      {file_with(avc_head + "{valve: 1, source_address: 0x80, cycle: 20 bar}\n" + kPosition), 5,
+       "joints[0].valve.iso11783_avc.cycle", "bar"},
+      {file_with(avc_head + "{valve: 1, source_address: 0x80, cycle: 20 ms, fail_safe: open}\n" +
+                 kPosition),
+       5, "joints[0].valve.iso11783_avc.fail_safe", "block or float"},
+      {file_with(avc_head + "{valve: 1, source_address: 0x80, cycl: 20 ms}\n" + kPosition), 5,
+       "joints[0].valve.iso11783_avc.cycl", "unknown field"},
+      {file_with("    valve: {}\n" + kPosition), 4, "joints[0].valve", "exactly one of"},
+      {file_with(kValve +
+                 "    position: {id: 0x18FF1021, start_bit: 0, length: 16, byte_order: intel,\n"
+                 "               scale: 0.01, unit: deg}\n"),
+       6, "joints[0].position.id", "at most 2047"},
+      {file_with(kValve +
+                 "    position: {id: 0x101, start_bit: 60, length: 16, byte_order: intel,\n"
+                 "               scale: 0.01, unit: deg}\n"),
+       6, "joints[0].position.start_bit", "runs past the 8th data byte"},
+      {file_with(kValve +
+                 "    position: {id: 0x101, start_bit: 6, length: 64, byte_order: motorola,\n"
+                 "               scale: 0.01, unit: deg}\n"),
+       6, "joints[0].position.start_bit", "runs past"},
+      {file_with(kValve + "    position: {id: 0x101, start_bit: 0, length: 0, byte_order: intel,\n"
+                          "               scale: 0.01, unit: deg}\n"),
+       6, "joints[0].position.length", "1..64"},
+      {file_with(kValve + "    position: {id: 0x101, start_bit: 0, length: 16, byte_order: pdp,\n"
+                          "               scale: 0.01, unit: deg}\n"),
+       6, "joints[0].position.byte_order", "intel"},
+      {file_with(kValve + "    position: {id: 0x101, start_bit: 0, length: 16, byte_order: intel,\n"
+                          "               scale: 0.01, unit: bar}\n"),
+       7, "joints[0].position.unit", "not an angle"},
+      {file_with(kValve + "    position: {id: 0x101, start_bit: 0, length: 16, byte_order: intel,\n"
+                          "               scale: 0, unit: deg}\n"),
+       7, "joints[0].position.scale", "nonzero"},
+      {file_with(kValve + "    position: {id: 0x101, start_bit: 0, length: 16, byte_order: intel,\n"
+                          "               scale: abc, unit: deg}\n"),
+       7, "joints[0].position.scale", "not a number"},
+      {file_with(kValve + "    position: {id: 0x101, start_bit: 0, length: 16, byte_order: intel,\n"
+                          "               scale: 0.1, unit: deg, min: 5, max: 1}\n"),
+       7, "joints[0].position.min", "at most max"},
+      {file_with(kValve + kPosition +
+                 "    pressure_a: {id: 0x301, start_bit: 0, length: 16, byte_order: intel,\n"
+                 "                 scale: 0.01, unit: deg}\n"),
+       9, "joints[0].pressure_a.unit", "not a pressure"},
+      {file_with(kValve + kPosition +
+                 "    pressure_a: {id: 0x18FF1021, extended: true, start_bit: 8, length: 16,\n"
+                 "                 byte_order: intel, scale: 0.01, unit: bar}\n"),
+       8, "joints[0].pressure_a", "overlaps the bits of joints[0].position"},
+      {file_with(kValve + kPosition) + "  - name: slew\n" + kValve + kPosition, 8, "joints[1].name",
+       "duplicate joint"},
+      {file_with(kValve + kPosition) + "  - name: lift\n" + kValve + kPosition, 10,
+       "joints[1].valve.iso11783_avc.valve", "already used by joint 'slew'"},
+      {file_with("    valve:\n"
+                 "      signal: {id: 0x210, start_bit: 0, length: 16, byte_order: intel,\n"
+                 "               signed: true, scale: 1, unit: deg, cycle: 20 ms}\n" +
+                 kPosition),
+       6, "joints[0].valve.signal.unit", "current"},
+      {file_with("    valve:\n"
+                 "      signal: {id: 0x210, start_bit: 0, length: 16, byte_order: intel,\n"
+                 "               signed: true, scale: 1, unit: mA}\n" +
+                 kPosition),
+       5, "joints[0].valve.signal.cycle", "missing"},
+      {file_with("    valve:\n"
+                 "      signal: {id: 0x18FF1021, extended: true, start_bit: 32, length: 16,\n"
+                 "               byte_order: intel, scale: 1, unit: mA, cycle: 20 ms}\n" +
+                 kPosition),
+       7, "joints[0].position", "other direction"},
+      {"format: craneassist-can-map/1\njoints: [\n", 3, "", "YAML syntax"},
+  };
+  for (const Case& c : cases) {
+    const ConfigError e = error_of(c.text);
+    EXPECT_EQ(e.file(), "map.yaml");
+    EXPECT_EQ(e.line(), c.line) << e.what();
+    EXPECT_EQ(e.field(), c.field) << e.what();
+    EXPECT_NE(e.reason().find(c.reason_part), std::string::npos) << e.what();
+  }
+}
+
+TEST(CanMapping, MissingFile) {
+  try {
+    load_can_mapping("/nonexistent/map.yaml");
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.line(), 0);
+    EXPECT_NE(std::string(e.what()).find("cannot open"), std::string::npos);
+  }
+}

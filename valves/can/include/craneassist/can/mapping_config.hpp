@@ -1,0 +1,78 @@
+// The CAN mapping file: per crane joint, where its valve command goes and where its sensor
+// feedback comes from (docs/can.md). Loaded once at start-up, outside the control loop; errors
+// are config::ConfigError naming file, line and field, like the crane config.
+//
+//   format: craneassist-can-map/1
+//   joints:
+//     - name: slew
+//       valve:
+//         iso11783_avc: {valve: 0, source_address: 0x80, cycle: 20 ms}
+//       position: {id: 0x18FF1021, extended: true, start_bit: 0, length: 16,
+//                  byte_order: intel, signed: true, scale: 0.01, offset: 0, unit: deg}
+//       pressure_a: {id: 0x18FF2021, extended: true, start_bit: 0, length: 16,
+//                    byte_order: intel, scale: 0.01, unit: bar}
+//
+// A signal's scale, offset, min and max are in its `unit`; the loader converts them so the
+// decoded value is SI (rad or m for positions, Pa for pressures, A for currents, a fraction
+// for `%` or no unit).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "craneassist/can/iso11783_valve.hpp"
+#include "craneassist/can/signal_map.hpp"
+
+namespace craneassist::can {
+
+inline constexpr const char* kMappingFormat = "craneassist-can-map/1";
+
+// ISO 11783-7 Auxiliary Valve Command output (PGN 65072 + valve).
+struct AvcOutput {
+  std::uint8_t valve = 0;              // 0..15
+  std::uint8_t source_address = 0x80;  // craneassist's address on the bus, 0..253
+  std::uint8_t priority = iso11783::kDefaultPriority;
+  double cycle_s = 0.02;  // send period, 1..100 ms
+  iso11783::FailSafeMode fail_safe = iso11783::FailSafeMode::kBlock;
+  bool extended_resolution = true;
+};
+
+// A current (or duty) command through a generic signal: signed, negative = retract.
+struct SignalOutput {
+  SignalSpec signal;  // decoded/encoded in A (unit A or mA) or as a fraction (unit % or none)
+  double cycle_s = 0.02;
+};
+
+enum class ValveOutputKind { kIso11783Avc, kSignal };
+
+struct ValveOutput {
+  ValveOutputKind kind = ValveOutputKind::kIso11783Avc;
+  AvcOutput avc;        // when kind == kIso11783Avc
+  SignalOutput signal;  // when kind == kSignal
+};
+
+enum class PositionKind { kAngle, kLength };  // from the position signal's unit
+
+struct JointMapping {
+  std::string name;
+  ValveOutput valve;
+  SignalSpec position;  // rad or m
+  PositionKind position_kind = PositionKind::kAngle;
+  std::optional<SignalSpec> pressure_a;  // Pa, piston side
+  std::optional<SignalSpec> pressure_b;  // Pa, rod side
+};
+
+struct CanMapping {
+  std::string source;  // the file name, for messages
+  std::vector<JointMapping> joints;
+};
+
+// Throws config::ConfigError (file:line: field 'joints[1].position.length': reason).
+CanMapping parse_can_mapping(std::string_view yaml_text, std::string_view source_name);
+CanMapping load_can_mapping(const std::filesystem::path& path);
+
+}  // namespace craneassist::can

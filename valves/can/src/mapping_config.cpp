@@ -1,0 +1,396 @@
+#include "craneassist/can/mapping_config.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <sstream>
+
+#include "craneassist/config/config_error.hpp"
+#include "craneassist/config/quantity.hpp"
+
+namespace craneassist::can {
+namespace {
+
+using config::ConfigError;
+using config::Dimension;
+
+// What a signal measures or commands; decides which units its `unit` may name.
+enum class SignalUse { kPosition, kPressure, kCommand };
+
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& field,
+                         const std::string& reason) const {
+    const int line = node.IsDefined() ? node.Mark().line + 1 : 0;
+    throw ConfigError(file_, line, field, reason);
+  }
+
+  void check_keys(const YAML::Node& map, const std::string& path,
+                  std::initializer_list<const char*> allowed) const {
+    if (!map.IsMap()) fail(map, path, "expected a mapping of fields");
+    for (const auto& kv : map) {
+      const auto key = kv.first.as<std::string>();
+      bool ok = false;
+      std::string list;
+      for (const char* a : allowed) {
+        ok = ok || key == a;
+        list += list.empty() ? a : std::string(", ") + a;
+      }
+      if (!ok) fail(kv.first, join(path, key), "unknown field (expected one of: " + list + ")");
+    }
+  }
+
+  YAML::Node child(const YAML::Node& map, const std::string& key, const std::string& path) const {
+    if (!map.IsMap()) fail(map, path, "expected a mapping of fields");
+    YAML::Node node = map[key];
+    if (!node.IsDefined() || node.IsNull()) fail(map, join(path, key), "missing");
+    return node;
+  }
+
+  std::string text(const YAML::Node& node, const std::string& field) const {
+    if (!node.IsScalar()) fail(node, field, "expected a single value");
+    return node.Scalar();
+  }
+
+  // A non-negative integer, decimal or 0x-prefixed hex, at most max_value.
+  std::uint64_t integer(const YAML::Node& map, const std::string& key, const std::string& path,
+                        std::uint64_t max_value) const {
+    const YAML::Node node = child(map, key, path);
+    const std::string field = join(path, key);
+    const std::string s = text(node, field);
+    std::uint64_t v = 0;
+    const bool hex = s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
+    const char* begin = s.data() + (hex ? 2 : 0);
+    const char* end = s.data() + s.size();
+    const auto [ptr, ec] = std::from_chars(begin, end, v, hex ? 16 : 10);
+    if (ec != std::errc() || ptr != end || begin == end) {
+      fail(node, field, "expected a non-negative integer (decimal or 0x hex), got '" + s + "'");
+    }
+    if (v > max_value) fail(node, field, "must be at most " + std::to_string(max_value));
+    return v;
+  }
+
+  double number(const YAML::Node& node, const std::string& field) const {
+    const std::string s = text(node, field);
+    double v = 0.0;
+    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (ec != std::errc() || ptr != s.data() + s.size() || !std::isfinite(v)) {
+      fail(node, field, "not a number: '" + s + "'");
+    }
+    return v;
+  }
+
+  bool flag(const YAML::Node& map, const std::string& key, const std::string& path,
+            bool default_value) const {
+    const YAML::Node node = map[key];
+    if (!node.IsDefined()) return default_value;
+    if (node.IsScalar()) {
+      if (node.Scalar() == "true") return true;
+      if (node.Scalar() == "false") return false;
+    }
+    fail(node, join(path, key), "expected true or false");
+  }
+
+  // A time such as "20 ms", in [lo, hi] seconds.
+  double time(const YAML::Node& map, const std::string& key, const std::string& path, double lo,
+              double hi, const std::string& range_text) const {
+    const YAML::Node node = child(map, key, path);
+    const std::string field = join(path, key);
+    std::string error;
+    const auto q = config::parse_quantity(text(node, field), Dimension::kTime, error);
+    if (!q) fail(node, field, error);
+    if (q->si_values.size() != 1) fail(node, field, "expected one value");
+    const double v = q->si_values[0];
+    if (!(v >= lo && v <= hi)) fail(node, field, "must be " + range_text);
+    return v;
+  }
+
+  static std::string join(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+  }
+
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+};
+
+// SI factor of a unit as the mapping file writes it; false if the unit does not suit the use.
+bool unit_factor(const std::string& unit, SignalUse use, double& factor, PositionKind& kind) {
+  std::string error;
+  switch (use) {
+    case SignalUse::kPosition:
+      if (auto q = config::parse_quantity("1 " + unit, Dimension::kAngle, error)) {
+        factor = q->si_values[0];
+        kind = PositionKind::kAngle;
+        return true;
+      }
+      if (auto q = config::parse_quantity("1 " + unit, Dimension::kLength, error)) {
+        factor = q->si_values[0];
+        kind = PositionKind::kLength;
+        return true;
+      }
+      return false;
+    case SignalUse::kPressure:
+      if (auto q = config::parse_quantity("1 " + unit, Dimension::kPressure, error)) {
+        factor = q->si_values[0];
+        return true;
+      }
+      return false;
+    case SignalUse::kCommand:
+      if (unit == "A")
+        factor = 1.0;
+      else if (unit == "mA")
+        factor = 1e-3;
+      else if (unit == "%")
+        factor = 1e-2;
+      else if (unit == "1")
+        factor = 1.0;
+      else
+        return false;
+      return true;
+  }
+  return false;
+}
+
+const char* units_text(SignalUse use) {
+  switch (use) {
+    case SignalUse::kPosition:
+      return "an angle (rad, deg) or a length (m, mm, cm)";
+    case SignalUse::kPressure:
+      return "a pressure (Pa, kPa, MPa, bar)";
+    case SignalUse::kCommand:
+      return "a current (A, mA) or a ratio (%, 1)";
+  }
+  return "";
+}
+
+SignalSpec read_signal(const Reader& r, const YAML::Node& node, const std::string& path,
+                       SignalUse use, std::initializer_list<const char*> keys,
+                       PositionKind* kind_out) {
+  r.check_keys(node, path, keys);
+  SignalSpec s;
+  s.extended = r.flag(node, "extended", path, false);
+  s.id = static_cast<std::uint32_t>(
+      r.integer(node, "id", path, s.extended ? kMaxExtendedId : kMaxStandardId));
+  s.start_bit = static_cast<std::uint16_t>(r.integer(node, "start_bit", path, 63));
+  const YAML::Node length_node = r.child(node, "length", path);
+  s.length = static_cast<std::uint16_t>(r.integer(node, "length", path, 64));
+  if (s.length == 0) r.fail(length_node, Reader::join(path, "length"), "must be 1..64");
+  const YAML::Node order_node = r.child(node, "byte_order", path);
+  const std::string order = r.text(order_node, Reader::join(path, "byte_order"));
+  if (order == "intel" || order == "little_endian") {
+    s.byte_order = ByteOrder::kLittleEndian;
+  } else if (order == "motorola" || order == "big_endian") {
+    s.byte_order = ByteOrder::kBigEndian;
+  } else {
+    r.fail(order_node, Reader::join(path, "byte_order"),
+           "expected intel, little_endian, motorola or big_endian, got '" + order + "'");
+  }
+  s.is_signed = r.flag(node, "signed", path, false);
+  if (validate(s) == SpecError::kDoesNotFit) {
+    r.fail(node["start_bit"], Reader::join(path, "start_bit"),
+           "the signal (start bit " + std::to_string(s.start_bit) + ", " +
+               std::to_string(s.length) + " bits, " + order + ") runs past the 8th data byte");
+  }
+
+  const YAML::Node unit_node = r.child(node, "unit", path);
+  s.unit = r.text(unit_node, Reader::join(path, "unit"));
+  double factor = 1.0;
+  PositionKind kind = PositionKind::kAngle;
+  if (!unit_factor(s.unit, use, factor, kind)) {
+    r.fail(unit_node, Reader::join(path, "unit"),
+           "unit '" + s.unit + "' is not " + units_text(use));
+  }
+  if (kind_out) *kind_out = kind;
+
+  const YAML::Node scale_node = r.child(node, "scale", path);
+  const double scale = r.number(scale_node, Reader::join(path, "scale"));
+  if (scale == 0.0) r.fail(scale_node, Reader::join(path, "scale"), "must be nonzero");
+  s.scale = scale * factor;
+  if (node["offset"].IsDefined()) {
+    s.offset = r.number(node["offset"], Reader::join(path, "offset")) * factor;
+  }
+  if (node["min"].IsDefined())
+    s.minimum = r.number(node["min"], Reader::join(path, "min")) * factor;
+  if (node["max"].IsDefined())
+    s.maximum = r.number(node["max"], Reader::join(path, "max")) * factor;
+  if (s.minimum && s.maximum && *s.minimum > *s.maximum) {
+    r.fail(node["min"], Reader::join(path, "min"), "must be at most max");
+  }
+  const SpecError e = validate(s);
+  if (e != SpecError::kNone) r.fail(node, path, to_string(e));
+  return s;
+}
+
+constexpr std::initializer_list<const char*> kSignalKeys = {
+    "id",    "extended", "start_bit", "length", "byte_order", "signed",
+    "scale", "offset",   "unit",      "min",    "max"};
+
+ValveOutput read_valve(const Reader& r, const YAML::Node& node, const std::string& path) {
+  r.check_keys(node, path, {"iso11783_avc", "signal"});
+  const bool has_avc = node["iso11783_avc"].IsDefined();
+  const bool has_signal = node["signal"].IsDefined();
+  if (has_avc == has_signal) {
+    r.fail(node, path, "expected exactly one of iso11783_avc or signal");
+  }
+  ValveOutput out;
+  if (has_avc) {
+    const std::string p = Reader::join(path, "iso11783_avc");
+    const YAML::Node a = node["iso11783_avc"];
+    r.check_keys(
+        a, p, {"valve", "source_address", "cycle", "priority", "fail_safe", "extended_resolution"});
+    out.kind = ValveOutputKind::kIso11783Avc;
+    out.avc.valve =
+        static_cast<std::uint8_t>(r.integer(a, "valve", p, iso11783::kAuxValveCount - 1));
+    out.avc.source_address = static_cast<std::uint8_t>(r.integer(a, "source_address", p, 253));
+    out.avc.cycle_s = r.time(a, "cycle", p, 0.001, 0.1, "between 1 ms and 100 ms");
+    if (a["priority"].IsDefined()) {
+      out.avc.priority = static_cast<std::uint8_t>(r.integer(a, "priority", p, 7));
+    }
+    if (a["fail_safe"].IsDefined()) {
+      const std::string f = r.text(a["fail_safe"], Reader::join(p, "fail_safe"));
+      if (f == "block") {
+        out.avc.fail_safe = iso11783::FailSafeMode::kBlock;
+      } else if (f == "float") {
+        out.avc.fail_safe = iso11783::FailSafeMode::kFloat;
+      } else {
+        r.fail(a["fail_safe"], Reader::join(p, "fail_safe"),
+               "expected block or float, got '" + f + "'");
+      }
+    }
+    out.avc.extended_resolution = r.flag(a, "extended_resolution", p, true);
+  } else {
+    const std::string p = Reader::join(path, "signal");
+    const YAML::Node s = node["signal"];
+    std::initializer_list<const char*> keys = {"id",         "extended", "start_bit", "length",
+                                               "byte_order", "signed",   "scale",     "offset",
+                                               "unit",       "min",      "max",       "cycle"};
+    out.kind = ValveOutputKind::kSignal;
+    out.signal.signal = read_signal(r, s, p, SignalUse::kCommand, keys, nullptr);
+    out.signal.cycle_s = r.time(s, "cycle", p, 0.001, 0.1, "between 1 ms and 100 ms");
+  }
+  return out;
+}
+
+// Bits a signal occupies, for the overlap check.
+struct Occupancy {
+  std::uint32_t id;
+  bool extended;
+  std::uint64_t bits;
+  std::string field;
+  YAML::Node node;
+  bool sent;
+};
+
+std::uint64_t occupied_bits(const SignalSpec& spec) {
+  CanFrame probe;
+  probe.id = spec.id;
+  probe.extended = spec.extended;
+  probe.dlc = 8;
+  insert_raw(spec, ~std::uint64_t{0}, probe);
+  std::uint64_t bits = 0;
+  for (std::size_t i = 0; i < 8; ++i) bits |= static_cast<std::uint64_t>(probe.data[i]) << (8 * i);
+  return bits;
+}
+
+CanMapping read_mapping(const Reader& r, const YAML::Node& root) {
+  r.check_keys(root, "", {"format", "note", "joints"});
+  const YAML::Node format = r.child(root, "format", "");
+  if (r.text(format, "format") != kMappingFormat) {
+    r.fail(format, "format", std::string("expected ") + kMappingFormat);
+  }
+  const YAML::Node joints = r.child(root, "joints", "");
+  if (!joints.IsSequence() || joints.size() == 0) {
+    r.fail(joints, "joints", "expected a list of joints");
+  }
+  CanMapping mapping;
+  mapping.source = r.file();
+  std::vector<Occupancy> occupancy;
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    const YAML::Node j = joints[i];
+    const std::string path = "joints[" + std::to_string(i) + "]";
+    r.check_keys(j, path, {"name", "valve", "position", "pressure_a", "pressure_b"});
+    JointMapping jm;
+    const YAML::Node name = r.child(j, "name", path);
+    jm.name = r.text(name, path + ".name");
+    for (const auto& other : mapping.joints) {
+      if (other.name == jm.name) r.fail(name, path + ".name", "duplicate joint '" + jm.name + "'");
+    }
+    jm.valve = read_valve(r, r.child(j, "valve", path), path + ".valve");
+    if (jm.valve.kind == ValveOutputKind::kIso11783Avc) {
+      for (const auto& other : mapping.joints) {
+        if (other.valve.kind == ValveOutputKind::kIso11783Avc &&
+            other.valve.avc.valve == jm.valve.avc.valve &&
+            other.valve.avc.source_address == jm.valve.avc.source_address) {
+          r.fail(j["valve"]["iso11783_avc"]["valve"], path + ".valve.iso11783_avc.valve",
+                 "valve " + std::to_string(jm.valve.avc.valve) + " is already used by joint '" +
+                     other.name + "'");
+        }
+      }
+    } else {
+      occupancy.push_back({jm.valve.signal.signal.id, jm.valve.signal.signal.extended,
+                           occupied_bits(jm.valve.signal.signal), path + ".valve.signal",
+                           j["valve"]["signal"], true});
+    }
+    jm.position = read_signal(r, r.child(j, "position", path), path + ".position",
+                              SignalUse::kPosition, kSignalKeys, &jm.position_kind);
+    occupancy.push_back({jm.position.id, jm.position.extended, occupied_bits(jm.position),
+                         path + ".position", j["position"], false});
+    for (const char* key : {"pressure_a", "pressure_b"}) {
+      if (!j[key].IsDefined()) continue;
+      const std::string p = path + "." + key;
+      SignalSpec s = read_signal(r, j[key], p, SignalUse::kPressure, kSignalKeys, nullptr);
+      occupancy.push_back({s.id, s.extended, occupied_bits(s), p, j[key], false});
+      (std::string(key) == "pressure_a" ? jm.pressure_a : jm.pressure_b) = s;
+    }
+    mapping.joints.push_back(std::move(jm));
+  }
+  // Signals sharing a frame must not share bits; a frame is either sent or received.
+  for (std::size_t a = 0; a < occupancy.size(); ++a) {
+    for (std::size_t b = 0; b < a; ++b) {
+      const Occupancy& x = occupancy[a];
+      const Occupancy& y = occupancy[b];
+      if (x.id != y.id || x.extended != y.extended) continue;
+      if (x.sent != y.sent) {
+        r.fail(
+            x.node, x.field,
+            "identifier is also used by " + y.field + " in the other direction (sent vs received)");
+      }
+      if ((x.bits & y.bits) != 0) r.fail(x.node, x.field, "overlaps the bits of " + y.field);
+    }
+  }
+  return mapping;
+}
+
+}  // namespace
+
+CanMapping parse_can_mapping(std::string_view yaml_text, std::string_view source_name) {
+  const Reader reader{std::string(source_name)};
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(yaml_text));
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(std::string(source_name), e.mark.line + 1, "", "YAML syntax: " + e.msg);
+  }
+  try {
+    return read_mapping(reader, root);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(std::string(source_name), e.mark.line + 1, "", e.msg);
+  }
+}
+
+CanMapping load_can_mapping(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError(path.string(), 0, "", "cannot open the file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_can_mapping(text.str(), path.string());
+}
+
+}  // namespace craneassist::can
