@@ -10,6 +10,7 @@
 #include "craneassist/config/quantity.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/inverse_kinematics.hpp"
+#include "craneassist/dynamics/valve_table.hpp"
 #include "embedded_configs.hpp"
 
 namespace craneassist::config {
@@ -296,6 +297,34 @@ void read_bodies(Reader& r, const YAML::Node& root, dynamics::CraneModel& model)
   model.bodies.push_back(p);
 }
 
+// hydraulics.valves.tables: the measured characteristic of some sections, by joint name
+// (craneassist calibrate writes this block); the others keep the straight line.
+void read_valve_tables(Reader& r, const YAML::Node& tables, const std::string& path,
+                       dynamics::CraneModel& model) {
+  if (!tables.IsMap()) r.fail(tables, path, "expected joint: {command, velocity} entries");
+  model.valves.tables.assign(model.cylinders.size(), dynamics::ValveTable{});
+  for (const auto& kv : tables) {
+    const std::string name = kv.first.Scalar();
+    const std::string tp = path + "." + name;
+    std::size_t index = model.joints.size();
+    for (std::size_t i = 0; i < model.joints.size(); ++i) {
+      if (model.joints[i].name == name) index = i;
+    }
+    if (index == model.joints.size()) r.fail(kv.first, tp, "no joint of that name");
+    const YAML::Node entry = kv.second;
+    r.check_keys(entry, tp, {"command", "velocity"});
+    dynamics::ValveTable table;
+    table.command = r.values(entry, "command", tp, Dimension::kDimensionless, 0);
+    table.velocity_m_s = r.values(entry, "velocity", tp, Dimension::kVelocity, 0);
+    if (const std::string why = dynamics::check_valve_table(table); !why.empty()) {
+      const bool about_command = why.rfind("command", 0) == 0;  // else about the velocities
+      r.fail(entry[about_command ? "command" : "velocity"],
+             tp + (about_command ? ".command" : ".velocity"), why);
+    }
+    model.valves.tables[index] = std::move(table);
+  }
+}
+
 void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& model) {
   const YAML::Node h = r.child(root, "hydraulics", "");
   r.check_keys(h, "hydraulics", {"pump", "valves"});
@@ -342,13 +371,14 @@ void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& mo
 
   const YAML::Node valves = r.child(h, "valves", "hydraulics");
   const std::string vp = "hydraulics.valves";
-  r.check_keys(valves, vp, {"dead_zone", "time_constant", "delay"});
+  r.check_keys(valves, vp, {"dead_zone", "time_constant", "delay", "tables"});
   auto& v = model.valves;
   v.dead_zone = r.value_in(valves, "dead_zone", vp, Dimension::kDimensionless, 0.0, 0.95,
                            "between 0 and 0.95");
   v.time_constant_s =
       r.value_in(valves, "time_constant", vp, Dimension::kTime, 0.0, 5.0, "between 0 and 5 s");
   v.delay_s = r.value_in(valves, "delay", vp, Dimension::kTime, 0.0, 2.0, "between 0 and 2 s");
+  if (valves["tables"].IsDefined()) read_valve_tables(r, valves["tables"], vp + ".tables", model);
 }
 
 CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view source_name) {

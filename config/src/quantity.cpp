@@ -124,9 +124,11 @@ std::optional<Quantity> parse_quantity(std::string_view text, Dimension dimensio
       q.source = Source::kDerived;
     } else if (source == "standard") {
       q.source = Source::kStandard;
+    } else if (source == "measured") {
+      q.source = Source::kMeasured;
     } else {
       error = "unknown source '" + std::string(source) +
-              "' (expected paper, assumed, derived or standard)";
+              "' (expected paper, assumed, derived, standard or measured)";
       return std::nullopt;
     }
   }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "craneassist/dynamics/valve_table.hpp"
+
 namespace craneassist::valves {
 
 const char* to_string(PumpLimit limit) {
@@ -36,7 +38,23 @@ ProportionalValves::ProportionalValves(const dynamics::CraneModel& model, double
     : model_(model),
       position_gain_1_s_(position_gain_1_s),
       activation_speed_m_s_(activation_speed_m_s),
-      activation_error_m_(activation_error_m) {}
+      activation_error_m_(activation_error_m) {
+  const auto& tables = model.valves.tables;
+  for (std::size_t i = 0; i < tables.size() && i < tables_.size(); ++i) {
+    if (!tables[i].empty()) tables_[i] = &tables[i];
+  }
+}
+
+double ProportionalValves::spool_for(int i, double velocity_m_s) const {
+  if (const auto* t = table(i)) return dynamics::valve_table_command(*t, velocity_m_s);
+  return spool_from_velocity(velocity_m_s, model_.valves.dead_zone,
+                             model_.cylinders[static_cast<std::size_t>(i)].v_max_m_s);
+}
+
+double ProportionalValves::dead_band_edge(int i, double side) const {
+  if (const auto* t = table(i)) return dynamics::valve_table_dead_band_edge(*t, side);
+  return side > 0.0 ? model_.valves.dead_zone : -model_.valves.dead_zone;
+}
 
 double ProportionalValves::velocity_from_spool(double spool, double dead_zone, double v_max) {
   const double open = std::clamp((std::abs(spool) - dead_zone) / (1.0 - dead_zone), 0.0, 1.0);
@@ -61,7 +79,7 @@ void ProportionalValves::update(const ProportionalValvesInput& in, ValveCommand&
       continue;
     }
     const double v = in.velocity_ref_m_s[i] + position_gain_1_s_ * in.position_error_m[i];
-    out.spool[i] = spool_from_velocity(v, model_.valves.dead_zone, model_.cylinders[i].v_max_m_s);
+    out.spool[i] = spool_for(i, v);
   }
 }
 

@@ -56,12 +56,13 @@ void ReferenceFollower::update(const JointVector& q_ref, const JointVector& qdot
   // Deadbeat compensation of the spool lag while a spool still has to cross the dead zone to the
   // side it is wanted on (no flow passes there, so a fast crossing costs nothing); outside it
   // the wanted position goes through unchanged, so feedback corrections are not amplified.
-  const double dead_zone = model_.valves.dead_zone;
   for (int i = 0; i < n; ++i) {
     const double wanted = out.spool[i];
     const double estimate = spool_estimate_[i];
+    // The dead band on the wanted side (the section's table, or the straight line's dead_zone).
+    const double edge = wanted != 0.0 ? valves_.dead_band_edge(i, wanted) : 0.0;
     const bool crossing =
-        wanted != 0.0 && (estimate * wanted <= 0.0 || std::abs(estimate) < dead_zone);
+        wanted != 0.0 && (estimate * wanted <= 0.0 || std::abs(estimate) < std::abs(edge));
     const double command =
         crossing ? std::clamp(estimate + (wanted - estimate) / lag_alpha_, -1.0, 1.0) : wanted;
     spool_estimate_[i] += lag_alpha_ * (command - spool_estimate_[i]);

@@ -32,7 +32,7 @@ enum class Dimension {
 const char* to_string(Dimension dimension);
 
 // Where a value comes from, as the config file states it.
-enum class Source { kUnstated, kPaper, kAssumed, kDerived, kStandard };
+enum class Source { kUnstated, kPaper, kAssumed, kDerived, kStandard, kMeasured };
 
 struct Quantity {
   std::vector<double> si_values;  // converted to SI

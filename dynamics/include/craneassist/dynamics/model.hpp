@@ -97,10 +97,24 @@ inline double supply_pressure_ceiling_pa(const Pump& p) {
                                                : p.max_pressure_pa;
 }
 
+// Measured characteristic of one valve section (paper 000 appendix A): the steady cylinder
+// velocity reached at each normalised spool command, both directions in one table, commands
+// strictly increasing in [-1, 1], velocities non-decreasing (zero over the dead band, strictly
+// increasing outside it). The command is the normalised spool command of ValveCommand; a valve
+// driver (CAN) maps it to a current or a flow. Empty: the straight-line model of ValveSections.
+struct ValveTable {
+  std::vector<double> command;       // -1 .. 1
+  std::vector<double> velocity_m_s;  // positive: extending
+  bool empty() const { return command.empty(); }
+};
+
 struct ValveSections {
   double dead_zone = 0.0;  // fraction of the spool (current) range with no flow
   double time_constant_s = 0.0;
   double delay_s = 0.0;
+  // Optional measured characteristic per section (cylinder, same index); empty tables or an
+  // empty vector: the straight line through dead_zone and the cylinder's max_speed.
+  std::vector<ValveTable> tables;
 };
 
 struct CraneModel {
