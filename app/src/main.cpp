@@ -11,6 +11,7 @@
 #include <sstream>
 #include <string>
 
+#include "calibrate_command.hpp"
 #include "craneassist/app/csv_log.hpp"
 #include "craneassist/app/embedded_replays.hpp"
 #include "craneassist/app/replay_runner.hpp"
@@ -455,6 +456,8 @@ int main(int argc, char** argv) {
   auto* plan = cli::add_plan_command(cli, plan_args);
   cli::EnergyArgs energy_args;
   auto* energy = cli::add_energy_command(cli, energy_args);
+  cli::CalibrateArgs calibrate_args;
+  auto* calibrate = cli::add_calibrate_command(cli, calibrate_args);
 
   try {
     cli.parse(argc, argv);
@@ -466,6 +469,14 @@ int main(int argc, char** argv) {
   if (*energy) {
     try {
       return cli::run_energy_command(energy_args);
+    } catch (const CLI::Error& e) {
+      cli.exit(e);
+      return kExitUsage;
+    }
+  }
+  if (*calibrate) {
+    try {
+      return cli::run_calibrate_command(calibrate_args);
     } catch (const CLI::Error& e) {
       cli.exit(e);
       return kExitUsage;

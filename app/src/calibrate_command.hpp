@@ -1,0 +1,21 @@
+// `craneassist calibrate`: sweep each valve section on the simulator and write the fitted
+// velocity-vs-command tables (docs/valves.md).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace craneassist::cli {
+
+struct CalibrateArgs {
+  std::string config_file;  // empty: the embedded reference crane
+  std::string section = "all";
+  std::string out_file = "craneassist-valve-tables.yaml";
+  std::string log_file = "craneassist-sweep.csv";
+  bool quiet = false;
+};
+
+CLI::App* add_calibrate_command(CLI::App& cli, CalibrateArgs& args);
+int run_calibrate_command(const CalibrateArgs& args);
+
+}  // namespace craneassist::cli
