@@ -184,6 +184,20 @@ void CanBackend::latch(FaultReason reason, const char* fmt, ...) {
   fault_.store(kLatched, std::memory_order_release);
 }
 
+bool CanBackend::wait_for_feedback(double timeout_s, valves::MachineState& state) {
+  const std::int64_t end = mono_us() + static_cast<std::int64_t>(timeout_s * 1e6);
+  for (;;) {
+    read(state);
+    bool all = true;
+    for (const auto& j : impl_->joints) all = all && j.seen;
+    if (all) return true;
+    const std::int64_t left = end - mono_us();
+    if (left <= 0) return false;
+    impl_->transport.wait_readable(static_cast<int>(std::min<std::int64_t>(left / 1000 + 1, 10)));
+    impl_->last_write_us.store(mono_us(), std::memory_order_release);
+  }
+}
+
 void CanBackend::enable() {
   // Deliberate: the fault is cleared and the feedback must be fresh again before the next
   // read() reports valid.
