@@ -201,7 +201,7 @@ bool CanBackend::wait_for_feedback(double timeout_s, valves::MachineState& state
 void CanBackend::enable() {
   // Deliberate: the fault is cleared and the feedback must be fresh again before the next
   // read() reports valid.
-  impl_->last_write_us.store(mono_us(), std::memory_order_release);
+  impl_->last_write_us.store(0, std::memory_order_release);  // armed by the next write()
   reason_.store(FaultReason::kNone, std::memory_order_release);
   impl_->reason_text[0] = '\0';
   impl_->fault_time_s.store(NAN);
@@ -394,7 +394,9 @@ void CanBackend::watchdog_loop() {
     }
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
     const std::int64_t now = mono_us();
-    const std::int64_t since_write = now - m.last_write_us.load(std::memory_order_acquire);
+    const std::int64_t last_write = m.last_write_us.load(std::memory_order_acquire);
+    if (last_write == 0) continue;  // enabled, no write() yet: not armed
+    const std::int64_t since_write = now - last_write;
     if (since_write < loop_timeout_us) continue;
     if (enabled() && !faulted()) {
       latch(FaultReason::kLoopFrozen, "control loop frozen: write() not called for %.0f ms",

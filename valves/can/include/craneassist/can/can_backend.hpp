@@ -11,7 +11,7 @@
 //   - bus-off or error-passive reported by the controller (error frames),
 //   - send errors on max_send_errors consecutive sends,
 //   - a frozen control loop: write() not called for loop_timeout_s (100 ms; the watchdog thread
-//     notices and sends the block commands itself)
+//     notices and sends the block commands itself; armed by the first write() after enable())
 // latches a fault: every section is commanded to block (ISO 11783: state block, flow 0; signal
 // outputs: 0) on every cycle from then on, read() reports kFault and state.valid = false. The
 // fault stays until a deliberate enable(); nothing clears it by itself.
