@@ -27,11 +27,13 @@ can::CanMapping load_mapping_or_default(const std::string& file) {
 }
 
 CanMachine::CanMachine(const dynamics::CraneModel& model, const std::string& iface,
-                       const std::string& mapping_file, const std::string& candump_log) {
+                       const std::string& mapping_file, const std::string& candump_log,
+                       double feedback_timeout_s) {
   const auto mapping = load_mapping_or_default(mapping_file);
   transport_ = std::make_unique<can::SocketCanTransport>(iface);
   can::CanBackendOptions options;
   options.candump_log = candump_log;
+  options.feedback_timeout_s = feedback_timeout_s;
   backend_ = std::make_unique<can::CanBackend>(mapping, model, *transport_, options);
 }
 

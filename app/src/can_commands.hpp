@@ -20,7 +20,8 @@ can::CanMapping load_mapping_or_default(const std::string& file);
 class CanMachine {
  public:
   CanMachine(const dynamics::CraneModel& model, const std::string& iface,
-             const std::string& mapping_file, const std::string& candump_log);
+             const std::string& mapping_file, const std::string& candump_log,
+             double feedback_timeout_s = 0.05);
   // Waits for every joint's feedback, then enables the backend. False: no feedback in time.
   bool start(double timeout_s);
   can::CanBackend& backend() { return *backend_; }

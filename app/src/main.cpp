@@ -39,10 +39,11 @@ struct ReplayArgs {
   std::string trajectory_file;  // a planned joint trajectory instead of a replay
   std::string config_file;      // empty: the embedded reference crane
   std::string backend = "sim";
-  std::string can_iface;      // --backend can: the interface
-  std::string mapping_file;   // --backend can: empty: the embedded K70M mapping
-  std::string can_log;        // --backend can: candump -L log of all traffic
-  double freeze_at_s = -1.0;  // test hook: freeze the loop at this machine time
+  std::string can_iface;             // --backend can: the interface
+  std::string mapping_file;          // --backend can: empty: the embedded K70M mapping
+  std::string can_log;               // --backend can: candump -L log of all traffic
+  double feedback_timeout_s = 0.05;  // --backend can: lost feedback after this long
+  double freeze_at_s = -1.0;         // test hook: freeze the loop at this machine time
   double freeze_for_s = 0.0;
   std::string log_file = "craneassist-log.csv";
   bool no_log = false;
@@ -282,7 +283,8 @@ int run_replay_command(const ReplayArgs& args) {
         spdlog::error("--backend can needs --can IFACE");
         return kExitUsage;
       }
-      can_machine.emplace(cfg.model, args.can_iface, args.mapping_file, args.can_log);
+      can_machine.emplace(cfg.model, args.can_iface, args.mapping_file, args.can_log,
+                          args.feedback_timeout_s);
       if (!can_machine->start(2.0)) {
         spdlog::error(
             "no position feedback of every joint on {} within 2 s (is the machine or "
@@ -431,6 +433,11 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   replay->add_option("--can-log", args.can_log,
                      "--backend can: write all CAN traffic as a candump -L log");
+  replay
+      ->add_option("--can-feedback-timeout", args.feedback_timeout_s,
+                   "--backend can: fault when a joint's position is older than this, s")
+      ->check(CLI::Range(0.005, 1.0))
+      ->capture_default_str();
   replay->add_option("--test-freeze-at", args.freeze_at_s)->group("");
   replay->add_option("--test-freeze-for", args.freeze_for_s)->group("");
   replay->add_option("--log", args.log_file, "Per-cycle CSV log (docs/log-format.md)")

@@ -28,8 +28,10 @@ echo "=== 1. the same replay on the sim backend and on the CAN backend (emulator
 ./craneassist replay can_short.csv --log /tmp/sim.csv --settle 0.5 >/tmp/sim.out 2>&1 || fail "sim replay"
 start_emulator
 start_capture /tmp/cap1.log
+# A longer feedback timeout here: this case compares paths, and a loaded host can stall the
+# emulated CPU for tens of ms (the fault cases below keep the default 50 ms).
 ./craneassist replay can_short.csv --backend can --can vcan0 --log /tmp/can.csv --settle 0.5 \
-  --can-log /tmp/backend.log >/tmp/can.out 2>&1 || fail "replay --backend can exited $?"
+  --can-feedback-timeout 0.3 --can-log /tmp/backend.log >/tmp/can.out 2>&1 || fail "replay --backend can exited $?"
 stop_capture
 kill "$emu"; wait "$emu"
 cat /tmp/can.out /tmp/emu.log
@@ -56,7 +58,8 @@ grep -q "CAN FAULT (feedback lost)" /tmp/f2.out || fail "no feedback-lost fault"
 echo "=== 3. garbage frames (ignored, counted), then a wrong dlc on the lift encoder"
 start_emulator
 start_capture /tmp/cap3.log
-./craneassist replay can_short.csv --backend can --can vcan0 --no-log --settle 0 >/tmp/f3.out 2>&1 &
+./craneassist replay can_short.csv --backend can --can vcan0 --no-log --settle 0 \
+  --can-feedback-timeout 0.3 >/tmp/f3.out 2>&1 &
 rp=$!
 sleep 1
 cangen vcan0 -I 555 -L r -D r -g 1 -n 100
@@ -75,7 +78,7 @@ echo "=== 4. the control loop freezes (test hook: 0.5 s at t = 1 s)"
 start_emulator
 start_capture /tmp/cap4.log
 ./craneassist replay can_short.csv --backend can --can vcan0 --no-log --settle 0 \
-  --test-freeze-at 1.0 --test-freeze-for 0.5 >/tmp/f4.out 2>&1; rc=$?
+  --can-feedback-timeout 0.3 --test-freeze-at 1.0 --test-freeze-for 0.5 >/tmp/f4.out 2>&1; rc=$?
 stop_capture
 kill "$emu"; wait "$emu"
 grep CAN /tmp/f4.out

@@ -100,8 +100,9 @@ int compare(const char* sim_path, const char* can_path, double tol) {
   return (max_d <= tol && a.size() == b.size()) ? 0 : 1;
 }
 
+// Reports the period statistics; only the mean is asserted, within tol of nominal (TCG timing).
 void period_stats(const char* what, const std::vector<std::int64_t>& t, double nominal_ms,
-                  bool& ok) {
+                  double tol, bool& ok) {
   if (t.size() < 3) {
     std::printf("%s: only %zu frames\n", what, t.size());
     ok = false;
@@ -121,7 +122,7 @@ void period_stats(const char* what, const std::vector<std::int64_t>& t, double n
       "%s: %zu frames, period mean %.2f ms (nominal %.0f), std dev %.2f ms, max |dev| %.2f "
       "ms\n",
       what, t.size(), mean, nominal_ms, sd, max_dev);
-  if (std::abs(mean - nominal_ms) > 0.1 * nominal_ms) ok = false;
+  if (std::abs(mean - nominal_ms) > tol * nominal_ms) ok = false;
 }
 
 int traffic(const char* path) {
@@ -159,8 +160,9 @@ int traffic(const char* path) {
       path, recs.size(), bad_payload, unknown, moving);
   const char* names[] = {"slew AVC 0CFE3080", "lift AVC 0CFE3180", "tilt AVC 0CFE3280",
                          "extension current 210"};
-  for (int s = 0; s < 4; ++s) period_stats(names[s], times[s], 20.0, ok);
-  period_stats("slew position 18FF1021 (emulator)", position, 10.0, ok);
+  for (int s = 0; s < 4; ++s) period_stats(names[s], times[s], 20.0, 0.1, ok);
+  // The emulator is the test machine, not the code under test: a looser bound.
+  period_stats("slew position 18FF1021 (emulator)", position, 10.0, 0.3, ok);
   return ok && bad_payload == 0 && unknown == 0 && moving > 0 ? 0 : 1;
 }
 
