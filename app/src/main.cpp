@@ -12,6 +12,7 @@
 #include <string>
 
 #include "calibrate_command.hpp"
+#include "can_commands.hpp"
 #include "craneassist/app/csv_log.hpp"
 #include "craneassist/app/embedded_replays.hpp"
 #include "craneassist/app/replay_runner.hpp"
@@ -39,6 +40,12 @@ struct ReplayArgs {
   std::string trajectory_file;  // a planned joint trajectory instead of a replay
   std::string config_file;      // empty: the embedded reference crane
   std::string backend = "sim";
+  std::string can_iface;             // --backend can: the interface
+  std::string mapping_file;          // --backend can: empty: the embedded K70M mapping
+  std::string can_log;               // --backend can: candump -L log of all traffic
+  double feedback_timeout_s = 0.05;  // --backend can: lost feedback after this long
+  double freeze_at_s = -1.0;         // test hook: freeze the loop at this machine time
+  double freeze_for_s = 0.0;
   std::string log_file = "craneassist-log.csv";
   bool no_log = false;
   bool no_scaling = false;
@@ -104,11 +111,12 @@ void print_pump_line(double energy_j, double peak_power_w, double peak_flow_m3_s
 }
 
 void print_summary(const app::RunSummary& s, const config::CraneConfig& cfg,
-                   const std::string& replay_name, app::ScalingMode mode, const app::CsvLog* log) {
+                   const std::string& replay_name, app::ScalingMode mode, const app::CsvLog* log,
+                   const char* backend) {
   const double speedup = s.wall_time_s > 0.0 ? s.duration_s / s.wall_time_s : 0.0;
   std::printf("craneassist replay: %s on %s\n", replay_name.c_str(), cfg.model.name.c_str());
-  std::printf("  backend sim, resolution %s, scaling %s, control %.0f Hz, payload %.0f kg\n",
-              dynamics::to_string(cfg.redundancy.resolution),
+  std::printf("  backend %s, resolution %s, scaling %s, control %.0f Hz, payload %.0f kg\n",
+              backend, dynamics::to_string(cfg.redundancy.resolution),
               mode == app::ScalingMode::kFull
                   ? (std::string("full (power bound: ") +
                      power_bound_name(cfg.scaling.power_bound, cfg.model.pump.mode) + ")")
@@ -268,7 +276,30 @@ int run_replay_command(const ReplayArgs& args) {
   const input::Replay& replay = *loaded;
   const std::string replay_name(replay.source_name());
   try {
-    sim_backend::SimBackend machine(cfg.model, {cfg.simulation.step_s, cfg.simulation.q_initial});
+    std::optional<sim_backend::SimBackend> sim;
+    std::optional<cli::CanMachine> can_machine;
+    valves::MachineInterface* machine_ptr = nullptr;
+    if (args.backend == "can") {
+      if (args.can_iface.empty()) {
+        spdlog::error("--backend can needs --can IFACE");
+        return kExitUsage;
+      }
+      can_machine.emplace(cfg.model, args.can_iface, args.mapping_file, args.can_log,
+                          args.feedback_timeout_s);
+      if (!can_machine->start(2.0)) {
+        spdlog::error(
+            "no position feedback of every joint on {} within 2 s (is the machine or "
+            "`craneassist emulate --can {}` running?)",
+            args.can_iface, args.can_iface);
+        return kExitRuntime;
+      }
+      machine_ptr = &can_machine->backend();
+    } else {
+      sim.emplace(cfg.model,
+                  sim_backend::SimSettings{cfg.simulation.step_s, cfg.simulation.q_initial});
+      machine_ptr = &*sim;
+    }
+    valves::MachineInterface& machine = *machine_ptr;
     std::optional<app::CsvLog> log;
     if (!args.no_log) log.emplace(args.log_file, cfg.model.dof());
     app::RunOptions options;
@@ -276,16 +307,24 @@ int run_replay_command(const ReplayArgs& args) {
                               : args.scaling == "flow" ? app::ScalingMode::kFlowOnly
                               : args.scaling == "none" ? app::ScalingMode::kNone
                                                        : app::ScalingMode::kFull;
-    options.realtime = args.realtime;
+    options.realtime = args.realtime || args.backend == "can";  // a real machine runs in real time
     options.settle_s = args.settle_s;
+    options.freeze_at_s = args.freeze_at_s;
+    options.freeze_for_s = args.freeze_for_s;
     spdlog::info("running {} ({:.1f} s) on {} with the {} backend{}", replay_name,
                  replay.end_time_s() + args.settle_s, cfg.model.name, machine.name(),
-                 args.realtime ? ", paced at real time" : "");
+                 options.realtime ? ", paced at real time" : "");
     const app::RunSummary summary =
         app::run_replay(cfg, replay, machine, options, log ? &*log : nullptr);
-    print_summary(summary, cfg, replay_name, options.controller.mode, log ? &*log : nullptr);
+    print_summary(summary, cfg, replay_name, options.controller.mode, log ? &*log : nullptr,
+                  machine.name());
     if (summary.log_rows_dropped > 0) {
       spdlog::warn("the log writer fell behind: {} rows dropped", summary.log_rows_dropped);
+    }
+    if (can_machine) {
+      can_machine->backend().stop();
+      can_machine->report();
+      if (can_machine->backend().faulted()) return kExitRuntime;
     }
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
@@ -381,9 +420,27 @@ int main(int argc, char** argv) {
       ->add_option("--config", args.config_file,
                    "Crane config YAML (default: the embedded K70M reference crane)")
       ->check(CLI::ExistingFile);
-  replay->add_option("--backend", args.backend, "Machine backend")
-      ->check(CLI::IsMember({"sim"}))
+  replay
+      ->add_option("--backend", args.backend,
+                   "Machine backend: sim (the simulated crane) or can (a machine on a CAN bus, "
+                   "docs/can.md; implies --realtime)")
+      ->check(CLI::IsMember({"sim", "can"}))
       ->capture_default_str();
+  replay->add_option("--can", args.can_iface, "--backend can: the CAN interface (can0, vcan0)");
+  replay
+      ->add_option("--mapping", args.mapping_file,
+                   "--backend can: CAN mapping YAML (default: the embedded "
+                   "config/can/k70m_can.yaml)")
+      ->check(CLI::ExistingFile);
+  replay->add_option("--can-log", args.can_log,
+                     "--backend can: write all CAN traffic as a candump -L log");
+  replay
+      ->add_option("--can-feedback-timeout", args.feedback_timeout_s,
+                   "--backend can: fault when a joint's position is older than this, s")
+      ->check(CLI::Range(0.005, 1.0))
+      ->capture_default_str();
+  replay->add_option("--test-freeze-at", args.freeze_at_s)->group("");
+  replay->add_option("--test-freeze-for", args.freeze_for_s)->group("");
   replay->add_option("--log", args.log_file, "Per-cycle CSV log (docs/log-format.md)")
       ->capture_default_str();
   replay->add_flag("--no-log", args.no_log, "Do not write the log");
@@ -454,6 +511,8 @@ int main(int argc, char** argv) {
 
   cli::PlanArgs plan_args;
   auto* plan = cli::add_plan_command(cli, plan_args);
+  cli::EmulateArgs emulate_args;
+  auto* emulate = cli::add_emulate_command(cli, emulate_args);
   cli::EnergyArgs energy_args;
   auto* energy = cli::add_energy_command(cli, energy_args);
   cli::CalibrateArgs calibrate_args;
@@ -466,6 +525,7 @@ int main(int argc, char** argv) {
     return cli.exit(e) == 0 ? kExitOk : kExitUsage;
   }
   if (*experiment) return run_experiment_command(exp);
+  if (*emulate) return cli::run_emulate_command(emulate_args);
   if (*energy) {
     try {
       return cli::run_energy_command(energy_args);

@@ -35,6 +35,7 @@ RunSummary run_replay(const config::CraneConfig& config, const input::Replay& re
 
   machine.read(state);
   controller.reset(state);
+  bool frozen_once = false;
   const auto wall_start = std::chrono::steady_clock::now();
   auto next_tick = wall_start;
   for (int k = 0; k < cycles; ++k) {
@@ -113,6 +114,11 @@ RunSummary run_replay(const config::CraneConfig& config, const input::Replay& re
     }
 
     machine.advance(period);
+    if (!frozen_once && options.freeze_at_s >= 0.0 && t >= options.freeze_at_s) {
+      std::this_thread::sleep_for(std::chrono::duration<double>(options.freeze_for_s));
+      next_tick = std::chrono::steady_clock::now();
+      frozen_once = true;
+    }
     if (options.realtime) {
       next_tick += std::chrono::duration_cast<std::chrono::steady_clock::duration>(
           std::chrono::duration<double>(period));

@@ -4,5 +4,7 @@ namespace craneassist::app::embedded {
 
 // examples/replays/demo.csv, the default replay of `craneassist replay`.
 extern const char* const kDemoReplayCsv;
+// config/can/k70m_can.yaml, the default CAN mapping of `replay --backend can` and `emulate`.
+extern const char* const kK70mCanMappingYaml;
 
 }  // namespace craneassist::app::embedded

@@ -20,6 +20,10 @@ struct RunOptions {
   // than min_speed_m_s.
   double steady_after_s = 0.5;
   double min_speed_m_s = 0.05;
+  // Test hook (the CAN watchdog tests): at this machine time the loop stops for freeze_for_s
+  // without reading or writing, as a hung control thread would. Negative: never.
+  double freeze_at_s = -1.0;
+  double freeze_for_s = 0.0;
 };
 
 struct RunSummary {

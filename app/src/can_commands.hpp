@@ -1,0 +1,48 @@
+// The CAN side of the command line: `craneassist emulate` (the simulated crane behind the CAN
+// protocol) and the machine of `craneassist replay --backend can`.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <string>
+
+#include "craneassist/can/can_backend.hpp"
+#include "craneassist/can/mapping_config.hpp"
+#include "craneassist/can/socketcan.hpp"
+#include "craneassist/dynamics/model.hpp"
+
+namespace craneassist::cli {
+
+// The mapping file, or the embedded K70M mapping (config/can/k70m_can.yaml) when file is empty.
+can::CanMapping load_mapping_or_default(const std::string& file);
+
+// replay --backend can: the SocketCAN transport and the backend on it.
+class CanMachine {
+ public:
+  CanMachine(const dynamics::CraneModel& model, const std::string& iface,
+             const std::string& mapping_file, const std::string& candump_log,
+             double feedback_timeout_s = 0.05);
+  // Waits for every joint's feedback, then enables the backend. False: no feedback in time.
+  bool start(double timeout_s);
+  can::CanBackend& backend() { return *backend_; }
+  // Prints the counters and, after a fault, its reason and how to recover.
+  void report() const;
+
+ private:
+  std::unique_ptr<can::SocketCanTransport> transport_;
+  std::unique_ptr<can::CanBackend> backend_;
+};
+
+struct EmulateArgs {
+  std::string iface;
+  std::string config_file;
+  std::string mapping_file;
+  double feedback_period_s = 0.01;
+  double duration_s = 0.0;  // 0: until killed
+  double command_timeout_s = 0.2;
+};
+
+CLI::App* add_emulate_command(CLI::App& cli, EmulateArgs& args);
+int run_emulate_command(const EmulateArgs& args);
+
+}  // namespace craneassist::cli

@@ -1,0 +1,226 @@
+// Checks of the can_vm_can_backend test, run in the guest on files the test wrote:
+//   compare SIM.csv CAN.csv TOL_M       tip paths of the two backends' logs, row by row
+//   traffic CAPTURE                     candump -L capture: identifiers, payloads, cycle times
+//   safe CAPTURE EVENT LIMIT_MS         time from EVENT to every section commanded to block;
+//        EVENT: last-feedback (the last position frame), bad-frame (the first position frame
+//        with a wrong dlc), last-motion (the last non-block command before the safe state)
+// Prints the figures; exit 0 when they are within the bounds.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "craneassist/can/can_frame.hpp"
+#include "craneassist/can/iso11783_valve.hpp"
+
+using namespace craneassist::can;
+
+namespace {
+
+std::vector<CandumpRecord> read_capture(const char* path, std::vector<std::string>& storage) {
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) storage.push_back(line);
+  std::vector<CandumpRecord> out;
+  for (const auto& l : storage) {
+    CandumpRecord r;
+    if (parse_candump(l, r) == CandumpStatus::kOk) out.push_back(r);
+  }
+  return out;
+}
+
+constexpr std::uint32_t kCommandIds[] = {0x0CFE3080, 0x0CFE3180, 0x0CFE3280, 0x210};
+constexpr std::uint32_t kSlewPosition = 0x18FF1021;
+
+int section_of(const CanFrame& f) {
+  for (int i = 0; i < 4; ++i) {
+    if (f.id == kCommandIds[i] && f.extended == (i < 3)) return i;
+  }
+  return -1;
+}
+
+bool is_block(const CanFrame& f) {
+  const int s = section_of(f);
+  if (s < 0) return false;
+  if (s < 3) return f.dlc == 8 && (f.data[2] & 0x0F) == 0 && f.data[0] == 0;
+  return f.dlc == 2 && f.data[0] == 0 && f.data[1] == 0;
+}
+
+std::vector<std::vector<double>> read_csv(const char* path, std::vector<std::string>& header) {
+  std::ifstream in(path);
+  std::string line;
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::stringstream ss(line);
+    std::string cell;
+    std::vector<std::string> cells;
+    while (std::getline(ss, cell, ',')) cells.push_back(cell);
+    if (header.empty()) {
+      header = cells;
+      continue;
+    }
+    std::vector<double> row;
+    for (const auto& c : cells) row.push_back(std::strtod(c.c_str(), nullptr));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+int compare(const char* sim_path, const char* can_path, double tol) {
+  std::vector<std::string> hs, hc;
+  const auto a = read_csv(sim_path, hs);
+  const auto b = read_csv(can_path, hc);
+  auto col = [](const std::vector<std::string>& h, const char* name) {
+    for (std::size_t i = 0; i < h.size(); ++i) {
+      if (h[i] == name) return i;
+    }
+    return h.size();
+  };
+  const std::size_t x = col(hs, "tip_x"), y = col(hs, "tip_y"), z = col(hs, "tip_z");
+  if (x == hs.size() || a.empty() || b.empty()) {
+    std::printf("compare: no tip columns or rows\n");
+    return 1;
+  }
+  const std::size_t n = std::min(a.size(), b.size());
+  double max_d = 0.0, sum_sq = 0.0, end_d = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double d = std::hypot(a[k][x] - b[k][x], a[k][y] - b[k][y], a[k][z] - b[k][z]);
+    max_d = std::max(max_d, d);
+    sum_sq += d * d;
+    end_d = d;
+  }
+  std::printf(
+      "tip path, can vs sim backend over %zu cycles: max %.1f mm, rms %.1f mm, end %.1f mm "
+      "(tolerance %.0f mm)\n",
+      n, max_d * 1e3, std::sqrt(sum_sq / static_cast<double>(n)) * 1e3, end_d * 1e3, tol * 1e3);
+  return (max_d <= tol && a.size() == b.size()) ? 0 : 1;
+}
+
+// Reports the period statistics; only the mean is asserted, within tol of nominal (TCG timing).
+void period_stats(const char* what, const std::vector<std::int64_t>& t, double nominal_ms,
+                  double tol, bool& ok) {
+  if (t.size() < 3) {
+    std::printf("%s: only %zu frames\n", what, t.size());
+    ok = false;
+    return;
+  }
+  double sum = 0.0, sum_sq = 0.0, max_dev = 0.0;
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    const double p = static_cast<double>(t[i] - t[i - 1]) * 1e-3;
+    sum += p;
+    sum_sq += p * p;
+    max_dev = std::max(max_dev, std::abs(p - nominal_ms));
+  }
+  const double n = static_cast<double>(t.size() - 1);
+  const double mean = sum / n;
+  const double sd = std::sqrt(std::max(0.0, sum_sq / n - mean * mean));
+  std::printf(
+      "%s: %zu frames, period mean %.2f ms (nominal %.0f), std dev %.2f ms, max |dev| %.2f "
+      "ms\n",
+      what, t.size(), mean, nominal_ms, sd, max_dev);
+  if (std::abs(mean - nominal_ms) > tol * nominal_ms) ok = false;
+}
+
+int traffic(const char* path) {
+  std::vector<std::string> storage;
+  const auto recs = read_capture(path, storage);
+  bool ok = !recs.empty();
+  std::vector<std::int64_t> times[4], position;
+  int bad_payload = 0, unknown = 0, moving = 0;
+  for (const auto& r : recs) {
+    const int s = section_of(r.frame);
+    if (s >= 0) {
+      times[s].push_back(r.timestamp);
+      if (s < 3) {
+        iso11783::AuxValveCommand c;
+        std::uint8_t sa = 0;
+        if (iso11783::decode(r.frame, c, sa) != iso11783::CodecStatus::kOk || sa != 0x80 ||
+            static_cast<int>(c.valve) != s || c.fail_safe != iso11783::FailSafeMode::kBlock) {
+          ++bad_payload;
+        }
+        if (c.state != iso11783::ValveState::kBlock) ++moving;
+      } else {
+        const auto ma = static_cast<std::int16_t>(r.frame.data[0] | (r.frame.data[1] << 8));
+        if (r.frame.dlc != 2 || ma < -800 || ma > 800) ++bad_payload;
+      }
+    } else if (r.frame.extended && r.frame.id == kSlewPosition) {
+      position.push_back(r.timestamp);
+    } else if (!((r.frame.extended && (r.frame.id & 0xFFFFFFF0u) == 0x18FF1020u) ||
+                 (!r.frame.extended && r.frame.id >= 0x301 && r.frame.id <= 0x304))) {
+      ++unknown;
+    }
+  }
+  std::printf(
+      "capture %s: %zu frames, %d command payloads wrong, %d unexpected identifiers, %d "
+      "AVC commands not block\n",
+      path, recs.size(), bad_payload, unknown, moving);
+  const char* names[] = {"slew AVC 0CFE3080", "lift AVC 0CFE3180", "tilt AVC 0CFE3280",
+                         "extension current 210"};
+  for (int s = 0; s < 4; ++s) period_stats(names[s], times[s], 20.0, 0.1, ok);
+  // The emulator is the test machine, not the code under test: a looser bound.
+  period_stats("slew position 18FF1021 (emulator)", position, 10.0, 0.3, ok);
+  return ok && bad_payload == 0 && unknown == 0 && moving > 0 ? 0 : 1;
+}
+
+int safe(const char* path, const std::string& event, double limit_ms) {
+  std::vector<std::string> storage;
+  const auto recs = read_capture(path, storage);
+  // The safe state: from this frame on, the latest command of every section is block and stays so.
+  std::int64_t safe_at = -1;
+  std::size_t safe_index = recs.size();
+  bool blocked[4] = {};
+  for (std::size_t i = 0; i < recs.size(); ++i) {
+    const int s = section_of(recs[i].frame);
+    if (s < 0) continue;
+    blocked[s] = is_block(recs[i].frame);
+    const bool all = blocked[0] && blocked[1] && blocked[2] && blocked[3];
+    if (all && safe_at < 0) {
+      safe_at = recs[i].timestamp;
+      safe_index = i;
+    } else if (!all) {
+      safe_at = -1;
+    }
+  }
+  if (safe_at < 0) {
+    std::printf("safe state: never reached in %s\n", path);
+    return 1;
+  }
+  std::int64_t event_at = -1;
+  for (std::size_t i = 0; i < recs.size(); ++i) {
+    const auto& f = recs[i].frame;
+    if (event == "last-feedback" && f.extended && f.id == kSlewPosition)
+      event_at = recs[i].timestamp;
+    if (event == "bad-frame" && event_at < 0 && f.extended && (f.id & 0xFFFFFFF0u) == 0x18FF1020u &&
+        f.dlc != 2) {
+      event_at = recs[i].timestamp;
+    }
+    if (event == "last-motion" && i < safe_index && section_of(f) >= 0 && !is_block(f)) {
+      event_at = recs[i].timestamp;
+    }
+  }
+  if (event_at < 0) {
+    std::printf("safe state: event %s not found in %s\n", event.c_str(), path);
+    return 1;
+  }
+  const double dt = static_cast<double>(safe_at - event_at) * 1e-3;
+  std::printf(
+      "time to safe state (%s -> every section block, from candump): %.1f ms (limit %.0f)\n",
+      event.c_str(), dt, limit_ms);
+  return dt <= limit_ms ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string mode = argc > 1 ? argv[1] : "";
+  if (mode == "compare" && argc == 5)
+    return compare(argv[2], argv[3], std::strtod(argv[4], nullptr));
+  if (mode == "traffic" && argc == 3) return traffic(argv[2]);
+  if (mode == "safe" && argc == 5) return safe(argv[2], argv[3], std::strtod(argv[4], nullptr));
+  std::fprintf(stderr, "usage: can_backend_check compare|traffic|safe ...\n");
+  return 2;
+}

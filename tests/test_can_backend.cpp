@@ -1,0 +1,331 @@
+// CanBackend on an in-memory bus (no kernel CAN needed): valve command frames, feedback decoding,
+// staleness, the watchdog, fault latching and re-enable, send errors, bus errors, the log.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <string>
+#include <thread>
+
+#include "craneassist/can/can_backend.hpp"
+#include "craneassist/can/valve_frames.hpp"
+#include "craneassist/config/crane_config.hpp"
+#include "fake_can_bus.hpp"
+
+namespace craneassist::can {
+namespace {
+
+using testing::FakeCanBus;
+using testing::FakeCanTransport;
+using namespace std::chrono_literals;
+
+std::string hex(const CanFrame& f) {
+  char buf[kCandumpLineCapacity];
+  std::size_t n = 0;
+  format_candump(f, 0, "x", buf, n);
+  return std::string(buf, n).substr(std::string("(0.000000) x ").size());
+}
+
+CanMapping k70m_mapping() {
+  return load_can_mapping(std::string(CRANEASSIST_SOURCE_DIR) + "/config/can/k70m_can.yaml");
+}
+
+// Plays the machine's sensors: the position (and pressure) frames of every joint.
+void send_feedback(FakeCanTransport& sensors, const CanMapping& map, const double* q) {
+  for (std::size_t i = 0; i < map.joints.size(); ++i) {
+    const auto& spec = map.joints[i].position;
+    CanFrame f;
+    f.id = spec.id;
+    f.extended = spec.extended;
+    f.dlc = required_dlc(spec);
+    ASSERT_EQ(encode(spec, q[i], f), SignalStatus::kOk);
+    sensors.send(f);
+  }
+}
+
+// Is this frame a block/neutral command of joint i?
+bool is_block(const JointMapping& j, const CanFrame& f) {
+  double spool = 1.0;
+  bool block = false;
+  return is_valve_frame(j.valve, f) && decode_valve_command(j.valve, f, spool, block) && block &&
+         spool == 0.0;
+}
+
+struct Rig {
+  CanMapping map = k70m_mapping();
+  config::CraneConfig cfg = config::default_crane_config();
+  FakeCanBus bus;
+  FakeCanTransport backend_end{bus}, sensors{bus};
+  double q[4] = {0.1, 0.2, -0.3, 1.0};
+  Rig() {
+    bus.attach(&backend_end);
+    bus.attach(&sensors);
+  }
+};
+
+TEST(ValveFrames, AvcAndCurrentCommandsFromTheSpool) {
+  const auto map = k70m_mapping();
+  CanFrame f;
+  ASSERT_TRUE(encode_valve_command(map.joints[0].valve, 0.5, f));
+  EXPECT_EQ(hex(f), "0CFE3080#7DFD31007DFFFFFF");  // the known ISO 11783 vector
+  ASSERT_TRUE(encode_valve_command(map.joints[1].valve, -0.25, f));
+  EXPECT_EQ(f.id, 0x0CFE3180u);
+  EXPECT_EQ(f.data[2] & 0x0F, 2);  // retract
+  ASSERT_TRUE(encode_valve_command(map.joints[2].valve, 0.0, f));
+  EXPECT_EQ(f.data[2] & 0x0F, 0);  // block
+  EXPECT_EQ(f.data[0], 0);
+  ASSERT_TRUE(encode_valve_command(map.joints[3].valve, -0.5, f));  // -400 mA of 800
+  EXPECT_EQ(hex(f), "210#70FE");
+  for (std::size_t j = 0; j < 4; ++j) {
+    for (double s : {-1.0, -0.3, 0.0, 0.42, 1.0}) {
+      ASSERT_TRUE(encode_valve_command(map.joints[j].valve, s, f));
+      double back = 9.0;
+      bool block = false;
+      ASSERT_TRUE(is_valve_frame(map.joints[j].valve, f));
+      ASSERT_TRUE(decode_valve_command(map.joints[j].valve, f, back, block));
+      EXPECT_NEAR(back, s, 2e-3) << j;
+      EXPECT_EQ(block, s == 0.0);
+    }
+  }
+  ASSERT_TRUE(encode_valve_command(map.joints[0].valve, NAN, f));
+  EXPECT_EQ(f.data[2] & 0x0F, 0);  // non-finite: block
+  CanFrame other = f;
+  other.id = 0x0CFE3181;  // another source address
+  EXPECT_FALSE(is_valve_frame(map.joints[0].valve, other));
+}
+
+TEST(CanBackend, DecodesFeedbackInSiAndDisabledSendsBlock) {
+  Rig r;
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  valves::MachineState state;
+  EXPECT_EQ(backend.read(state), valves::BackendStatus::kNoData);
+  EXPECT_FALSE(state.valid);
+  send_feedback(r.sensors, r.map, r.q);
+  CanFrame p;
+  p.id = 0x302;
+  p.dlc = 4;
+  p.data = {0x10, 0x27, 0xE8, 0x03};  // 100 bar, 10 bar
+  r.sensors.send(p);
+  EXPECT_EQ(backend.read(state), valves::BackendStatus::kOk);
+  ASSERT_TRUE(state.valid);
+  EXPECT_NEAR(state.q[0], 0.1, 1e-4);   // rad, 0.01 deg resolution
+  EXPECT_NEAR(state.q[2], -0.3, 1e-4);  // Motorola encoder
+  EXPECT_NEAR(state.q[3], 1.0, 1e-4);   // m, 0.1 mm resolution
+  const auto& cyl = r.cfg.model.cylinders[1];
+  EXPECT_NEAR(state.load_pressure_pa[1], 100e5 - 10e5 * cyl.area_b_m2 / cyl.area_a_m2, 1.0);
+
+  r.bus.clear_log();
+  valves::ValveCommand cmd;
+  cmd.spool = dynamics::JointVector::Constant(4, 0.5);
+  backend.write(cmd);  // not enabled yet: block
+  auto log = r.bus.log();
+  ASSERT_EQ(log.size(), 4u);
+  for (std::size_t j = 0; j < 4; ++j) EXPECT_TRUE(is_block(r.map.joints[j], log[j].frame)) << j;
+  EXPECT_FALSE(backend.faulted());
+}
+
+TEST(CanBackend, SendsAtTheMappingCycleNotEveryWrite) {
+  Rig r;
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  valves::MachineState state;
+  send_feedback(r.sensors, r.map, r.q);
+  backend.read(state);
+  backend.enable();
+  valves::ValveCommand cmd;
+  cmd.spool = dynamics::JointVector::Constant(4, 0.3);
+  r.bus.clear_log();
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 0; k < 10; ++k) {  // 100 ms at 100 Hz, cycle 20 ms: 5 frames per joint
+    send_feedback(r.sensors, r.map, r.q);
+    backend.read(state);
+    backend.write(cmd);
+    std::this_thread::sleep_until(t0 + (k + 1) * 10ms);
+  }
+  const auto log = r.bus.log();
+  int slew = 0;
+  for (const auto& rx : log) {
+    if (rx.frame.id == 0x0CFE3080u) {
+      ++slew;
+      EXPECT_EQ(rx.frame.data[2] & 0x0F, 1);  // extend
+    }
+  }
+  EXPECT_GE(slew, 4);
+  EXPECT_LE(slew, 6);
+  EXPECT_FALSE(backend.faulted());
+}
+
+TEST(CanBackend, LostFeedbackLatchesBlockUntilEnable) {
+  Rig r;
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  valves::MachineState state;
+  valves::ValveCommand cmd;
+  cmd.spool = dynamics::JointVector::Constant(4, 0.3);
+  send_feedback(r.sensors, r.map, r.q);
+  backend.read(state);
+  backend.enable();
+  const auto t0 = std::chrono::steady_clock::now();
+  auto last_feedback = t0;
+  std::chrono::steady_clock::time_point first_block_all{};
+  for (int k = 0; k < 20; ++k) {
+    if (k < 5) {
+      send_feedback(r.sensors, r.map, r.q);
+      last_feedback = std::chrono::steady_clock::now();
+    }
+    backend.read(state);
+    backend.write(cmd);
+    if (backend.faulted() && first_block_all == std::chrono::steady_clock::time_point{}) {
+      first_block_all = std::chrono::steady_clock::now();
+    }
+    std::this_thread::sleep_until(t0 + (k + 1) * 10ms);
+  }
+  ASSERT_TRUE(backend.faulted());
+  EXPECT_EQ(backend.fault_reason(), FaultReason::kFeedbackLost);
+  EXPECT_NE(backend.fault_text().find("no position frame"), std::string::npos);
+  EXPECT_LT(first_block_all - last_feedback, 100ms);
+  EXPECT_FALSE(state.valid);
+  // The last commands on the bus are block, and they stay block with fresh feedback again.
+  r.bus.clear_log();
+  for (int k = 0; k < 5; ++k) {
+    send_feedback(r.sensors, r.map, r.q);
+    EXPECT_EQ(backend.read(state), valves::BackendStatus::kFault);
+    backend.write(cmd);
+    std::this_thread::sleep_for(10ms);
+  }
+  for (const auto& rx : r.bus.log()) {
+    for (const auto& j : r.map.joints) {
+      if (is_valve_frame(j.valve, rx.frame)) {
+        EXPECT_TRUE(is_block(j, rx.frame));
+      }
+    }
+  }
+  backend.enable();  // the deliberate re-enable
+  send_feedback(r.sensors, r.map, r.q);
+  EXPECT_EQ(backend.read(state), valves::BackendStatus::kOk);
+  EXPECT_TRUE(state.valid);
+  EXPECT_EQ(backend.counters().faults, 1u);
+}
+
+TEST(CanBackend, WatchdogBlocksEverySectionWhenTheLoopFreezes) {
+  Rig r;
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  valves::MachineState state;
+  valves::ValveCommand cmd;
+  cmd.spool = dynamics::JointVector::Constant(4, -0.4);
+  send_feedback(r.sensors, r.map, r.q);
+  backend.read(state);
+  backend.enable();
+  backend.write(cmd);
+  const auto frozen_at = realtime_now_us();
+  r.bus.clear_log();
+  std::this_thread::sleep_for(250ms);  // the control loop stops calling write()
+  ASSERT_TRUE(backend.faulted());
+  EXPECT_EQ(backend.fault_reason(), FaultReason::kLoopFrozen);
+  const auto log = r.bus.log();
+  TimestampUs all_blocked = 0;
+  bool seen[4] = {};
+  for (const auto& rx : log) {
+    for (std::size_t j = 0; j < 4; ++j) {
+      if (is_block(r.map.joints[j], rx.frame)) seen[j] = true;
+    }
+    if (all_blocked == 0 && seen[0] && seen[1] && seen[2] && seen[3]) all_blocked = rx.timestamp_us;
+  }
+  ASSERT_NE(all_blocked, 0);
+  EXPECT_LT(all_blocked - frozen_at, 100000 + 20000);  // loop timeout + one watchdog step
+  EXPECT_GT(backend.counters().watchdog_block_frames, 4u);
+  std::printf("frozen loop: every section blocked %.1f ms after the last write()\n",
+              static_cast<double>(all_blocked - frozen_at) * 1e-3);
+}
+
+TEST(CanBackend, WrongDlcOnFeedbackLatchesAndUnknownFramesAreOnlyCounted) {
+  Rig r;
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  valves::MachineState state;
+  send_feedback(r.sensors, r.map, r.q);
+  backend.read(state);
+  backend.enable();
+  CanFrame junk;
+  junk.id = 0x555;
+  junk.dlc = 3;
+  r.sensors.send(junk);
+  junk.id = 0x7FF;
+  r.sensors.send(junk);
+  send_feedback(r.sensors, r.map, r.q);
+  EXPECT_EQ(backend.read(state), valves::BackendStatus::kOk);
+  EXPECT_EQ(backend.counters().unknown_frames, 2u);
+  CanFrame bad;
+  bad.id = 0x18FF1022;
+  bad.extended = true;
+  bad.dlc = 1;  // the lift encoder needs 2 bytes
+  r.sensors.send(bad);
+  EXPECT_EQ(backend.read(state), valves::BackendStatus::kFault);
+  EXPECT_EQ(backend.fault_reason(), FaultReason::kBadFeedbackFrame);
+  EXPECT_NE(backend.fault_text().find("lift"), std::string::npos);
+  EXPECT_EQ(backend.counters().bad_frames, 1u);
+}
+
+TEST(CanBackend, BusOffAndErrorPassiveLatch) {
+  for (auto flag : {kBusOff, kErrorPassive}) {
+    Rig r;
+    CanBackend backend(r.map, r.cfg.model, r.backend_end);
+    valves::MachineState state;
+    send_feedback(r.sensors, r.map, r.q);
+    backend.read(state);
+    backend.enable();
+    Received err;
+    err.kind = ReceiveKind::kBusError;
+    err.bus_error = flag;
+    err.timestamp_us = realtime_now_us();
+    r.backend_end.deliver(err);
+    send_feedback(r.sensors, r.map, r.q);
+    EXPECT_EQ(backend.read(state), valves::BackendStatus::kFault);
+    EXPECT_EQ(backend.fault_reason(),
+              flag == kBusOff ? FaultReason::kBusOff : FaultReason::kErrorPassive);
+    EXPECT_EQ(backend.counters().bus_error_frames, 1u);
+  }
+}
+
+TEST(CanBackend, ConsecutiveSendErrorsLatch) {
+  Rig r;
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  valves::MachineState state;
+  valves::ValveCommand cmd;
+  cmd.spool = dynamics::JointVector::Constant(4, 0.1);
+  send_feedback(r.sensors, r.map, r.q);
+  backend.read(state);
+  backend.enable();
+  r.backend_end.next_send_status = SendStatus::kQueueFull;
+  backend.write(cmd);  // 4 sections, 4 failed sends, no waiting
+  EXPECT_TRUE(backend.faulted());
+  EXPECT_EQ(backend.fault_reason(), FaultReason::kSendError);
+  EXPECT_EQ(backend.counters().send_queue_full, 4u);
+}
+
+TEST(CanBackend, CandumpLogHoldsSentAndReceivedFrames) {
+  const std::string path = ::testing::TempDir() + "/can_backend_log.txt";
+  {
+    Rig r;
+    CanBackendOptions options;
+    options.candump_log = path;
+    CanBackend backend(r.map, r.cfg.model, r.backend_end, options);
+    valves::MachineState state;
+    send_feedback(r.sensors, r.map, r.q);
+    backend.read(state);
+    valves::ValveCommand cmd;
+    cmd.spool = dynamics::JointVector::Zero(4);
+    backend.write(cmd);
+  }
+  std::ifstream in(path);
+  std::string line;
+  int lines = 0;
+  while (std::getline(in, line)) {
+    CandumpRecord rec;
+    ASSERT_EQ(parse_candump(line, rec), CandumpStatus::kOk) << line;
+    EXPECT_EQ(rec.iface, "fake0");
+    ++lines;
+  }
+  EXPECT_EQ(lines, 8);  // 4 positions received, 4 commands sent
+}
+
+}  // namespace
+}  // namespace craneassist::can

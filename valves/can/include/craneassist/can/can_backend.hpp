@@ -1,0 +1,115 @@
+// The real machine behind valves::MachineInterface: valve commands out and joint feedback in over
+// a CAN transport (SocketCAN on a real bus), per the mapping file (docs/can.md).
+//
+// Control thread (read/write): no allocation, no blocking, no I/O except non-blocking socket
+// calls. A watchdog thread and a log writer thread run beside it.
+//
+// Safety. Any of
+//   - lost feedback: no position frame of some joint for feedback_timeout_s (50 ms),
+//   - a malformed feedback frame (a mapped feedback identifier with a wrong dlc or a value
+//     outside the signal's min/max),
+//   - bus-off or error-passive reported by the controller (error frames),
+//   - send errors on max_send_errors consecutive sends,
+//   - a frozen control loop: write() not called for loop_timeout_s (100 ms; the watchdog thread
+//     notices and sends the block commands itself; armed by the first write() after enable())
+// latches a fault: every section is commanded to block (ISO 11783: state block, flow 0; signal
+// outputs: 0) on every cycle from then on, read() reports kFault and state.valid = false. The
+// fault stays until a deliberate enable(); nothing clears it by itself.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "craneassist/can/mapping_config.hpp"
+#include "craneassist/can/transport.hpp"
+#include "craneassist/dynamics/model.hpp"
+#include "craneassist/valves/machine_interface.hpp"
+
+namespace craneassist::can {
+
+struct CanBackendOptions {
+  double feedback_timeout_s = 0.05;  // per joint: no position frame for this long -> fault
+  double loop_timeout_s = 0.1;       // write() not called for this long -> fault (watchdog)
+  double watchdog_period_s = 0.005;
+  int max_send_errors = 3;           // consecutive failed sends -> fault
+  std::string candump_log;           // candump -L file of all traffic; empty: none
+  std::size_t log_capacity = 16384;  // frames buffered for the log writer
+  double velocity_filter_s = 0.02;   // first-order filter on the differentiated positions
+};
+
+enum class FaultReason : std::uint8_t {
+  kNone,
+  kFeedbackLost,
+  kBadFeedbackFrame,
+  kBusOff,
+  kErrorPassive,
+  kSendError,
+  kLoopFrozen,
+};
+const char* to_string(FaultReason reason);
+
+struct CanBackendCounters {
+  std::uint64_t frames_sent = 0;
+  std::uint64_t frames_received = 0;
+  std::uint64_t send_queue_full = 0;
+  std::uint64_t send_errors = 0;
+  std::uint64_t unknown_frames = 0;  // identifiers the mapping does not name (ignored)
+  std::uint64_t bad_frames = 0;      // mapped feedback identifiers that failed to decode
+  std::uint64_t unsupported_frames = 0;
+  std::uint64_t bus_error_frames = 0;
+  std::uint64_t receive_errors = 0;
+  std::uint64_t watchdog_block_frames = 0;  // block commands the watchdog sent itself
+  std::uint64_t faults = 0;
+  std::uint64_t log_dropped = 0;
+};
+
+class CanBackend final : public valves::MachineInterface {
+ public:
+  // The mapping must name the model's joints in order (throws std::invalid_argument otherwise).
+  // The backend starts disabled: it sends block commands until enable().
+  CanBackend(const CanMapping& mapping, const dynamics::CraneModel& model, Transport& transport,
+             const CanBackendOptions& options = {});
+  ~CanBackend() override;
+  CanBackend(const CanBackend&) = delete;
+  CanBackend& operator=(const CanBackend&) = delete;
+
+  valves::BackendStatus read(valves::MachineState& state) override;
+  valves::BackendStatus write(const valves::ValveCommand& command) override;
+  void advance(double) override {}
+  const char* name() const override { return "can"; }
+
+  // Start-up (may block): reads until every joint's position has arrived, or the timeout.
+  bool wait_for_feedback(double timeout_s, valves::MachineState& state);
+  // The deliberate (re-)enable: clears a latched fault and lets write() command the valves.
+  void enable();
+  bool enabled() const { return enabled_.load(std::memory_order_acquire); }
+  bool faulted() const { return fault_.load(std::memory_order_acquire) == kLatched; }
+  FaultReason fault_reason() const { return reason_.load(std::memory_order_acquire); }
+  // The reason text of the latched fault ("" when none); not for the control thread.
+  std::string fault_text() const;
+  // Monotonic time (s since construction) when the fault latched, or NaN.
+  double fault_time_s() const;
+  CanBackendCounters counters() const;
+  // Stops the watchdog and flushes the log (also done by the destructor).
+  void stop();
+
+ private:
+  struct Impl;
+  enum : int { kClear = 0, kLatching = 1, kLatched = 2 };
+  void latch(FaultReason reason, const char* fmt, ...);
+  void watchdog_loop();
+  void log_loop();
+
+  std::unique_ptr<Impl> impl_;
+  std::atomic<bool> enabled_{false};
+  std::atomic<int> fault_{kClear};
+  std::atomic<FaultReason> reason_{FaultReason::kNone};
+};
+
+}  // namespace craneassist::can

@@ -1,0 +1,448 @@
+#include "craneassist/can/can_backend.hpp"
+
+#include <time.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdarg>
+#include <mutex>
+#include <stdexcept>
+
+#include "craneassist/can/valve_frames.hpp"
+
+namespace craneassist::can {
+
+const char* to_string(FaultReason reason) {
+  switch (reason) {
+    case FaultReason::kNone:
+      return "none";
+    case FaultReason::kFeedbackLost:
+      return "feedback lost";
+    case FaultReason::kBadFeedbackFrame:
+      return "bad feedback frame";
+    case FaultReason::kBusOff:
+      return "bus-off";
+    case FaultReason::kErrorPassive:
+      return "error-passive";
+    case FaultReason::kSendError:
+      return "send errors";
+    case FaultReason::kLoopFrozen:
+      return "control loop frozen";
+  }
+  return "?";
+}
+
+namespace {
+
+std::int64_t mono_us() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000 + ts.tv_nsec / 1000;
+}
+
+struct LogEntry {
+  CanFrame frame;
+  TimestampUs t_us = 0;
+};
+
+// Single producer, single consumer; a full ring drops the entry (counted by the caller).
+class LogRing {
+ public:
+  explicit LogRing(std::size_t capacity) : buf_(capacity + 1) {}
+  bool push(const CanFrame& f, TimestampUs t) {
+    const std::size_t h = head_.load(std::memory_order_relaxed);
+    const std::size_t next = (h + 1) % buf_.size();
+    if (next == tail_.load(std::memory_order_acquire)) return false;
+    buf_[h].frame = f;
+    buf_[h].t_us = t;
+    head_.store(next, std::memory_order_release);
+    return true;
+  }
+  bool pop(LogEntry& e) {
+    const std::size_t t = tail_.load(std::memory_order_relaxed);
+    if (t == head_.load(std::memory_order_acquire)) return false;
+    e = buf_[t];
+    tail_.store((t + 1) % buf_.size(), std::memory_order_release);
+    return true;
+  }
+
+ private:
+  std::vector<LogEntry> buf_;
+  std::atomic<std::size_t> head_{0}, tail_{0};
+};
+
+struct AtomicCounters {
+  std::atomic<std::uint64_t> frames_sent{0}, frames_received{0}, send_queue_full{0}, send_errors{0},
+      unknown_frames{0}, bad_frames{0}, unsupported_frames{0}, bus_error_frames{0},
+      receive_errors{0}, watchdog_block_frames{0}, faults{0}, log_dropped{0};
+};
+
+constexpr int kMaxDrainPerRead = 512;
+
+}  // namespace
+
+struct CanBackend::Impl {
+  Impl(Transport& t, const CanBackendOptions& o)
+      : transport(t), options(o), control_ring(o.log_capacity), watchdog_ring(o.log_capacity) {}
+
+  struct Joint {
+    JointMapping map;
+    double area_ratio = 0.0;  // A_B / A_A
+    std::int64_t cycle_us = 20000;
+    std::int64_t last_sent_us = 0;           // control thread
+    std::int64_t watchdog_last_sent_us = 0;  // watchdog thread
+    CanFrame block_frame;                    // preencoded
+    CanFrame command_frame;
+    bool seen = false;
+    TimestampUs last_position_us = 0;
+    double q = 0.0, qdot = 0.0, pa = 0.0, pb = 0.0;
+  };
+
+  Transport& transport;
+  CanBackendOptions options;
+  std::vector<Joint> joints;
+  std::int64_t start_us = mono_us();
+  std::atomic<std::int64_t> last_write_us{0};
+  std::atomic<double> fault_time_s{NAN};
+  bool block_sent_after_fault = false;
+  int consecutive_send_errors = 0;
+  AtomicCounters counters;
+  LogRing control_ring, watchdog_ring;
+  std::FILE* log_file = nullptr;
+  char reason_text[256] = {};
+  std::atomic<bool> stop{false};
+  std::thread watchdog, logger;
+  std::mutex stop_mutex;
+  Received rx;
+};
+
+CanBackend::CanBackend(const CanMapping& mapping, const dynamics::CraneModel& model,
+                       Transport& transport, const CanBackendOptions& options)
+    : impl_(std::make_unique<Impl>(transport, options)) {
+  if (static_cast<int>(mapping.joints.size()) != model.dof()) {
+    throw std::invalid_argument(mapping.source + ": the mapping has " +
+                                std::to_string(mapping.joints.size()) + " joints, the crane " +
+                                std::to_string(model.dof()));
+  }
+  for (int i = 0; i < model.dof(); ++i) {
+    const auto s = static_cast<std::size_t>(i);
+    const JointMapping& jm = mapping.joints[s];
+    if (!model.joints[s].name.empty() && jm.name != model.joints[s].name) {
+      throw std::invalid_argument(mapping.source + ": joint " + std::to_string(i + 1) + " is '" +
+                                  jm.name + "', the crane's is '" + model.joints[s].name + "'");
+    }
+    Impl::Joint j;
+    j.map = jm;
+    if (s < model.cylinders.size() && model.cylinders[s].area_a_m2 > 0.0) {
+      j.area_ratio = model.cylinders[s].area_b_m2 / model.cylinders[s].area_a_m2;
+    }
+    const double cycle = jm.valve.kind == ValveOutputKind::kIso11783Avc ? jm.valve.avc.cycle_s
+                                                                        : jm.valve.signal.cycle_s;
+    j.cycle_us = static_cast<std::int64_t>(std::llround(cycle * 1e6));
+    if (!encode_valve_block(jm.valve, j.block_frame)) {
+      throw std::invalid_argument(mapping.source + ": joint '" + jm.name +
+                                  "': its valve command cannot be encoded");
+    }
+    impl_->joints.push_back(std::move(j));
+  }
+  if (!options.candump_log.empty()) {
+    impl_->log_file = std::fopen(options.candump_log.c_str(), "w");
+    if (impl_->log_file == nullptr) {
+      throw std::runtime_error("cannot write the CAN log '" + options.candump_log + "'");
+    }
+  }
+  impl_->last_write_us.store(mono_us());
+  impl_->watchdog = std::thread([this] { watchdog_loop(); });
+  impl_->logger = std::thread([this] { log_loop(); });
+}
+
+CanBackend::~CanBackend() {
+  stop();
+}
+
+void CanBackend::stop() {
+  std::lock_guard<std::mutex> lock(impl_->stop_mutex);
+  impl_->stop.store(true);
+  if (impl_->watchdog.joinable()) impl_->watchdog.join();
+  if (impl_->logger.joinable()) impl_->logger.join();
+  if (impl_->log_file != nullptr) {
+    std::fclose(impl_->log_file);
+    impl_->log_file = nullptr;
+  }
+}
+
+void CanBackend::latch(FaultReason reason, const char* fmt, ...) {
+  int expected = kClear;
+  if (!fault_.compare_exchange_strong(expected, kLatching, std::memory_order_acq_rel)) return;
+  va_list args;
+  va_start(args, fmt);
+  std::vsnprintf(impl_->reason_text, sizeof impl_->reason_text, fmt, args);
+  va_end(args);
+  impl_->fault_time_s.store(static_cast<double>(mono_us() - impl_->start_us) * 1e-6);
+  reason_.store(reason, std::memory_order_release);
+  impl_->counters.faults.fetch_add(1, std::memory_order_relaxed);
+  fault_.store(kLatched, std::memory_order_release);
+}
+
+bool CanBackend::wait_for_feedback(double timeout_s, valves::MachineState& state) {
+  const std::int64_t end = mono_us() + static_cast<std::int64_t>(timeout_s * 1e6);
+  for (;;) {
+    read(state);
+    bool all = true;
+    for (const auto& j : impl_->joints) all = all && j.seen;
+    if (all) return true;
+    const std::int64_t left = end - mono_us();
+    if (left <= 0) return false;
+    impl_->transport.wait_readable(static_cast<int>(std::min<std::int64_t>(left / 1000 + 1, 10)));
+    impl_->last_write_us.store(mono_us(), std::memory_order_release);
+  }
+}
+
+void CanBackend::enable() {
+  // Deliberate: the fault is cleared and the feedback must be fresh again before the next
+  // read() reports valid.
+  impl_->last_write_us.store(0, std::memory_order_release);  // armed by the next write()
+  reason_.store(FaultReason::kNone, std::memory_order_release);
+  impl_->reason_text[0] = '\0';
+  impl_->fault_time_s.store(NAN);
+  impl_->block_sent_after_fault = false;
+  impl_->consecutive_send_errors = 0;
+  fault_.store(kClear, std::memory_order_release);
+  enabled_.store(true, std::memory_order_release);
+}
+
+std::string CanBackend::fault_text() const {
+  if (!faulted()) return {};
+  return impl_->reason_text;
+}
+
+double CanBackend::fault_time_s() const {
+  return impl_->fault_time_s.load();
+}
+
+CanBackendCounters CanBackend::counters() const {
+  const auto& c = impl_->counters;
+  CanBackendCounters out;
+  out.frames_sent = c.frames_sent.load();
+  out.frames_received = c.frames_received.load();
+  out.send_queue_full = c.send_queue_full.load();
+  out.send_errors = c.send_errors.load();
+  out.unknown_frames = c.unknown_frames.load();
+  out.bad_frames = c.bad_frames.load();
+  out.unsupported_frames = c.unsupported_frames.load();
+  out.bus_error_frames = c.bus_error_frames.load();
+  out.receive_errors = c.receive_errors.load();
+  out.watchdog_block_frames = c.watchdog_block_frames.load();
+  out.faults = c.faults.load();
+  out.log_dropped = c.log_dropped.load();
+  return out;
+}
+
+valves::BackendStatus CanBackend::read(valves::MachineState& state) {
+  Impl& m = *impl_;
+  const int n = static_cast<int>(m.joints.size());
+  for (int k = 0; k < kMaxDrainPerRead; ++k) {
+    m.transport.receive(m.rx);
+    if (m.rx.kind == ReceiveKind::kNone) break;
+    switch (m.rx.kind) {
+      case ReceiveKind::kError:
+        m.counters.receive_errors.fetch_add(1, std::memory_order_relaxed);
+        k = kMaxDrainPerRead;  // stop draining this cycle
+        continue;
+      case ReceiveKind::kUnsupported:
+        m.counters.unsupported_frames.fetch_add(1, std::memory_order_relaxed);
+        continue;
+      case ReceiveKind::kBusError:
+        m.counters.bus_error_frames.fetch_add(1, std::memory_order_relaxed);
+        if ((m.rx.bus_error & kBusOff) != 0) {
+          latch(FaultReason::kBusOff, "bus-off reported by the CAN controller on %s",
+                m.transport.interface_name());
+        } else if ((m.rx.bus_error & kErrorPassive) != 0) {
+          latch(FaultReason::kErrorPassive, "error-passive reported by the CAN controller on %s",
+                m.transport.interface_name());
+        }
+        continue;
+      default:
+        break;
+    }
+    const CanFrame& f = m.rx.frame;
+    m.counters.frames_received.fetch_add(1, std::memory_order_relaxed);
+    if (m.log_file != nullptr && !m.control_ring.push(f, m.rx.timestamp_us)) {
+      m.counters.log_dropped.fetch_add(1, std::memory_order_relaxed);
+    }
+    bool known = false;
+    for (auto& j : m.joints) {
+      auto matches = [&f](const SignalSpec& s) { return s.id == f.id && s.extended == f.extended; };
+      double value = 0.0;
+      if (matches(j.map.position)) {
+        known = true;
+        const auto st = decode(j.map.position, f, value);
+        if (st != SignalStatus::kOk) {
+          m.counters.bad_frames.fetch_add(1, std::memory_order_relaxed);
+          latch(FaultReason::kBadFeedbackFrame, "joint %s: position frame %X with dlc %u: %s",
+                j.map.name.c_str(), f.id, static_cast<unsigned>(f.dlc), to_string(st));
+          continue;
+        }
+        if (j.seen && m.rx.timestamp_us > j.last_position_us) {
+          const double dt = static_cast<double>(m.rx.timestamp_us - j.last_position_us) * 1e-6;
+          const double rate = (value - j.q) / dt;
+          const double a = dt / (m.options.velocity_filter_s + dt);
+          j.qdot += a * (rate - j.qdot);
+        }
+        j.q = value;
+        j.seen = true;
+        j.last_position_us = m.rx.timestamp_us;
+      }
+      for (int side = 0; side < 2; ++side) {
+        const auto& spec = side == 0 ? j.map.pressure_a : j.map.pressure_b;
+        if (!spec || !matches(*spec)) continue;
+        known = true;
+        const auto st = decode(*spec, f, value);
+        if (st != SignalStatus::kOk) {
+          m.counters.bad_frames.fetch_add(1, std::memory_order_relaxed);
+          latch(FaultReason::kBadFeedbackFrame, "joint %s: pressure frame %X with dlc %u: %s",
+                j.map.name.c_str(), f.id, static_cast<unsigned>(f.dlc), to_string(st));
+          continue;
+        }
+        (side == 0 ? j.pa : j.pb) = value;
+      }
+    }
+    if (!known) m.counters.unknown_frames.fetch_add(1, std::memory_order_relaxed);
+  }
+
+  const TimestampUs now = realtime_now_us();
+  const auto timeout_us = static_cast<TimestampUs>(m.options.feedback_timeout_s * 1e6);
+  bool fresh = true;
+  state.q.resize(n);
+  state.qdot.resize(n);
+  state.load_pressure_pa.resize(n);
+  for (int i = 0; i < n; ++i) {
+    auto& j = m.joints[static_cast<std::size_t>(i)];
+    const bool stale = !j.seen || now - j.last_position_us > timeout_us;
+    if (stale) {
+      fresh = false;
+      if (enabled() && j.seen) {
+        latch(FaultReason::kFeedbackLost, "joint %s: no position frame for %.0f ms",
+              j.map.name.c_str(), static_cast<double>(now - j.last_position_us) * 1e-3);
+      } else if (enabled()) {
+        latch(FaultReason::kFeedbackLost, "joint %s: no position frame yet", j.map.name.c_str());
+      }
+    }
+    state.q[i] = j.q;
+    state.qdot[i] = j.qdot;
+    state.load_pressure_pa[i] = j.pa - j.pb * j.area_ratio;
+  }
+  state.t_s = static_cast<double>(mono_us() - m.start_us) * 1e-6;
+  state.pump = valves::PumpMeasurement{};
+  state.valid = fresh && !faulted();
+  if (faulted()) return valves::BackendStatus::kFault;
+  return state.valid ? valves::BackendStatus::kOk : valves::BackendStatus::kNoData;
+}
+
+valves::BackendStatus CanBackend::write(const valves::ValveCommand& command) {
+  Impl& m = *impl_;
+  const std::int64_t now = mono_us();
+  m.last_write_us.store(now, std::memory_order_release);
+  const bool safe = faulted() || !enabled();
+  // The first cycle after a fault sends the block commands at once, whatever the cycle.
+  const bool force = faulted() && !m.block_sent_after_fault;
+  constexpr std::int64_t kEarlyUs = 3000;  // send up to 3 ms early rather than a period late
+  const TimestampUs now_rt = m.log_file != nullptr ? realtime_now_us() : 0;
+  for (std::size_t i = 0; i < m.joints.size(); ++i) {
+    auto& j = m.joints[i];
+    if (!force && now - j.last_sent_us < j.cycle_us - kEarlyUs) continue;
+    const double spool = safe || static_cast<Eigen::Index>(i) >= command.spool.size()
+                             ? 0.0
+                             : command.spool[static_cast<Eigen::Index>(i)];
+    const CanFrame* frame = &j.block_frame;
+    if (!safe && encode_valve_command(j.map.valve, spool, j.command_frame)) {
+      frame = &j.command_frame;
+    }
+    const SendStatus st = m.transport.send(*frame);
+    j.last_sent_us = now;
+    if (st == SendStatus::kOk) {
+      m.consecutive_send_errors = 0;
+      m.counters.frames_sent.fetch_add(1, std::memory_order_relaxed);
+      if (m.log_file != nullptr && !m.control_ring.push(*frame, now_rt)) {
+        m.counters.log_dropped.fetch_add(1, std::memory_order_relaxed);
+      }
+    } else {
+      (st == SendStatus::kQueueFull ? m.counters.send_queue_full : m.counters.send_errors)
+          .fetch_add(1, std::memory_order_relaxed);
+      if (++m.consecutive_send_errors >= m.options.max_send_errors && enabled()) {
+        latch(FaultReason::kSendError, "%d consecutive sends failed on %s (last: %s)",
+              m.consecutive_send_errors, m.transport.interface_name(), to_string(st));
+      }
+    }
+  }
+  if (force) m.block_sent_after_fault = true;
+  if (faulted()) return valves::BackendStatus::kFault;
+  return valves::BackendStatus::kOk;
+}
+
+void CanBackend::watchdog_loop() {
+  Impl& m = *impl_;
+  const auto period_ns = static_cast<long>(m.options.watchdog_period_s * 1e9);
+  const auto loop_timeout_us = static_cast<std::int64_t>(m.options.loop_timeout_s * 1e6);
+  timespec next{};
+  clock_gettime(CLOCK_MONOTONIC, &next);
+  while (!m.stop.load(std::memory_order_acquire)) {
+    next.tv_nsec += period_ns;
+    while (next.tv_nsec >= 1000000000L) {
+      next.tv_nsec -= 1000000000L;
+      ++next.tv_sec;
+    }
+    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+    const std::int64_t now = mono_us();
+    const std::int64_t last_write = m.last_write_us.load(std::memory_order_acquire);
+    if (last_write == 0) continue;  // enabled, no write() yet: not armed
+    const std::int64_t since_write = now - last_write;
+    if (since_write < loop_timeout_us) continue;
+    if (enabled() && !faulted()) {
+      latch(FaultReason::kLoopFrozen, "control loop frozen: write() not called for %.0f ms",
+            static_cast<double>(since_write) * 1e-3);
+    }
+    // The loop is not writing: the watchdog keeps the valves blocked itself, at each cycle.
+    const TimestampUs now_rt = realtime_now_us();
+    for (auto& j : m.joints) {
+      if (now - j.watchdog_last_sent_us < j.cycle_us - 2000) continue;
+      j.watchdog_last_sent_us = now;
+      if (m.transport.send(j.block_frame) == SendStatus::kOk) {
+        m.counters.frames_sent.fetch_add(1, std::memory_order_relaxed);
+        m.counters.watchdog_block_frames.fetch_add(1, std::memory_order_relaxed);
+        if (m.log_file != nullptr && !m.watchdog_ring.push(j.block_frame, now_rt)) {
+          m.counters.log_dropped.fetch_add(1, std::memory_order_relaxed);
+        }
+      } else {
+        m.counters.send_errors.fetch_add(1, std::memory_order_relaxed);
+      }
+    }
+  }
+}
+
+void CanBackend::log_loop() {
+  Impl& m = *impl_;
+  char line[kCandumpLineCapacity];
+  LogEntry e;
+  for (;;) {
+    const bool stopping = m.stop.load(std::memory_order_acquire);
+    if (m.log_file != nullptr) {
+      for (LogRing* ring : {&m.control_ring, &m.watchdog_ring}) {
+        while (ring->pop(e)) {
+          std::size_t written = 0;
+          if (format_candump(e.frame, e.t_us, m.transport.interface_name(), line, written) ==
+              CandumpStatus::kOk) {
+            std::fwrite(line, 1, written, m.log_file);
+            std::fputc('\n', m.log_file);
+          }
+        }
+      }
+      std::fflush(m.log_file);
+    }
+    if (stopping) break;
+    timespec ts{0, 20000000};
+    nanosleep(&ts, nullptr);
+  }
+}
+
+}  // namespace craneassist::can
