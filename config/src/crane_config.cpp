@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "craneassist/config/quantity.hpp"
+#include "craneassist/config/yaml_reader.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/inverse_kinematics.hpp"
 #include "craneassist/dynamics/valve_table.hpp"
@@ -19,38 +20,9 @@ namespace {
 constexpr const char* kFormat = "craneassist-crane/1";
 
 // Walks the YAML tree, converting and checking values; every failure names file, line, field.
-class Reader {
+class Reader : public YamlReader {
  public:
-  explicit Reader(std::string file) : file_(std::move(file)) {}
-
-  [[noreturn]] void fail(const YAML::Node& node, const std::string& field,
-                         const std::string& reason) const {
-    const int line = node.IsDefined() ? node.Mark().line + 1 : 0;
-    throw ConfigError(file_, line, field, reason);
-  }
-
-  // Rejects keys that are not in `allowed` (catches typos such as "bor:").
-  void check_keys(const YAML::Node& map, const std::string& path,
-                  std::initializer_list<const char*> allowed) const {
-    if (!map.IsMap()) fail(map, path, "expected a mapping of fields");
-    for (const auto& kv : map) {
-      const auto key = kv.first.as<std::string>();
-      bool ok = false;
-      std::string list;
-      for (const char* a : allowed) {
-        ok = ok || key == a;
-        list += list.empty() ? a : std::string(", ") + a;
-      }
-      if (!ok) fail(kv.first, join(path, key), "unknown field (expected one of: " + list + ")");
-    }
-  }
-
-  YAML::Node child(const YAML::Node& map, const std::string& key, const std::string& path) const {
-    if (!map.IsMap()) fail(map, path, "expected a mapping of fields");
-    YAML::Node node = map[key];
-    if (!node.IsDefined() || node.IsNull()) fail(map, join(path, key), "missing");
-    return node;
-  }
+  using YamlReader::YamlReader;
 
   std::string text(const YAML::Node& map, const std::string& key, const std::string& path) const {
     const YAML::Node node = child(map, key, path);
@@ -99,14 +71,9 @@ class Reader {
     fail(node, join(path, key), "expected true or false");
   }
 
-  static std::string join(const std::string& path, const std::string& key) {
-    return path.empty() ? key : path + "." + key;
-  }
-
   int unsourced() const { return unsourced_; }
 
  private:
-  std::string file_;
   int unsourced_ = 0;
 };
 

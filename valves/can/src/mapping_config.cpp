@@ -10,6 +10,7 @@
 
 #include "craneassist/config/config_error.hpp"
 #include "craneassist/config/quantity.hpp"
+#include "craneassist/config/yaml_reader.hpp"
 
 namespace craneassist::can {
 namespace {
@@ -20,37 +21,9 @@ using config::Dimension;
 // What a signal measures or commands; decides which units its `unit` may name.
 enum class SignalUse { kPosition, kPressure, kCommand };
 
-class Reader {
+class Reader : public config::YamlReader {
  public:
-  explicit Reader(std::string file) : file_(std::move(file)) {}
-
-  [[noreturn]] void fail(const YAML::Node& node, const std::string& field,
-                         const std::string& reason) const {
-    const int line = node.IsDefined() ? node.Mark().line + 1 : 0;
-    throw ConfigError(file_, line, field, reason);
-  }
-
-  void check_keys(const YAML::Node& map, const std::string& path,
-                  std::initializer_list<const char*> allowed) const {
-    if (!map.IsMap()) fail(map, path, "expected a mapping of fields");
-    for (const auto& kv : map) {
-      const auto key = kv.first.as<std::string>();
-      bool ok = false;
-      std::string list;
-      for (const char* a : allowed) {
-        ok = ok || key == a;
-        list += list.empty() ? a : std::string(", ") + a;
-      }
-      if (!ok) fail(kv.first, join(path, key), "unknown field (expected one of: " + list + ")");
-    }
-  }
-
-  YAML::Node child(const YAML::Node& map, const std::string& key, const std::string& path) const {
-    if (!map.IsMap()) fail(map, path, "expected a mapping of fields");
-    YAML::Node node = map[key];
-    if (!node.IsDefined() || node.IsNull()) fail(map, join(path, key), "missing");
-    return node;
-  }
+  using YamlReader::YamlReader;
 
   std::string text(const YAML::Node& node, const std::string& field) const {
     if (!node.IsScalar()) fail(node, field, "expected a single value");
@@ -109,15 +82,6 @@ class Reader {
     if (!(v >= lo && v <= hi)) fail(node, field, "must be " + range_text);
     return v;
   }
-
-  static std::string join(const std::string& path, const std::string& key) {
-    return path.empty() ? key : path + "." + key;
-  }
-
-  const std::string& file() const { return file_; }
-
- private:
-  std::string file_;
 };
 
 // SI factor of a unit as the mapping file writes it; false if the unit does not suit the use.

@@ -1,0 +1,59 @@
+// The checks every craneassist YAML file shares (crane configs, CAN mappings): fail with file,
+// line and field; reject unknown keys; require a child. Readers of a file format derive from it
+// and add their own value conversions. Needs yaml-cpp in the including target.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <initializer_list>
+#include <string>
+#include <utility>
+
+#include "craneassist/config/config_error.hpp"
+
+namespace craneassist::config {
+
+class YamlReader {
+ public:
+  explicit YamlReader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& field,
+                         const std::string& reason) const {
+    const int line = node.IsDefined() ? node.Mark().line + 1 : 0;
+    throw ConfigError(file_, line, field, reason);
+  }
+
+  // Rejects keys that are not in `allowed` (catches typos such as "bor:").
+  void check_keys(const YAML::Node& map, const std::string& path,
+                  std::initializer_list<const char*> allowed) const {
+    if (!map.IsMap()) fail(map, path, "expected a mapping of fields");
+    for (const auto& kv : map) {
+      const auto key = kv.first.as<std::string>();
+      bool ok = false;
+      std::string list;
+      for (const char* a : allowed) {
+        ok = ok || key == a;
+        list += list.empty() ? a : std::string(", ") + a;
+      }
+      if (!ok) fail(kv.first, join(path, key), "unknown field (expected one of: " + list + ")");
+    }
+  }
+
+  YAML::Node child(const YAML::Node& map, const std::string& key, const std::string& path) const {
+    if (!map.IsMap()) fail(map, path, "expected a mapping of fields");
+    YAML::Node node = map[key];
+    if (!node.IsDefined() || node.IsNull()) fail(map, join(path, key), "missing");
+    return node;
+  }
+
+  static std::string join(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+  }
+
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+};
+
+}  // namespace craneassist::config
