@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "craneassist/can/can_backend.hpp"
+#include "craneassist/can/heartbeat.hpp"
 #include "craneassist/can/valve_frames.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "fake_can_bus.hpp"
@@ -118,10 +119,13 @@ TEST(CanBackend, DecodesFeedbackInSiAndDisabledSendsBlock) {
   r.bus.clear_log();
   valves::ValveCommand cmd;
   cmd.spool = dynamics::JointVector::Constant(4, 0.5);
-  backend.write(cmd);  // not enabled yet: block
+  backend.write(cmd);  // not enabled yet: block, and the heartbeat says disabled
   auto log = r.bus.log();
-  ASSERT_EQ(log.size(), 4u);
+  ASSERT_EQ(log.size(), 5u);
   for (std::size_t j = 0; j < 4; ++j) EXPECT_TRUE(is_block(r.map.joints[j], log[j].frame)) << j;
+  Heartbeat hb;
+  ASSERT_TRUE(decode_heartbeat(*r.map.heartbeat, log[4].frame, hb));
+  EXPECT_EQ(hb.state, HeartbeatState::kDisabled);
   EXPECT_FALSE(backend.faulted());
 }
 
@@ -233,8 +237,216 @@ TEST(CanBackend, WatchdogBlocksEverySectionWhenTheLoopFreezes) {
   ASSERT_NE(all_blocked, 0);
   EXPECT_LT(all_blocked - frozen_at, 100000 + 20000);  // loop timeout + one watchdog step
   EXPECT_GT(backend.counters().watchdog_block_frames, 4u);
+  // The heartbeat comes from the control loop only: a frozen loop stops it, so the machine's
+  // supervisor sees the loss even if it missed the block commands.
+  for (const auto& rx : log) EXPECT_FALSE(is_heartbeat_frame(*r.map.heartbeat, rx.frame));
   std::printf("frozen loop: every section blocked %.1f ms after the last write()\n",
               static_cast<double>(all_blocked - frozen_at) * 1e-3);
+}
+
+// Collects the heartbeats on the bus.
+std::vector<Heartbeat> heartbeats(FakeCanBus& bus, const HeartbeatSpec& spec) {
+  std::vector<Heartbeat> out;
+  for (const auto& rx : bus.log()) {
+    Heartbeat hb;
+    if (decode_heartbeat(spec, rx.frame, hb)) out.push_back(hb);
+  }
+  return out;
+}
+
+TEST(CanBackend, HeartbeatCountsUpAtItsCycleAndReportsTheState) {
+  Rig r;
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  valves::MachineState state;
+  valves::ValveCommand cmd;
+  cmd.spool = dynamics::JointVector::Constant(4, 0.3);
+  send_feedback(r.sensors, r.map, r.q);
+  backend.read(state);
+  backend.enable();
+  r.bus.clear_log();
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 0; k < 20; ++k) {  // 200 ms at 100 Hz; heartbeat cycle 20 ms
+    send_feedback(r.sensors, r.map, r.q);
+    backend.read(state);
+    backend.write(cmd);
+    std::this_thread::sleep_until(t0 + (k + 1) * 10ms);
+  }
+  auto hbs = heartbeats(r.bus, *r.map.heartbeat);
+  ASSERT_GE(hbs.size(), 9u);
+  ASSERT_LE(hbs.size(), 11u);
+  for (std::size_t i = 1; i < hbs.size(); ++i) {
+    EXPECT_EQ(hbs[i].counter, static_cast<std::uint8_t>(hbs[i - 1].counter + 1));
+    EXPECT_EQ(hbs[i].state, HeartbeatState::kEnabled);
+  }
+  EXPECT_EQ(backend.counters().heartbeats_sent, hbs.size());
+
+  // Feedback stops: the fault latches and the heartbeat carries it, with its reason.
+  r.bus.clear_log();
+  for (int k = 0; k < 12; ++k) {
+    backend.read(state);
+    backend.write(cmd);
+    std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_TRUE(backend.faulted());
+  hbs = heartbeats(r.bus, *r.map.heartbeat);
+  ASSERT_FALSE(hbs.empty());
+  EXPECT_EQ(hbs.back().state, HeartbeatState::kFault);
+  EXPECT_EQ(hbs.back().reason, static_cast<std::uint8_t>(FaultReason::kFeedbackLost));
+}
+
+TEST(CanBackend, DisableBlocksEverySectionAtOnceWithoutAFault) {
+  Rig r;
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  valves::MachineState state;
+  valves::ValveCommand cmd;
+  cmd.spool = dynamics::JointVector::Constant(4, 0.5);
+  send_feedback(r.sensors, r.map, r.q);
+  backend.read(state);
+  backend.enable();
+  backend.write(cmd);
+  r.bus.clear_log();
+  backend.disable();  // the normal end of a run, 0 ms after the last write
+  auto log = r.bus.log();
+  ASSERT_EQ(log.size(), 5u);
+  for (std::size_t j = 0; j < 4; ++j) EXPECT_TRUE(is_block(r.map.joints[j], log[j].frame)) << j;
+  Heartbeat hb;
+  ASSERT_TRUE(decode_heartbeat(*r.map.heartbeat, log[4].frame, hb));
+  EXPECT_EQ(hb.state, HeartbeatState::kDisabled);
+  EXPECT_FALSE(backend.enabled());
+  // No more writes: not a frozen loop (no fault), but the watchdog keeps every section blocked.
+  r.bus.clear_log();
+  std::this_thread::sleep_for(150ms);
+  EXPECT_FALSE(backend.faulted());
+  log = r.bus.log();
+  int blocks = 0;
+  for (const auto& rx : log) {
+    for (const auto& j : r.map.joints) {
+      if (is_valve_frame(j.valve, rx.frame)) {
+        EXPECT_TRUE(is_block(j, rx.frame));
+        ++blocks;
+      }
+    }
+  }
+  EXPECT_GE(blocks, 4 * 5);  // each section at its 20 ms cycle
+  // Writes after disable() send block too.
+  r.bus.clear_log();
+  std::this_thread::sleep_for(25ms);
+  backend.write(cmd);
+  for (const auto& rx : r.bus.log()) {
+    for (const auto& j : r.map.joints) {
+      if (is_valve_frame(j.valve, rx.frame)) {
+        EXPECT_TRUE(is_block(j, rx.frame));
+      }
+    }
+  }
+}
+
+TEST(CanBackend, RejectsAMappingThatDoesNotFitTheCrane) {
+  Rig r;
+  auto expect_rejected = [&](const CanMapping& map, const std::string& part) {
+    try {
+      CanBackend backend(map, r.cfg.model, r.backend_end);
+      ADD_FAILURE() << "accepted; expected: " << part;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+    }
+  };
+  CanMapping swapped = r.map;  // the extension's length sensor on the slew
+  std::swap(swapped.joints[0].position, swapped.joints[3].position);
+  std::swap(swapped.joints[0].position_kind, swapped.joints[3].position_kind);
+  expect_rejected(swapped, "joint 'slew': the crane's joint is revolute");
+  CanMapping narrow = r.map;  // the lift encoder's range ends inside the joint range
+  narrow.joints[1].position.maximum = r.cfg.model.joints[1].q_max - 0.1;
+  expect_rejected(narrow, "joint 'lift': the position signal's min/max do not cover");
+  CanMapping renamed = r.map;
+  renamed.joints[2].name = "boom";
+  expect_rejected(renamed, "joint 3 is 'boom'");
+}
+
+TEST(CanBackend, PumpPressureAndFlowFromTheBus) {
+  Rig r;
+  ASSERT_TRUE(r.map.pump.pressure && r.map.pump.flow);
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  valves::MachineState state;
+  send_feedback(r.sensors, r.map, r.q);
+  backend.read(state);
+  EXPECT_EQ(state.pump.flow_m3_s, 0.0);  // no pump frame yet: unmeasured
+  CanFrame f;
+  f.id = r.map.pump.pressure->id;
+  f.dlc = 4;
+  ASSERT_EQ(encode(*r.map.pump.pressure, 180e5, f), SignalStatus::kOk);     // 180 bar
+  ASSERT_EQ(encode(*r.map.pump.flow, 90e-3 / 60.0, f), SignalStatus::kOk);  // 90 L/min
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 0; k < 10; ++k) {
+    send_feedback(r.sensors, r.map, r.q);
+    r.sensors.send(f);
+    backend.read(state);
+    std::this_thread::sleep_until(t0 + (k + 1) * 10ms);
+  }
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_NEAR(state.pump.pressure_pa, 180e5, 1e3);
+  EXPECT_NEAR(state.pump.flow_m3_s, 1.5e-3, 1e-6);
+  EXPECT_NEAR(state.pump.power_w, 27e3, 30.0);
+  // Integrated between reads: about 27 kW over the 9 intervals after the first measured read.
+  EXPECT_GT(state.pump.energy_j, 27e3 * 0.07);
+  EXPECT_LT(state.pump.energy_j, 27e3 * elapsed);
+  // The pump frames stop: unmeasured again after the feedback timeout, the energy is kept.
+  const double energy = state.pump.energy_j;
+  std::this_thread::sleep_for(60ms);
+  send_feedback(r.sensors, r.map, r.q);
+  backend.read(state);
+  EXPECT_EQ(state.pump.flow_m3_s, 0.0);
+  EXPECT_EQ(state.pump.energy_j, energy);
+  EXPECT_FALSE(backend.faulted());  // informational, never a fault
+}
+
+TEST(HeartbeatMonitor, AliveOnlyWhileTheCounterAdvancesInStateEnabled) {
+  const HeartbeatSpec spec{0x18FF0080, true, 0.02, 0.1};
+  HeartbeatMonitor mon(spec);
+  CanFrame f;
+  Heartbeat hb;
+  hb.state = HeartbeatState::kEnabled;
+  hb.counter = 254;
+  auto feed = [&](double t) {
+    encode_heartbeat(spec, hb, f);
+    EXPECT_TRUE(mon.on_frame(f, t));
+    ++hb.counter;
+  };
+  EXPECT_FALSE(mon.alive(0.0));
+  feed(0.00);  // the first message alone proves nothing
+  EXPECT_FALSE(mon.alive(0.00));
+  feed(0.02);  // 254 -> 255
+  EXPECT_TRUE(mon.alive(0.02));
+  feed(0.04);  // 255 -> 0 wraps
+  EXPECT_TRUE(mon.alive(0.10));
+  EXPECT_TRUE(mon.alive(0.13));
+  EXPECT_FALSE(mon.alive(0.15));  // 110 ms after the last advancing message
+  EXPECT_EQ(mon.losses(), 1u);
+  // A repeated counter (a stuck sender) does not refresh.
+  hb.counter = static_cast<std::uint8_t>(hb.counter - 1);
+  feed(0.16);
+  EXPECT_FALSE(mon.alive(0.16));
+  EXPECT_EQ(mon.sequence_errors(), 1u);
+  feed(0.18);
+  EXPECT_TRUE(mon.alive(0.18));
+  // The sender reports disabled or a fault: not alive at once.
+  hb.state = HeartbeatState::kFault;
+  feed(0.19);
+  EXPECT_FALSE(mon.alive(0.19));
+  EXPECT_EQ(mon.last().state, HeartbeatState::kFault);
+  // Other frames are not the heartbeat; a short or unknown-state frame is malformed.
+  CanFrame other;
+  other.id = 0x18FF0081;
+  other.extended = true;
+  EXPECT_FALSE(mon.on_frame(other, 0.2));
+  encode_heartbeat(spec, hb, f);
+  f.data[1] = 7;
+  EXPECT_TRUE(mon.on_frame(f, 0.2));
+  f.dlc = 2;
+  EXPECT_TRUE(mon.on_frame(f, 0.2));
+  EXPECT_EQ(mon.malformed(), 2u);
+  EXPECT_EQ(mon.messages(), 6u);
 }
 
 TEST(CanBackend, WrongDlcOnFeedbackLatchesAndUnknownFramesAreOnlyCounted) {
@@ -295,10 +507,10 @@ TEST(CanBackend, ConsecutiveSendErrorsLatch) {
   backend.read(state);
   backend.enable();
   r.backend_end.next_send_status = SendStatus::kQueueFull;
-  backend.write(cmd);  // 4 sections, 4 failed sends, no waiting
+  backend.write(cmd);  // 4 sections and the heartbeat, 5 failed sends, no waiting
   EXPECT_TRUE(backend.faulted());
   EXPECT_EQ(backend.fault_reason(), FaultReason::kSendError);
-  EXPECT_EQ(backend.counters().send_queue_full, 4u);
+  EXPECT_EQ(backend.counters().send_queue_full, 5u);
 }
 
 TEST(CanBackend, CandumpLogHoldsSentAndReceivedFrames) {
@@ -324,7 +536,7 @@ TEST(CanBackend, CandumpLogHoldsSentAndReceivedFrames) {
     EXPECT_EQ(rec.iface, "fake0");
     ++lines;
   }
-  EXPECT_EQ(lines, 8);  // 4 positions received, 4 commands sent
+  EXPECT_EQ(lines, 9);  // 4 positions received, 4 commands and the heartbeat sent
 }
 
 }  // namespace

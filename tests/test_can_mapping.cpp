@@ -192,6 +192,83 @@ TEST(CanMapping, ErrorsNameFileLineAndField) {
   }
 }
 
+TEST(CanMapping, Heartbeat) {
+  const CanMapping shipped = load_can_mapping(kExample);
+  ASSERT_TRUE(shipped.heartbeat.has_value());
+  EXPECT_EQ(shipped.heartbeat->id, 0x18FF0080u);
+  EXPECT_TRUE(shipped.heartbeat->extended);
+  EXPECT_DOUBLE_EQ(shipped.heartbeat->cycle_s, 0.02);
+  EXPECT_DOUBLE_EQ(shipped.heartbeat->timeout_s, 0.1);
+  EXPECT_FALSE(parse_can_mapping(file_with(kValve + kPosition), "m.yaml").heartbeat.has_value());
+
+  const std::string head = "format: craneassist-can-map/1\nheartbeat: ";
+  const std::string joints = "\njoints:\n  - name: slew\n" + kValve + kPosition;
+  struct Case {
+    std::string heartbeat;
+    std::string field;
+    std::string reason_part;
+  };
+  const Case cases[] = {
+      {"{id: 0x18FF0080, cycle: 20 ms, timeout: 30 ms}", "heartbeat.timeout", "two cycles"},
+      {"{id: 0x18FF0080, cycle: 0 ms, timeout: 100 ms}", "heartbeat.cycle", "between 1 ms"},
+      {"{id: 0x18FF0080, cycle: 20 ms}", "heartbeat.timeout", "missing"},
+      {"{id: 0x800, extended: false, cycle: 20 ms, timeout: 100 ms}", "heartbeat.id",
+       "at most 2047"},
+      {"{id: 0x18FF0080, cycle: 20 ms, timeout: 100 ms, rate: 3}", "heartbeat.rate",
+       "unknown field"},
+      // The slew encoder's identifier: a received frame cannot also be sent.
+      {"{id: 0x18FF1021, cycle: 20 ms, timeout: 100 ms}", "heartbeat", "other direction"},
+      // The slew valve's AVC identifier (PGN 65072 from 0x80, priority 3).
+      {"{id: 0x0CFE3080, cycle: 20 ms, timeout: 100 ms}", "heartbeat.id", "valve command"},
+  };
+  for (const auto& c : cases) {
+    const ConfigError e = error_of(head + c.heartbeat + joints);
+    EXPECT_EQ(e.field(), c.field) << c.heartbeat;
+    EXPECT_NE(std::string(e.what()).find(c.reason_part), std::string::npos)
+        << c.heartbeat << ": " << e.what();
+    EXPECT_EQ(e.line(), 2) << c.heartbeat;
+  }
+}
+
+TEST(CanMapping, PumpSignals) {
+  const CanMapping m = load_can_mapping(kExample);
+  ASSERT_TRUE(m.pump.pressure.has_value());
+  ASSERT_TRUE(m.pump.flow.has_value());
+  EXPECT_NEAR(m.pump.pressure->scale, 0.01 * 1e5, 1e-9);       // 0.01 bar/bit in Pa
+  EXPECT_NEAR(m.pump.flow->scale, 0.01 * 1e-3 / 60.0, 1e-15);  // 0.01 L/min/bit in m^3/s
+  const std::string joints = "joints:\n  - name: slew\n" + kValve + kPosition;
+  auto e = error_of(
+      "format: craneassist-can-map/1\npump:\n  flow: {id: 0x310, start_bit: 0, "
+      "length: 16, byte_order: intel, scale: 1, unit: bar}\n" +
+      joints);
+  EXPECT_EQ(e.field(), "pump.flow.unit");
+  EXPECT_NE(std::string(e.what()).find("volume flow"), std::string::npos) << e.what();
+  e = error_of("format: craneassist-can-map/1\npump: {speed: 1}\n" + joints);
+  EXPECT_EQ(e.field(), "pump.speed");
+  // Sharing the slew encoder's frame is fine on free bits, not on the encoder's.
+  e = error_of(
+      "format: craneassist-can-map/1\npump:\n  pressure: {id: 0x18FF1021, extended: "
+      "true, start_bit: 8, length: 16, byte_order: intel, scale: 1, unit: bar}\n" +
+      joints);
+  EXPECT_EQ(e.field(), "pump.pressure");
+  EXPECT_NE(std::string(e.what()).find("overlaps"), std::string::npos) << e.what();
+}
+
+TEST(CanMapping, IsobusValveGroupExampleLoads) {
+  const CanMapping m = load_can_mapping(std::string(CRANEASSIST_SOURCE_DIR) +
+                                        "/config/can/pvg32_isobus_example.yaml");
+  ASSERT_EQ(m.joints.size(), 4u);
+  const char* names[] = {"slew", "lift", "tilt", "extension"};
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(m.joints[i].name, names[i]);
+    ASSERT_EQ(m.joints[i].valve.kind, ValveOutputKind::kIso11783Avc);
+    EXPECT_EQ(m.joints[i].valve.avc.valve, i + 1);  // valve 0 is power beyond
+    EXPECT_EQ(m.joints[i].valve.avc.fail_safe, iso11783::FailSafeMode::kBlock);
+  }
+  EXPECT_FALSE(m.joints[0].pressure_a.has_value());
+  ASSERT_TRUE(m.heartbeat.has_value());
+}
+
 TEST(CanMapping, MissingFile) {
   try {
     load_can_mapping("/nonexistent/map.yaml");

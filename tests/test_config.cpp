@@ -238,3 +238,35 @@ TEST(CraneConfig, PayloadMassCanBeSet) {
   EXPECT_DOUBLE_EQ(cfg.model.bodies.back().mass_kg, 650.0);
   EXPECT_THROW(craneassist::config::set_payload_mass(cfg.model, -1.0), std::invalid_argument);
 }
+
+TEST(CraneConfig, BackendAndCanSettings) {
+  using craneassist::config::BackendKind;
+  const auto shipped = craneassist::config::load_crane_config(kK70mPath);
+  EXPECT_EQ(shipped.backend.kind, BackendKind::kSim);
+  EXPECT_EQ(shipped.backend.can.interface, "can0");
+  EXPECT_TRUE(shipped.backend.can.mapping.empty());  // the embedded K70M mapping
+  EXPECT_DOUBLE_EQ(shipped.backend.can.feedback_timeout_s, 0.05);
+
+  const auto can = config_after_edit("backend: sim", "backend: can");
+  EXPECT_EQ(can.backend.kind, BackendKind::kCan);
+  // A relative mapping path is resolved against the config file's folder.
+  std::string text = read_file(kK70mPath);
+  text.replace(text.find("  # mapping:"), 12, "  mapping:");
+  const auto mapped = craneassist::config::parse_crane_config(text, "/etc/crane/k70m.yaml");
+  EXPECT_EQ(mapped.backend.can.mapping, "/etc/crane/../can/k70m_can.yaml");
+
+  // Both may be left out: sim.
+  text = read_file(kK70mPath);
+  text.erase(text.find("backend: sim"));
+  EXPECT_EQ(craneassist::config::parse_crane_config(text, "bare.yaml").backend.kind,
+            BackendKind::kSim);
+
+  const auto bad = error_after_edit("backend: sim", "backend: ros");
+  EXPECT_EQ(bad.field(), "backend");
+  EXPECT_EQ(bad.line(), line_of("backend: sim"));
+  EXPECT_NE(bad.reason().find("expected sim or can"), std::string::npos) << bad.reason();
+  EXPECT_EQ(error_after_edit("interface: can0", "interface: can0/x").field(), "can.interface");
+  EXPECT_EQ(error_after_edit("feedback_timeout: 50 ms", "feedback_timeout: 5 s").field(),
+            "can.feedback_timeout");
+  EXPECT_EQ(error_after_edit("interface: can0", "iface: can0").field(), "can.iface");
+}

@@ -424,5 +424,74 @@ TEST(ReplayWrite, RoundTripIsBitExact) {
   }
 }
 
+// ---- the stop column ---------------------------------------------------------------------------
+
+TEST(ReplayStopColumn, StopRowsGiveANonFiniteCommandAndOthersTheirVelocity) {
+  const Replay r = Replay::parse(
+      "t,v_x,v_y,v_z,stop\n0,0.3,0,0,0\n1,0,0,0,1\n1.5, 0, -0, 0 , 0\n2,0,0.2,0,0\n", "stop.csv");
+  ASSERT_EQ(r.rows().size(), 4u);
+  EXPECT_FALSE(r.rows()[0].stop);
+  EXPECT_TRUE(r.rows()[1].stop);
+  EXPECT_FALSE(r.rows()[2].stop);
+  ReplayCursor c(r);
+  expect_vec(c.command_at(0.5), 0.3, 0, 0);
+  const Eigen::Vector3d stop = c.command_at(1.0);
+  EXPECT_TRUE(std::isnan(stop.x()) && std::isnan(stop.y()) && std::isnan(stop.z()));
+  EXPECT_TRUE(c.command_at(1.49).hasNaN());
+  expect_vec(c.command_at(1.5), 0, 0, 0);
+  expect_vec(c.command_at(3.0), 0, 0.2, 0);
+  EXPECT_TRUE(c.command_at(1.2).hasNaN());  // going back
+  // A replay ending in a stop row holds the stop.
+  const Replay end = Replay::parse("t,v_x,v_y,v_z,stop\n0,0.1,0,0,0\n1,0,0,0,1\n", "end.csv");
+  ReplayCursor e(end);
+  EXPECT_TRUE(e.command_at(100.0).hasNaN());
+}
+
+TEST(ReplayStopColumn, StrictErrorsNameTheStopField) {
+  const std::string h = "t,v_x,v_y,v_z,stop\n";
+  expect_rejected(h + "0,0,0,0,2\n", 2, "stop", "expected 0 or 1, got '2'");
+  expect_rejected(h + "0,0,0,0,yes\n", 2, "stop", "expected 0 or 1, got 'yes'");
+  expect_rejected(h + "0,0,0,0,1.0\n", 2, "stop", "expected 0 or 1, got '1.0'");
+  expect_rejected(h + "0,0,0,0,\n", 2, "stop", "missing value");
+  expect_rejected(h + "0,0,0,0\n", 2, "", "expected 5 fields (t,v_x,v_y,v_z,stop), got 4");
+  expect_rejected(h + "0,0,0,0,0,1\n", 2, "", "expected 5 fields");
+  expect_rejected(h + "0,0,0.1,0,1\n", 2, "v_y", "must be 0 in a stop row (stop = 1), got '0.1'");
+  expect_rejected("t,v_x,v_y,v_z,Stop\n", 1, "",
+                  "expected the header 't,v_x,v_y,v_z' or 't,v_x,v_y,v_z,stop', got "
+                  "'t,v_x,v_y,v_z,Stop'");
+  expect_rejected("t,v_x,v_y,v_z\n0,0,0,0,1\n", 2, "", "expected 4 fields (t,v_x,v_y,v_z), got 5");
+  const ReplayError e = parse_error(h + "0,0,0,0,0\n1,0,0,0,x\n");
+  EXPECT_EQ(std::string(e.what()), "bad_replay.csv:3: field 'stop': expected 0 or 1, got 'x'");
+}
+
+TEST(ReplayStopColumn, WrittenOnlyWhenARowStopsAndRoundTrips) {
+  std::vector<ReplayRow> rows = {{0.0, Eigen::Vector3d(0.1, 0, 0)},
+                                 {0.5, Eigen::Vector3d::Zero(), true},
+                                 {1.25, Eigen::Vector3d(0, 0.2, -0.1)}};
+  std::ostringstream out;
+  write_replay(out, rows);
+  EXPECT_EQ(out.str(), "t,v_x,v_y,v_z,stop\n0,0.1,0,0,0\n0.5,0,0,0,1\n1.25,0,0.2,-0.1,0\n");
+  const Replay r = Replay::parse(out.str(), "rt.csv");
+  ASSERT_EQ(r.rows().size(), 3u);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(r.rows()[i].t_s, rows[i].t_s);
+    EXPECT_EQ(r.rows()[i].v_m_s, rows[i].v_m_s);
+    EXPECT_EQ(r.rows()[i].stop, rows[i].stop);
+  }
+  // Without a stop row: the 4-column form, and an old file round-trips byte for byte.
+  const std::string old = "t,v_x,v_y,v_z\n0,0.1,-0.25,0\n1.5,0,0,0\n";
+  std::ostringstream again;
+  write_replay(again, Replay::parse(old, "old.csv").rows());
+  EXPECT_EQ(again.str(), old);
+}
+
+TEST(ReplayStopColumn, ShippedDropoutReplayHasStopRows) {
+  const Replay r = Replay::load_file(fs::path(CRANEASSIST_SOURCE_DIR) / "examples" / "replays" /
+                                     "input_dropout.csv");
+  int stops = 0;
+  for (const ReplayRow& row : r.rows()) stops += row.stop;
+  EXPECT_GE(stops, 1);
+}
+
 }  // namespace
 }  // namespace craneassist::input

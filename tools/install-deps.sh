@@ -8,6 +8,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib
   qemu-system-x86 busybox-static can-utils cpio  # the SocketCAN test VM (tools/can-vm/)
+  libevdev-dev libsdl2-dev tmux  # joysticks; tmux drives the keyboard joystick in tests
+  libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools openssl  # DDS telemetry and security
 )
 
 missing=()

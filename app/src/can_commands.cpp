@@ -8,9 +8,11 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <optional>
 #include <vector>
 
 #include "craneassist/app/embedded_replays.hpp"
+#include "craneassist/can/heartbeat.hpp"
 #include "craneassist/can/valve_frames.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
@@ -48,8 +50,8 @@ void CanMachine::report() const {
   const auto c = backend_->counters();
   std::printf(
       "  CAN %s: sent %llu, received %llu, unknown %llu, bad %llu, unsupported %llu, bus errors "
-      "%llu, send queue full %llu, send errors %llu, watchdog block frames %llu, log dropped "
-      "%llu\n",
+      "%llu, send queue full %llu, send errors %llu, watchdog block frames %llu, heartbeats %llu, "
+      "log dropped %llu\n",
       "counters", static_cast<unsigned long long>(c.frames_sent),
       static_cast<unsigned long long>(c.frames_received),
       static_cast<unsigned long long>(c.unknown_frames),
@@ -59,6 +61,7 @@ void CanMachine::report() const {
       static_cast<unsigned long long>(c.send_queue_full),
       static_cast<unsigned long long>(c.send_errors),
       static_cast<unsigned long long>(c.watchdog_block_frames),
+      static_cast<unsigned long long>(c.heartbeats_sent),
       static_cast<unsigned long long>(c.log_dropped));
   if (backend_->faulted()) {
     std::printf("  CAN FAULT (%s) at %.3f s: %s\n", can::to_string(backend_->fault_reason()),
@@ -88,7 +91,7 @@ std::int64_t mono_ns() {
 struct FeedbackSignal {
   std::size_t frame = 0;
   int joint = 0;
-  int kind = 0;  // 0 position, 1 pressure a, 2 pressure b
+  int kind = 0;  // 0 position, 1 pressure a, 2 pressure b, 3 pump pressure, 4 pump flow
   const can::SignalSpec* spec = nullptr;
 };
 
@@ -155,6 +158,8 @@ int run_emulate_command(const EmulateArgs& args) {
       if (jm.pressure_a) add(j, 1, *jm.pressure_a);
       if (jm.pressure_b) add(j, 2, *jm.pressure_b);
     }
+    if (mapping.pump.pressure) add(0, 3, *mapping.pump.pressure);
+    if (mapping.pump.flow) add(0, 4, *mapping.pump.flow);
     std::signal(SIGTERM, on_signal);
     std::signal(SIGINT, on_signal);
 
@@ -163,6 +168,9 @@ int run_emulate_command(const EmulateArgs& args) {
     std::vector<std::int64_t> last_command_ns(static_cast<std::size_t>(n), 0);
     valves::MachineState state;
     can::Received rx;
+    std::optional<can::HeartbeatMonitor> heartbeat;
+    if (mapping.heartbeat) heartbeat.emplace(*mapping.heartbeat);
+    bool heartbeat_ok = false;
     unsigned long long commands = 0, bad = 0, other = 0, sent = 0, send_failed = 0, behind = 0;
     const double step = cfg.simulation.step_s;
     const auto step_ns = static_cast<std::int64_t>(std::llround(step * 1e9));
@@ -185,6 +193,7 @@ int run_emulate_command(const EmulateArgs& args) {
           ++other;
           continue;
         }
+        if (heartbeat && heartbeat->on_frame(rx.frame, static_cast<double>(now) * 1e-9)) continue;
         bool mine = false;
         for (int j = 0; j < n; ++j) {
           const auto& valve = mapping.joints[static_cast<std::size_t>(j)].valve;
@@ -202,9 +211,17 @@ int run_emulate_command(const EmulateArgs& args) {
         }
         if (!mine) ++other;
       }
-      // A section whose commands stop falls back to neutral (the valve's own fail-safe).
+      // A section whose commands stop falls back to neutral (the valve's own fail-safe); without
+      // a live heartbeat (when the mapping has one) every section does (the machine's supervisor).
+      const bool alive = !heartbeat || heartbeat->alive(static_cast<double>(now) * 1e-9);
+      if (heartbeat && alive != heartbeat_ok) {
+        std::printf("craneassist emulate: %.3f s: heartbeat %s\n", static_cast<double>(now) * 1e-9,
+                    alive ? "alive, sections enabled" : "lost or disabled, every section blocked");
+        std::fflush(stdout);
+        heartbeat_ok = alive;
+      }
       for (int j = 0; j < n; ++j) {
-        if (now - last_command_ns[static_cast<std::size_t>(j)] > command_timeout_ns) {
+        if (!alive || now - last_command_ns[static_cast<std::size_t>(j)] > command_timeout_ns) {
           command.spool[j] = 0.0;
         }
       }
@@ -232,6 +249,8 @@ int run_emulate_command(const EmulateArgs& args) {
           if (s.kind == 2) {
             value = cyl.area_b_m2 > 0.0 ? std::max(-lp, 0.0) * cyl.area_a_m2 / cyl.area_b_m2 : 0.0;
           }
+          if (s.kind == 3) value = state.pump.pressure_pa;
+          if (s.kind == 4) value = state.pump.flow_m3_s;
           can::encode(*s.spec, value, frames[s.frame]);
         }
         for (const auto& f : frames) {
@@ -251,6 +270,15 @@ int run_emulate_command(const EmulateArgs& args) {
         "frames; %llu feedback frames sent, %llu failed; fell behind %llu times\n",
         static_cast<double>(mono_ns() - start) * 1e-9, commands, bad, other, sent, send_failed,
         behind);
+    if (heartbeat) {
+      std::printf(
+          "craneassist emulate: heartbeat: %llu messages, %llu sequence errors, %llu malformed, "
+          "%llu losses\n",
+          static_cast<unsigned long long>(heartbeat->messages()),
+          static_cast<unsigned long long>(heartbeat->sequence_errors()),
+          static_cast<unsigned long long>(heartbeat->malformed()),
+          static_cast<unsigned long long>(heartbeat->losses()));
+    }
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return kExitRuntime;

@@ -71,6 +71,7 @@ void Controller::reset(const valves::MachineState& state) {
   q_ref_ = state.q;
   follower_.reset(q_ref_);
   tip_error_filtered_m_ = 0.0;
+  neutral_ = false;
   if (tip_path_) tip_path_->reset();
   if (scaler_) scaler_->reset();
 }
@@ -83,6 +84,9 @@ ControllerStatus Controller::update(const valves::MachineState& state, const Eig
   const bool command_ok = v_cmd.allFinite();
   const bool stale = !state_ok || !command_ok;
   out.flow_demand_m3_s = 0.0;
+  // Resuming after a stop with neutral valves: the machine stood on its holding valves, so the
+  // reference starts again from where it is measured (no P-feedback jump towards the old one).
+  if (neutral_ && !stale) reset(state);
 
   if (options_.mode == ScalingMode::kFull) {
     update_full(state, command_ok ? v_cmd : Eigen::Vector3d::Zero(), stale, out);
@@ -100,6 +104,7 @@ ControllerStatus Controller::update(const valves::MachineState& state, const Eig
   const bool at_rest = out.qdot_ref.isZero(0.0) && out.sddot == 0.0;
   if (stale && at_rest) {
     follower_.neutral(out.valves);  // stopped: valves neutral
+    neutral_ = true;
     return ControllerStatus::kStopped;
   }
   follower_.update(q_ref_, out.qdot_ref, state_ok ? &state.q : nullptr, out.valves);

@@ -16,6 +16,7 @@
 #include "craneassist/app/csv_log.hpp"
 #include "craneassist/app/embedded_replays.hpp"
 #include "craneassist/app/replay_runner.hpp"
+#include "craneassist/app/sim_setup.hpp"
 #include "craneassist/app/sine_path_experiment.hpp"
 #include "craneassist/app/trajectory_runner.hpp"
 #include "craneassist/config/crane_config.hpp"
@@ -25,7 +26,9 @@
 #include "craneassist/input/replay.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
 #include "exit_codes.hpp"
+#include "machine_setup.hpp"
 #include "plan_command.hpp"
+#include "sim_command.hpp"
 
 namespace {
 
@@ -39,12 +42,8 @@ struct ReplayArgs {
   std::string replay_file;      // empty: the bundled demo
   std::string trajectory_file;  // a planned joint trajectory instead of a replay
   std::string config_file;      // empty: the embedded reference crane
-  std::string backend = "sim";
-  std::string can_iface;             // --backend can: the interface
-  std::string mapping_file;          // --backend can: empty: the embedded K70M mapping
-  std::string can_log;               // --backend can: candump -L log of all traffic
-  double feedback_timeout_s = 0.05;  // --backend can: lost feedback after this long
-  double freeze_at_s = -1.0;         // test hook: freeze the loop at this machine time
+  cli::BackendArgs machine;     // the machine (empty values: the config's backend: and can:)
+  double freeze_at_s = -1.0;    // test hook: freeze the loop at this machine time
   double freeze_for_s = 0.0;
   std::string log_file = "craneassist-log.csv";
   bool no_log = false;
@@ -132,6 +131,12 @@ void print_summary(const app::RunSummary& s, const config::CraneConfig& cfg,
       "rms %.2f deg over %d cycles\n",
       s.max_direction_error_deg, s.rms_direction_error_deg, s.direction_samples);
   print_pump_line(s.energy_j, s.peak_power_w, s.peak_flow_m3_s, s.pump_saturated_cycles, cfg);
+  if (s.stopped_cycles > 0) {
+    std::printf(
+        "  stopped: %d cycles stopping or stopped (%d in stop rows: input not valid), valves "
+        "neutral in %d\n",
+        s.stopped_cycles, s.input_stop_cycles, s.neutral_valve_cycles);
+  }
   if (mode == app::ScalingMode::kFull) {
     std::printf("  path jerk: peak %.2f m/s^3 (bound %.2f)\n", s.peak_path_jerk,
                 cfg.scaling.jerk_max_m_s3);
@@ -174,6 +179,10 @@ void print_trajectory_summary(const app::TrajectoryRunSummary& s, const config::
 // configuration.
 int run_trajectory_command(const ReplayArgs& args, const config::CraneConfig& cfg) {
   std::optional<input::JointTrajectory> traj;
+  if (cli::uses_can_backend(args.machine, cfg)) {
+    spdlog::error("--trajectory runs on the simulated crane only (use --backend sim)");
+    return kExitUsage;
+  }
   try {
     traj = input::JointTrajectory::load_file(args.trajectory_file);
     if (traj->joints() != cfg.model.dof()) {
@@ -276,30 +285,10 @@ int run_replay_command(const ReplayArgs& args) {
   const input::Replay& replay = *loaded;
   const std::string replay_name(replay.source_name());
   try {
-    std::optional<sim_backend::SimBackend> sim;
-    std::optional<cli::CanMachine> can_machine;
-    valves::MachineInterface* machine_ptr = nullptr;
-    if (args.backend == "can") {
-      if (args.can_iface.empty()) {
-        spdlog::error("--backend can needs --can IFACE");
-        return kExitUsage;
-      }
-      can_machine.emplace(cfg.model, args.can_iface, args.mapping_file, args.can_log,
-                          args.feedback_timeout_s);
-      if (!can_machine->start(2.0)) {
-        spdlog::error(
-            "no position feedback of every joint on {} within 2 s (is the machine or "
-            "`craneassist emulate --can {}` running?)",
-            args.can_iface, args.can_iface);
-        return kExitRuntime;
-      }
-      machine_ptr = &can_machine->backend();
-    } else {
-      sim.emplace(cfg.model,
-                  sim_backend::SimSettings{cfg.simulation.step_s, cfg.simulation.q_initial});
-      machine_ptr = &*sim;
-    }
-    valves::MachineInterface& machine = *machine_ptr;
+    cli::Machine machines;
+    if (const int rc = machines.open(cfg, args.machine); rc != kExitOk) return rc;
+    valves::MachineInterface& machine = machines.get();
+    const bool use_can = machines.is_can();
     std::optional<app::CsvLog> log;
     if (!args.no_log) log.emplace(args.log_file, cfg.model.dof());
     app::RunOptions options;
@@ -307,7 +296,7 @@ int run_replay_command(const ReplayArgs& args) {
                               : args.scaling == "flow" ? app::ScalingMode::kFlowOnly
                               : args.scaling == "none" ? app::ScalingMode::kNone
                                                        : app::ScalingMode::kFull;
-    options.realtime = args.realtime || args.backend == "can";  // a real machine runs in real time
+    options.realtime = args.realtime || use_can;  // a real machine runs in real time
     options.settle_s = args.settle_s;
     options.freeze_at_s = args.freeze_at_s;
     options.freeze_for_s = args.freeze_for_s;
@@ -321,11 +310,7 @@ int run_replay_command(const ReplayArgs& args) {
     if (summary.log_rows_dropped > 0) {
       spdlog::warn("the log writer fell behind: {} rows dropped", summary.log_rows_dropped);
     }
-    if (can_machine) {
-      can_machine->backend().stop();
-      can_machine->report();
-      if (can_machine->backend().faulted()) return kExitRuntime;
-    }
+    if (const int rc = machines.finish(); rc != kExitOk) return rc;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return kExitRuntime;
@@ -420,25 +405,7 @@ int main(int argc, char** argv) {
       ->add_option("--config", args.config_file,
                    "Crane config YAML (default: the embedded K70M reference crane)")
       ->check(CLI::ExistingFile);
-  replay
-      ->add_option("--backend", args.backend,
-                   "Machine backend: sim (the simulated crane) or can (a machine on a CAN bus, "
-                   "docs/can.md; implies --realtime)")
-      ->check(CLI::IsMember({"sim", "can"}))
-      ->capture_default_str();
-  replay->add_option("--can", args.can_iface, "--backend can: the CAN interface (can0, vcan0)");
-  replay
-      ->add_option("--mapping", args.mapping_file,
-                   "--backend can: CAN mapping YAML (default: the embedded "
-                   "config/can/k70m_can.yaml)")
-      ->check(CLI::ExistingFile);
-  replay->add_option("--can-log", args.can_log,
-                     "--backend can: write all CAN traffic as a candump -L log");
-  replay
-      ->add_option("--can-feedback-timeout", args.feedback_timeout_s,
-                   "--backend can: fault when a joint's position is older than this, s")
-      ->check(CLI::Range(0.005, 1.0))
-      ->capture_default_str();
+  cli::add_backend_options(*replay, args.machine);
   replay->add_option("--test-freeze-at", args.freeze_at_s)->group("");
   replay->add_option("--test-freeze-for", args.freeze_for_s)->group("");
   replay->add_option("--log", args.log_file, "Per-cycle CSV log (docs/log-format.md)")
@@ -517,6 +484,8 @@ int main(int argc, char** argv) {
   auto* energy = cli::add_energy_command(cli, energy_args);
   cli::CalibrateArgs calibrate_args;
   auto* calibrate = cli::add_calibrate_command(cli, calibrate_args);
+  cli::SimArgs sim_args;
+  auto* sim = cli::add_sim_command(cli, sim_args);
 
   try {
     cli.parse(argc, argv);
@@ -550,6 +519,7 @@ int main(int argc, char** argv) {
       return kExitUsage;
     }
   }
+  if (*sim) return cli::run_sim_command(sim_args);
   if (*replay) {
     try {
       return run_replay_command(args);

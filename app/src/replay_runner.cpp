@@ -4,6 +4,8 @@
 #include <cmath>
 #include <thread>
 
+#include "craneassist/app/log_row_builder.hpp"
+
 namespace craneassist::app {
 
 double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -15,7 +17,6 @@ double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 RunSummary run_replay(const config::CraneConfig& config, const input::Replay& replay,
                       valves::MachineInterface& machine, const RunOptions& options, CsvLog* log) {
   const auto& model = config.model;
-  const int n = model.dof();
   Controller controller(config, options.controller);
   const double period = controller.period_s();
   const int cycles =
@@ -24,9 +25,9 @@ RunSummary run_replay(const config::CraneConfig& config, const input::Replay& re
   input::ReplayCursor cursor(replay);
   valves::MachineState state;
   ControllerOutput out;
-  dynamics::KinematicsData kin;
-  dynamics::TaskJacobian jac;
+  LogRowBuilder builder(model);
   LogRow row;
+  row.input_source = "replay";
   RunSummary summary;
   double sum_sq_direction = 0.0;
   Eigen::Vector3d last_cmd = Eigen::Vector3d::Zero();
@@ -42,18 +43,19 @@ RunSummary run_replay(const config::CraneConfig& config, const input::Replay& re
     const double t = k * period;
     machine.read(state);
     const Eigen::Vector3d cmd = cursor.command_at(t);
-    if (controller.update(state, cmd, out) != ControllerStatus::kRunning) ++summary.stopped_cycles;
+    const ControllerStatus status = controller.update(state, cmd, out);
+    const bool input_stop = !cmd.allFinite();  // a stop row
+    if (status != ControllerStatus::kRunning) ++summary.stopped_cycles;
+    summary.neutral_valve_cycles += status == ControllerStatus::kStopped;
+    summary.input_stop_cycles += input_stop;
     summary.peak_path_jerk = std::max(summary.peak_path_jerk, std::abs(out.sdddot));
     machine.write(out.valves);
 
     // Measured tip position and velocity.
-    Eigen::Vector3d tip = Eigen::Vector3d::Zero(), tip_v = Eigen::Vector3d::Zero();
-    if (state.valid) {
-      dynamics::tip_jacobian(model, kin, state.q, jac);
-      tip = model.task_from_base * kin.frames[static_cast<std::size_t>(n)].translation();
-      tip_v = jac * state.qdot;
-    }
-    if (cmd != last_cmd) {
+    builder.measure(state);
+    const Eigen::Vector3d& tip = builder.tip();
+    const Eigen::Vector3d& tip_v = builder.tip_velocity();
+    if (!(cmd == last_cmd || (input_stop && !last_cmd.allFinite()))) {
       last_cmd = cmd;
       cmd_since_s = t;
     }
@@ -83,33 +85,12 @@ RunSummary run_replay(const config::CraneConfig& config, const input::Replay& re
     ++summary.limit_cycles[static_cast<std::size_t>(out.limit)];
 
     if (log != nullptr) {
-      row.t = t;
-      for (int a = 0; a < 3; ++a) {
-        const auto s = static_cast<std::size_t>(a);
-        row.cmd[s] = cmd[a];
-        row.ref_v[s] = out.ref_tip_velocity_m_s[a];
-        row.tip[s] = tip[a];
-        row.tip_v[s] = tip_v[a];
-      }
-      for (int i = 0; i < n; ++i) {
-        const auto s = static_cast<std::size_t>(i);
-        row.q[s] = state.valid ? state.q[i] : NAN;
-        row.q_ref[s] = out.q_ref[i];
-        row.spool[s] = out.valves.spool[i];
-        row.load_pressure[s] = state.valid ? state.load_pressure_pa[i] : NAN;
-      }
-      row.set_pump(state.pump);
-      row.active_limit = scaling::to_string(out.limit);
-      row.scale = out.scale;
-      row.s = out.s;
-      row.sdot = out.sdot;
-      row.sddot = out.sddot;
-      row.sdddot = out.sdddot;
-      row.sddot_min = out.sddot_min;
-      row.sddot_max = out.sddot_max;
-      row.tip_error_m = out.tip_error_m;
-      row.ref_power_w = out.ref_power_w;
-      row.flow_demand_m3s = out.flow_demand_m3_s;
+      builder.fill(row, t, cmd, out, state);
+      row.status = status_word(status);
+      row.stop_reason = input_stop                             ? "replay stop row"
+                        : status == ControllerStatus::kRunning ? ""
+                                                               : "measurement invalid";
+      row.deadman = !input_stop;
       log->push(row);
     }
 

@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <initializer_list>
 #include <sstream>
@@ -348,13 +349,51 @@ void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& mo
   if (valves["tables"].IsDefined()) read_valve_tables(r, valves["tables"], vp + ".tables", model);
 }
 
+// `backend: sim | can` and the optional `can:` section; both may be left out (sim).
+void read_backend(Reader& r, const YAML::Node& root, BackendSettings& backend) {
+  const YAML::Node kind = root["backend"];
+  if (kind.IsDefined() && !kind.IsNull()) {
+    const std::string text = r.text(root, "backend", "");
+    if (text == "sim") {
+      backend.kind = BackendKind::kSim;
+    } else if (text == "can") {
+      backend.kind = BackendKind::kCan;
+    } else {
+      r.fail(kind, "backend", "unknown backend '" + text + "' (expected sim or can)");
+    }
+  }
+  const YAML::Node can = root["can"];
+  if (!can.IsDefined() || can.IsNull()) return;
+  r.check_keys(can, "can", {"interface", "mapping", "feedback_timeout"});
+  if (can["interface"].IsDefined()) {
+    backend.can.interface = r.text(can, "interface", "can");
+    const auto& name = backend.can.interface;
+    // Linux interface names: 1..15 characters, no '/', no whitespace.
+    if (name.empty() || name.size() > 15 || name.find_first_of("/ \t") != std::string::npos) {
+      r.fail(can["interface"], "can.interface", "not a network interface name (1-15 characters)");
+    }
+  }
+  if (can["mapping"].IsDefined()) {
+    std::filesystem::path mapping(r.text(can, "mapping", "can"));
+    const std::filesystem::path source(r.file());
+    if (mapping.is_relative() && source.has_parent_path() && r.file().front() != '<') {
+      mapping = source.parent_path() / mapping;
+    }
+    backend.can.mapping = mapping.string();
+  }
+  if (can["feedback_timeout"].IsDefined()) {
+    backend.can.feedback_timeout_s = r.value_in(can, "feedback_timeout", "can", Dimension::kTime,
+                                                1e-3, 1.0, "between 1 ms and 1 s");
+  }
+}
+
 CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view source_name) {
   CraneConfig cfg;
   cfg.source_name = std::string(source_name);
   if (!root.IsMap()) r.fail(root, "", "expected a mapping at the top level");
   r.check_keys(root, "",
                {"format", "name", "frames", "joints", "bodies", "payload", "hydraulics", "control",
-                "scaling", "redundancy", "simulation"});
+                "scaling", "redundancy", "simulation", "backend", "can"});
   const std::string format = r.text(root, "format", "");
   if (format != kFormat) {
     r.fail(root["format"], "format",
@@ -467,11 +506,16 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
     if (!known)
       r.fail(kv.first, "simulation.initial." + kv.first.Scalar(), "no joint of that name");
   }
+  read_backend(r, root, cfg.backend);
   cfg.unsourced_quantities = r.unsourced();
   return cfg;
 }
 
 }  // namespace
+
+const char* to_string(BackendKind kind) {
+  return kind == BackendKind::kCan ? "can" : "sim";
+}
 
 CraneConfig parse_crane_config(std::string_view yaml_text, std::string_view source_name) {
   Reader reader{std::string(source_name)};

@@ -4,5 +4,6 @@ namespace craneassist::config::embedded {
 
 extern const char* const kK70mYaml;
 extern const char* const kPlanar2rYaml;
+extern const char* const kGamepadYaml;
 
 }  // namespace craneassist::config::embedded

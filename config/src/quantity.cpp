@@ -42,6 +42,8 @@ constexpr UnitDef kUnits[] = {
     {"ms", Dimension::kTime, 1e-3},
     {"Hz", Dimension::kFrequency, 1.0},
     {"1/s", Dimension::kInverseTime, 1.0},
+    {"rad/s", Dimension::kAngularVelocity, 1.0},
+    {"deg/s", Dimension::kAngularVelocity, kPi / 180.0},
 };
 
 std::string_view trim(std::string_view s) {
@@ -94,6 +96,8 @@ const char* to_string(Dimension d) {
       return "frequency";
     case Dimension::kInverseTime:
       return "inverse time";
+    case Dimension::kAngularVelocity:
+      return "angular velocity";
   }
   return "?";
 }

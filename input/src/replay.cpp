@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <ostream>
 #include <system_error>
 
@@ -14,8 +15,10 @@
 namespace craneassist::input {
 namespace {
 
-constexpr std::array<std::string_view, 4> kColumns = {"t", "v_x", "v_y", "v_z"};
+// The optional fifth column `stop` (1: the operator input was not valid from this row on).
+constexpr std::array<std::string_view, 5> kColumns = {"t", "v_x", "v_y", "v_z", "stop"};
 constexpr std::string_view kHeader = "t,v_x,v_y,v_z";
+constexpr std::string_view kStopHeader = "t,v_x,v_y,v_z,stop";
 constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
 
 using detail::format_number;
@@ -37,11 +40,12 @@ class Parser {
     return ReplayError(source_, line, std::string(field), std::move(reason));
   }
   double parse_field(std::string_view text, std::size_t line, std::string_view field) const;
-  void check_header(std::string_view content, std::size_t line) const;
+  void check_header(std::string_view content, std::size_t line);
   ReplayRow parse_row(std::string_view content, std::size_t line);
 
   std::string source_;
   ReplayLimits limits_;
+  std::size_t columns_ = 4;  // 4, or 5 with the stop column
   std::vector<ReplayRow> rows_;
   std::size_t previous_row_line_ = 0;
 };
@@ -53,22 +57,27 @@ double Parser::parse_field(std::string_view text, std::size_t line, std::string_
   return value;
 }
 
-void Parser::check_header(std::string_view content, std::size_t line) const {
-  std::array<std::string_view, 4> fields;
-  bool ok = split_fields(content, fields) == kColumns.size();
-  for (std::size_t i = 0; ok && i < kColumns.size(); ++i) ok = fields[i] == kColumns[i];
+void Parser::check_header(std::string_view content, std::size_t line) {
+  std::array<std::string_view, 5> fields;
+  const std::size_t count = split_fields(content, fields);
+  bool ok = count == 4 || count == 5;
+  for (std::size_t i = 0; ok && i < count; ++i) ok = fields[i] == kColumns[i];
   if (!ok) {
     throw error(line, "",
-                "expected the header '" + std::string(kHeader) + "', got " + quoted(content));
+                "expected the header '" + std::string(kHeader) + "' or '" +
+                    std::string(kStopHeader) + "', got " + quoted(content));
   }
+  columns_ = count;
 }
 
 ReplayRow Parser::parse_row(std::string_view content, std::size_t line) {
-  std::array<std::string_view, 4> fields;
+  std::array<std::string_view, 5> fields;
   const std::size_t count = split_fields(content, fields);
-  if (count != kColumns.size()) {
+  if (count != columns_) {
     throw error(line, "",
-                "expected 4 fields (" + std::string(kHeader) + "), got " + std::to_string(count));
+                "expected " + std::to_string(columns_) + " fields (" +
+                    std::string(columns_ == 5 ? kStopHeader : kHeader) + "), got " +
+                    std::to_string(count));
   }
   if (rows_.size() >= limits_.max_rows) {
     throw error(line, "",
@@ -93,6 +102,22 @@ ReplayRow Parser::parse_row(std::string_view content, std::size_t line) {
                       number(limits_.max_speed_m_s) + " m/s");
     }
     row.v_m_s[i] = v;
+  }
+  if (columns_ == 5) {
+    if (fields[4] == "1") {
+      row.stop = true;
+    } else if (fields[4] != "0") {
+      throw error(line, kColumns[4],
+                  fields[4].empty() ? std::string("missing value")
+                                    : "expected 0 or 1, got " + quoted(fields[4]));
+    }
+    for (Eigen::Index i = 0; row.stop && i < 3; ++i) {
+      if (row.v_m_s[i] != 0.0) {
+        const auto column = static_cast<std::size_t>(i + 1);
+        throw error(line, kColumns[column],
+                    "must be 0 in a stop row (stop = 1), got " + quoted(fields[column]));
+      }
+    }
   }
   return row;
 }
@@ -203,11 +228,15 @@ Eigen::Vector3d ReplayCursor::command_at(double t_s) noexcept {
       ++next_;
     }
   }
-  return next_ == 0 ? Eigen::Vector3d::Zero() : rows[next_ - 1].v_m_s;
+  if (next_ == 0) return Eigen::Vector3d::Zero();
+  const ReplayRow& row = rows[next_ - 1];
+  return row.stop ? Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()) : row.v_m_s;
 }
 
 void write_replay(std::ostream& out, const std::vector<ReplayRow>& rows) {
-  out << kHeader << '\n';
+  const bool stop_column =
+      std::any_of(rows.begin(), rows.end(), [](const ReplayRow& row) { return row.stop; });
+  out << (stop_column ? kStopHeader : kHeader) << '\n';
   std::array<char, kMaxNumberChars> buffer{};
   std::string line;
   for (const ReplayRow& row : rows) {
@@ -217,6 +246,7 @@ void write_replay(std::ostream& out, const std::vector<ReplayRow>& rows) {
       line += ',';
       line += format_number(row.v_m_s[i], buffer);
     }
+    if (stop_column) line += row.stop ? ",1" : ",0";
     line += '\n';
     out << line;
   }

@@ -1,6 +1,7 @@
 # Guest script of the can_vm_can_backend test (tools/can-vm/run.sh, busybox sh in the VM, vcan0
 # up): the emulator and `craneassist replay --backend can` on vcan0, checked against the sim
-# backend and from independent candump captures; then the fault cases.
+# backend and from independent candump captures; then the fault cases; then the live loop
+# (`craneassist sim --backend can`) against the live loop on the sim backend.
 set -u
 status=0
 fail() { echo "FAIL: $*"; status=1; }
@@ -35,7 +36,7 @@ start_capture /tmp/cap1.log
 stop_capture
 kill "$emu"; wait "$emu"
 cat /tmp/can.out /tmp/emu.log
-./can_backend_check compare /tmp/sim.csv /tmp/can.csv 0.05 || fail "tip paths differ"
+./can_backend_check compare /tmp/sim.csv /tmp/can.csv 0.05 pump || fail "tip paths or pump differ"
 echo "--- the independent candump capture"
 ./can_backend_check traffic /tmp/cap1.log || fail "traffic"
 echo "--- the backend's own candump log"
@@ -84,5 +85,48 @@ kill "$emu"; wait "$emu"
 grep CAN /tmp/f4.out
 [ "$rc" = 3 ] || fail "expected exit 3 after the fault, got $rc"
 grep -q "CAN FAULT (control loop frozen)" /tmp/f4.out || fail "no frozen-loop fault"
+grep heartbeat /tmp/emu.log
+grep -q "heartbeat lost" /tmp/emu.log || fail "the emulator did not see the heartbeat stop"
 ./can_backend_check safe /tmp/cap4.log last-motion 130 || fail "safe state after the freeze"
+echo "=== 5. the ISOBUS valve-group example mapping (every section an AVC valve, 1..4)"
+./craneassist emulate --can vcan0 --mapping pvg32_isobus_example.yaml >/tmp/emu5.log 2>&1 &
+emu=$!
+sleep 0.5
+start_capture /tmp/cap5.log
+./craneassist replay can_short.csv --backend can --can vcan0 --mapping pvg32_isobus_example.yaml \
+  --log /tmp/can5.csv --settle 0.5 --can-feedback-timeout 0.3 >/tmp/f5.out 2>&1 || fail "replay with the ISOBUS mapping exited $?"
+stop_capture
+kill "$emu"; wait "$emu"
+grep CAN /tmp/f5.out
+./can_backend_check compare /tmp/sim.csv /tmp/can5.csv 0.05 || fail "tip paths differ (ISOBUS mapping)"
+for v in 0CFE3180 0CFE3280 0CFE3380 0CFE3480; do
+  grep -q " vcan0 $v#" /tmp/cap5.log || fail "no AVC frames $v in the capture"
+done
+echo "=== 6. the live loop (craneassist sim) on the CAN backend: the replay as a live operator"
+./craneassist sim --input replay can_short.csv --no-realtime --log /tmp/live_sim.csv \
+  >/tmp/live_sim.out 2>&1 || fail "sim on the sim backend exited $?"
+start_emulator
+start_capture /tmp/cap6.log
+./craneassist sim --input replay can_short.csv --backend can --can vcan0 --log /tmp/live_can.csv \
+  --can-feedback-timeout 0.3 >/tmp/live_can.out 2>&1 || fail "sim --backend can exited $?"
+stop_capture
+kill "$emu"; wait "$emu"
+cat /tmp/live_can.out
+grep -q "craneassist sim: replay input on .*, can backend" /tmp/live_can.out || fail "not on the can backend"
+./can_backend_check compare /tmp/live_sim.csv /tmp/live_can.csv 0.05 || fail "live tip paths differ"
+# The normal end: the backend's disable() blocks every section (the last commands are blocks).
+./can_backend_check safe /tmp/cap6.log last-motion 100 || fail "not blocked at the end of the live run"
+echo "=== 7. the live loop on CAN, the emulator dies: the run stops with the report, exit 3"
+start_emulator
+./craneassist sim --input replay can_short.csv --backend can --can vcan0 --log /tmp/live_f7.csv \
+  >/tmp/live_f7.out 2>&1 &
+rp=$!
+sleep 2
+kill -9 "$emu"
+wait "$rp"; rc=$?
+cat /tmp/live_f7.out
+[ "$rc" = 3 ] || fail "expected exit 3 after the fault, got $rc"
+grep -q "CAN FAULT (feedback lost)" /tmp/live_f7.out || fail "no feedback-lost fault"
+grep -q "the machine reported a fault: run stopped" /tmp/live_f7.out || fail "the run did not stop"
+grep -q "ran [0-4]\.[0-9]* s of machine time" /tmp/live_f7.out || fail "the run went on after the fault"
 exit "$status"

@@ -1,5 +1,6 @@
 // Checks of the can_vm_can_backend test, run in the guest on files the test wrote:
-//   compare SIM.csv CAN.csv TOL_M       tip paths of the two backends' logs, row by row
+//   compare SIM.csv CAN.csv TOL_M [pump]  tip paths of the two backends' logs, row by row; with
+//                                       pump, also the pump energy measured over the bus
 //   traffic CAPTURE                     candump -L capture: identifiers, payloads, cycle times
 //   safe CAPTURE EVENT LIMIT_MS         time from EVENT to every section commanded to block;
 //        EVENT: last-feedback (the last position frame), bad-frame (the first position frame
@@ -34,6 +35,7 @@ std::vector<CandumpRecord> read_capture(const char* path, std::vector<std::strin
 
 constexpr std::uint32_t kCommandIds[] = {0x0CFE3080, 0x0CFE3180, 0x0CFE3280, 0x210};
 constexpr std::uint32_t kSlewPosition = 0x18FF1021;
+constexpr std::uint32_t kHeartbeat = 0x18FF0080;
 
 int section_of(const CanFrame& f) {
   for (int i = 0; i < 4; ++i) {
@@ -70,7 +72,7 @@ std::vector<std::vector<double>> read_csv(const char* path, std::vector<std::str
   return rows;
 }
 
-int compare(const char* sim_path, const char* can_path, double tol) {
+int compare(const char* sim_path, const char* can_path, double tol, bool with_pump) {
   std::vector<std::string> hs, hc;
   const auto a = read_csv(sim_path, hs);
   const auto b = read_csv(can_path, hc);
@@ -97,7 +99,24 @@ int compare(const char* sim_path, const char* can_path, double tol) {
       "tip path, can vs sim backend over %zu cycles: max %.1f mm, rms %.1f mm, end %.1f mm "
       "(tolerance %.0f mm)\n",
       n, max_d * 1e3, std::sqrt(sum_sq / static_cast<double>(n)) * 1e3, end_d * 1e3, tol * 1e3);
-  return (max_d <= tol && a.size() == b.size()) ? 0 : 1;
+  // The pump as measured over the bus (the emulator's pressure and flow frames, integrated by
+  // the backend) against the simulator's own: the energy at the end within 15 %.
+  const std::size_t e = col(hs, "energy_j"), q = col(hs, "pump_flow_m3s");
+  bool pump_ok = !with_pump || (e < hs.size() && q < hs.size() && col(hc, "energy_j") == e);
+  if (with_pump && pump_ok) {
+    double peak_a = 0.0, peak_b = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      peak_a = std::max(peak_a, a[k][q]);
+      peak_b = std::max(peak_b, b[k][q]);
+    }
+    const double ea = a[n - 1][e], eb = b[n - 1][e];
+    std::printf(
+        "pump over the bus: energy %.1f kJ (sim backend %.1f kJ), peak flow %.1f L/min (sim "
+        "%.1f L/min)\n",
+        eb * 1e-3, ea * 1e-3, peak_b * 6e4, peak_a * 6e4);
+    pump_ok = ea > 0.0 && std::abs(eb - ea) <= 0.15 * ea;
+  }
+  return (max_d <= tol && a.size() == b.size() && pump_ok) ? 0 : 1;
 }
 
 // Reports the period statistics; only the mean is asserted, within tol of nominal (TCG timing).
@@ -129,11 +148,22 @@ int traffic(const char* path) {
   std::vector<std::string> storage;
   const auto recs = read_capture(path, storage);
   bool ok = !recs.empty();
-  std::vector<std::int64_t> times[4], position;
-  int bad_payload = 0, unknown = 0, moving = 0;
+  std::vector<std::int64_t> times[4], position, heartbeat;
+  int bad_payload = 0, unknown = 0, moving = 0, heartbeat_skips = 0, heartbeat_enabled = 0;
+  int last_counter = -1;
+  std::int64_t last_enabled_heartbeat = -1;
+  bool last_block[4] = {};
   for (const auto& r : recs) {
     const int s = section_of(r.frame);
-    if (s >= 0) {
+    if (s >= 0) last_block[s] = is_block(r.frame);
+    if (r.frame.extended && r.frame.id == kHeartbeat) {
+      heartbeat.push_back(r.timestamp);
+      if (r.frame.dlc != 8 || r.frame.data[1] > 2) ++bad_payload;
+      if (last_counter >= 0 && r.frame.data[0] != ((last_counter + 1) & 0xFF)) ++heartbeat_skips;
+      last_counter = r.frame.data[0];
+      heartbeat_enabled += r.frame.data[1] == 1;
+      if (r.frame.data[1] == 1) last_enabled_heartbeat = r.timestamp;
+    } else if (s >= 0) {
       times[s].push_back(r.timestamp);
       if (s < 3) {
         iso11783::AuxValveCommand c;
@@ -150,7 +180,8 @@ int traffic(const char* path) {
     } else if (r.frame.extended && r.frame.id == kSlewPosition) {
       position.push_back(r.timestamp);
     } else if (!((r.frame.extended && (r.frame.id & 0xFFFFFFF0u) == 0x18FF1020u) ||
-                 (!r.frame.extended && r.frame.id >= 0x301 && r.frame.id <= 0x304))) {
+                 (!r.frame.extended &&
+                  ((r.frame.id >= 0x301 && r.frame.id <= 0x304) || r.frame.id == 0x310)))) {
       ++unknown;
     }
   }
@@ -160,9 +191,27 @@ int traffic(const char* path) {
       path, recs.size(), bad_payload, unknown, moving);
   const char* names[] = {"slew AVC 0CFE3080", "lift AVC 0CFE3180", "tilt AVC 0CFE3280",
                          "extension current 210"};
-  for (int s = 0; s < 4; ++s) period_stats(names[s], times[s], 20.0, 0.1, ok);
-  // The emulator is the test machine, not the code under test: a looser bound.
-  period_stats("slew position 18FF1021 (emulator)", position, 10.0, 0.3, ok);
+  // The command cycle while the loop ran: up to the last heartbeat in state enabled (the block
+  // commands at the end of the run go out at once, off the cycle, and are checked below).
+  for (int s = 0; s < 4; ++s) {
+    if (last_enabled_heartbeat >= 0) {
+      while (!times[s].empty() && times[s].back() > last_enabled_heartbeat) times[s].pop_back();
+    }
+    period_stats(names[s], times[s], 20.0, 0.1, ok);
+  }
+  period_stats("heartbeat 18FF0080", heartbeat, 20.0, 0.1, ok);
+  std::printf("heartbeat: %zu messages, %d in state enabled, %d counter skips\n", heartbeat.size(),
+              heartbeat_enabled, heartbeat_skips);
+  const bool ended_blocked = last_block[0] && last_block[1] && last_block[2] && last_block[3];
+  std::printf("at the end of the capture every section is commanded to block: %s\n",
+              ended_blocked ? "yes" : "NO");
+  ok = ok && heartbeat_skips == 0 && heartbeat_enabled > 0 && ended_blocked;
+  // The emulator is the test machine, not the code under test, and it steps the simulator at
+  // 1 kHz on the same emulated CPU as the controller: under TCG on a loaded host its feedback
+  // period stretches (13 ms measured in one CI run). Reported; only a gross failure (a mean over
+  // twice nominal) fails here. Feedback arriving in time is what the replay itself checks: no
+  // lost-feedback fault.
+  period_stats("slew position 18FF1021 (emulator)", position, 10.0, 1.0, ok);
   return ok && bad_payload == 0 && unknown == 0 && moving > 0 ? 0 : 1;
 }
 
@@ -217,8 +266,10 @@ int safe(const char* path, const std::string& event, double limit_ms) {
 
 int main(int argc, char** argv) {
   const std::string mode = argc > 1 ? argv[1] : "";
-  if (mode == "compare" && argc == 5)
-    return compare(argv[2], argv[3], std::strtod(argv[4], nullptr));
+  if (mode == "compare" && (argc == 5 || argc == 6)) {
+    return compare(argv[2], argv[3], std::strtod(argv[4], nullptr),
+                   argc == 6 && std::string(argv[5]) == "pump");
+  }
   if (mode == "traffic" && argc == 3) return traffic(argv[2]);
   if (mode == "safe" && argc == 5) return safe(argv[2], argv[3], std::strtod(argv[4], nullptr));
   std::fprintf(stderr, "usage: can_backend_check compare|traffic|safe ...\n");

@@ -8,6 +8,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "craneassist/can/heartbeat.hpp"
 #include "craneassist/can/valve_frames.hpp"
 
 namespace craneassist::can {
@@ -74,7 +75,7 @@ class LogRing {
 struct AtomicCounters {
   std::atomic<std::uint64_t> frames_sent{0}, frames_received{0}, send_queue_full{0}, send_errors{0},
       unknown_frames{0}, bad_frames{0}, unsupported_frames{0}, bus_error_frames{0},
-      receive_errors{0}, watchdog_block_frames{0}, faults{0}, log_dropped{0};
+      receive_errors{0}, watchdog_block_frames{0}, faults{0}, log_dropped{0}, heartbeats_sent{0};
 };
 
 constexpr int kMaxDrainPerRead = 512;
@@ -114,7 +115,40 @@ struct CanBackend::Impl {
   std::thread watchdog, logger;
   std::mutex stop_mutex;
   Received rx;
+  // Pump measurements (when the mapping has them): control thread only.
+  PumpMapping pump_map;
+  double pump_pressure_pa = 0.0, pump_flow_m3_s = 0.0, pump_energy_j = 0.0;
+  TimestampUs pump_last_us = 0;         // newest pump frame
+  std::int64_t pump_integrated_us = 0;  // mono time of the last energy step
+  // The heartbeat (when the mapping has one): control thread only.
+  std::optional<HeartbeatSpec> heartbeat;
+  std::int64_t heartbeat_cycle_us = 0;
+  std::int64_t heartbeat_last_us = 0;
+  Heartbeat heartbeat_next;
+  CanFrame heartbeat_frame;
 };
+
+namespace {
+
+// Sends one frame and accounts for it: counted as sent and copied to the log ring, or counted
+// as a full queue or a send error. Non-blocking, allocation-free.
+template <class Counters, class Ring>
+SendStatus send_counted(Transport& transport, Counters& counters, Ring& ring, bool logging,
+                        const CanFrame& frame, TimestampUs now_rt_us) {
+  const SendStatus st = transport.send(frame);
+  if (st == SendStatus::kOk) {
+    counters.frames_sent.fetch_add(1, std::memory_order_relaxed);
+    if (logging && !ring.push(frame, now_rt_us)) {
+      counters.log_dropped.fetch_add(1, std::memory_order_relaxed);
+    }
+  } else {
+    (st == SendStatus::kQueueFull ? counters.send_queue_full : counters.send_errors)
+        .fetch_add(1, std::memory_order_relaxed);
+  }
+  return st;
+}
+
+}  // namespace
 
 CanBackend::CanBackend(const CanMapping& mapping, const dynamics::CraneModel& model,
                        Transport& transport, const CanBackendOptions& options)
@@ -131,6 +165,21 @@ CanBackend::CanBackend(const CanMapping& mapping, const dynamics::CraneModel& mo
       throw std::invalid_argument(mapping.source + ": joint " + std::to_string(i + 1) + " is '" +
                                   jm.name + "', the crane's is '" + model.joints[s].name + "'");
     }
+    // The position signal must measure what the joint is, over the joint's whole range (a valid
+    // position outside the signal's min/max would be read as a malformed frame).
+    const auto& joint = model.joints[s];
+    const bool revolute = joint.type == dynamics::JointType::kRevolute;
+    if (revolute != (jm.position_kind == PositionKind::kAngle)) {
+      throw std::invalid_argument(
+          mapping.source + ": joint '" + jm.name + "': the crane's joint is " +
+          (revolute ? "revolute" : "prismatic") + ", its position signal's unit is " +
+          (revolute ? "a length" : "an angle"));
+    }
+    if ((jm.position.minimum && *jm.position.minimum > joint.q_min + 1e-9) ||
+        (jm.position.maximum && *jm.position.maximum < joint.q_max - 1e-9)) {
+      throw std::invalid_argument(mapping.source + ": joint '" + jm.name +
+                                  "': the position signal's min/max do not cover the joint range");
+    }
     Impl::Joint j;
     j.map = jm;
     if (s < model.cylinders.size() && model.cylinders[s].area_a_m2 > 0.0) {
@@ -144,6 +193,12 @@ CanBackend::CanBackend(const CanMapping& mapping, const dynamics::CraneModel& mo
                                   "': its valve command cannot be encoded");
     }
     impl_->joints.push_back(std::move(j));
+  }
+  impl_->pump_map = mapping.pump;
+  if (mapping.heartbeat) {
+    impl_->heartbeat = *mapping.heartbeat;
+    impl_->heartbeat_cycle_us =
+        static_cast<std::int64_t>(std::llround(mapping.heartbeat->cycle_s * 1e6));
   }
   if (!options.candump_log.empty()) {
     impl_->log_file = std::fopen(options.candump_log.c_str(), "w");
@@ -235,6 +290,7 @@ CanBackendCounters CanBackend::counters() const {
   out.watchdog_block_frames = c.watchdog_block_frames.load();
   out.faults = c.faults.load();
   out.log_dropped = c.log_dropped.load();
+  out.heartbeats_sent = c.heartbeats_sent.load();
   return out;
 }
 
@@ -307,6 +363,19 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
         (side == 0 ? j.pa : j.pb) = value;
       }
     }
+    for (int which = 0; which < 2; ++which) {
+      const auto& spec = which == 0 ? m.pump_map.pressure : m.pump_map.flow;
+      if (!spec || spec->id != f.id || spec->extended != f.extended) continue;
+      known = true;
+      double value = 0.0;
+      const auto st = decode(*spec, f, value);
+      if (st != SignalStatus::kOk) {  // informational: counted, not a fault
+        m.counters.bad_frames.fetch_add(1, std::memory_order_relaxed);
+        continue;
+      }
+      (which == 0 ? m.pump_pressure_pa : m.pump_flow_m3_s) = value;
+      m.pump_last_us = m.rx.timestamp_us;
+    }
     if (!known) m.counters.unknown_frames.fetch_add(1, std::memory_order_relaxed);
   }
 
@@ -333,10 +402,29 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
     state.load_pressure_pa[i] = j.pa - j.pb * j.area_ratio;
   }
   state.t_s = static_cast<double>(mono_us() - m.start_us) * 1e-6;
-  state.pump = valves::PumpMeasurement{};
+  read_pump(state.pump, now, timeout_us);
   state.valid = fresh && !faulted();
   if (faulted()) return valves::BackendStatus::kFault;
   return state.valid ? valves::BackendStatus::kOk : valves::BackendStatus::kNoData;
+}
+
+void CanBackend::read_pump(valves::PumpMeasurement& pump, std::int64_t now_rt_us,
+                           std::int64_t timeout_us) {
+  // Measured when the mapping has pump signals and they are fresh; unmeasured: zeros.
+  Impl& m = *impl_;
+  pump = valves::PumpMeasurement{};
+  const std::int64_t mono = mono_us();
+  const bool fresh = m.pump_last_us != 0 && now_rt_us - m.pump_last_us <= timeout_us;
+  if (fresh) {
+    pump.pressure_pa = m.pump_pressure_pa;
+    pump.flow_m3_s = m.pump_flow_m3_s;
+    pump.power_w = m.pump_pressure_pa * m.pump_flow_m3_s;
+    if (m.pump_integrated_us != 0) {
+      m.pump_energy_j += pump.power_w * static_cast<double>(mono - m.pump_integrated_us) * 1e-6;
+    }
+  }
+  m.pump_integrated_us = mono;
+  pump.energy_j = m.pump_energy_j;
 }
 
 valves::BackendStatus CanBackend::write(const valves::ValveCommand& command) {
@@ -358,17 +446,12 @@ valves::BackendStatus CanBackend::write(const valves::ValveCommand& command) {
     if (!safe && encode_valve_command(j.map.valve, spool, j.command_frame)) {
       frame = &j.command_frame;
     }
-    const SendStatus st = m.transport.send(*frame);
+    const SendStatus st = send_counted(m.transport, m.counters, m.control_ring,
+                                       m.log_file != nullptr, *frame, now_rt);
     j.last_sent_us = now;
     if (st == SendStatus::kOk) {
       m.consecutive_send_errors = 0;
-      m.counters.frames_sent.fetch_add(1, std::memory_order_relaxed);
-      if (m.log_file != nullptr && !m.control_ring.push(*frame, now_rt)) {
-        m.counters.log_dropped.fetch_add(1, std::memory_order_relaxed);
-      }
     } else {
-      (st == SendStatus::kQueueFull ? m.counters.send_queue_full : m.counters.send_errors)
-          .fetch_add(1, std::memory_order_relaxed);
       if (++m.consecutive_send_errors >= m.options.max_send_errors && enabled()) {
         latch(FaultReason::kSendError, "%d consecutive sends failed on %s (last: %s)",
               m.consecutive_send_errors, m.transport.interface_name(), to_string(st));
@@ -376,8 +459,44 @@ valves::BackendStatus CanBackend::write(const valves::ValveCommand& command) {
     }
   }
   if (force) m.block_sent_after_fault = true;
+  if (m.heartbeat && (force || now - m.heartbeat_last_us >= m.heartbeat_cycle_us - kEarlyUs)) {
+    send_heartbeat(now, now_rt);
+  }
   if (faulted()) return valves::BackendStatus::kFault;
   return valves::BackendStatus::kOk;
+}
+
+void CanBackend::send_heartbeat(std::int64_t now_us, std::int64_t now_rt_us) {
+  Impl& m = *impl_;
+  Heartbeat& hb = m.heartbeat_next;
+  hb.state = faulted()   ? HeartbeatState::kFault
+             : enabled() ? HeartbeatState::kEnabled
+                         : HeartbeatState::kDisabled;
+  hb.reason = static_cast<std::uint8_t>(fault_reason());
+  encode_heartbeat(*m.heartbeat, hb, m.heartbeat_frame);
+  m.heartbeat_last_us = now_us;
+  if (send_counted(m.transport, m.counters, m.control_ring, m.log_file != nullptr,
+                   m.heartbeat_frame, now_rt_us) == SendStatus::kOk) {
+    m.counters.heartbeats_sent.fetch_add(1, std::memory_order_relaxed);
+  }
+  ++hb.counter;  // the next one advances, whether or not this one went out
+}
+
+void CanBackend::disable() {
+  // The normal end of a run: every section to block now, and the heartbeat says disabled.
+  enabled_.store(false, std::memory_order_release);
+  Impl& m = *impl_;
+  const std::int64_t now = mono_us();
+  const TimestampUs now_rt = m.log_file != nullptr ? realtime_now_us() : 0;
+  for (auto& j : m.joints) {
+    send_counted(m.transport, m.counters, m.control_ring, m.log_file != nullptr, j.block_frame,
+                 now_rt);
+    j.last_sent_us = now;
+  }
+  if (m.heartbeat) send_heartbeat(now, now_rt);
+  // No further write() is expected: the watchdog's loop-frozen check is disarmed, but it keeps
+  // sending block commands at each cycle until stop().
+  m.last_write_us.store(1, std::memory_order_release);
 }
 
 void CanBackend::watchdog_loop() {
@@ -407,14 +526,9 @@ void CanBackend::watchdog_loop() {
     for (auto& j : m.joints) {
       if (now - j.watchdog_last_sent_us < j.cycle_us - 2000) continue;
       j.watchdog_last_sent_us = now;
-      if (m.transport.send(j.block_frame) == SendStatus::kOk) {
-        m.counters.frames_sent.fetch_add(1, std::memory_order_relaxed);
+      if (send_counted(m.transport, m.counters, m.watchdog_ring, m.log_file != nullptr,
+                       j.block_frame, now_rt) == SendStatus::kOk) {
         m.counters.watchdog_block_frames.fetch_add(1, std::memory_order_relaxed);
-        if (m.log_file != nullptr && !m.watchdog_ring.push(j.block_frame, now_rt)) {
-          m.counters.log_dropped.fetch_add(1, std::memory_order_relaxed);
-        }
-      } else {
-        m.counters.send_errors.fetch_add(1, std::memory_order_relaxed);
       }
     }
   }

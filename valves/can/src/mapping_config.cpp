@@ -8,6 +8,7 @@
 #include <initializer_list>
 #include <sstream>
 
+#include "craneassist/can/valve_frames.hpp"
 #include "craneassist/config/config_error.hpp"
 #include "craneassist/config/quantity.hpp"
 #include "craneassist/config/yaml_reader.hpp"
@@ -19,7 +20,7 @@ using config::ConfigError;
 using config::Dimension;
 
 // What a signal measures or commands; decides which units its `unit` may name.
-enum class SignalUse { kPosition, kPressure, kCommand };
+enum class SignalUse { kPosition, kPressure, kCommand, kFlow };
 
 class Reader : public config::YamlReader {
  public:
@@ -106,6 +107,12 @@ bool unit_factor(const std::string& unit, SignalUse use, double& factor, Positio
         return true;
       }
       return false;
+    case SignalUse::kFlow:
+      if (auto q = config::parse_quantity("1 " + unit, Dimension::kFlow, error)) {
+        factor = q->si_values[0];
+        return true;
+      }
+      return false;
     case SignalUse::kCommand:
       if (unit == "A")
         factor = 1.0;
@@ -130,6 +137,8 @@ const char* units_text(SignalUse use) {
       return "a pressure (Pa, kPa, MPa, bar)";
     case SignalUse::kCommand:
       return "a current (A, mA) or a ratio (%, 1)";
+    case SignalUse::kFlow:
+      return "a volume flow (L/min, m^3/s)";
   }
   return "";
 }
@@ -264,7 +273,7 @@ std::uint64_t occupied_bits(const SignalSpec& spec) {
 }
 
 CanMapping read_mapping(const Reader& r, const YAML::Node& root) {
-  r.check_keys(root, "", {"format", "note", "joints"});
+  r.check_keys(root, "", {"format", "note", "joints", "heartbeat", "pump"});
   const YAML::Node format = r.child(root, "format", "");
   if (r.text(format, "format") != kMappingFormat) {
     r.fail(format, "format", std::string("expected ") + kMappingFormat);
@@ -314,6 +323,48 @@ CanMapping read_mapping(const Reader& r, const YAML::Node& root) {
       (std::string(key) == "pressure_a" ? jm.pressure_a : jm.pressure_b) = s;
     }
     mapping.joints.push_back(std::move(jm));
+  }
+  if (root["pump"].IsDefined()) {
+    const YAML::Node pump = root["pump"];
+    r.check_keys(pump, "pump", {"pressure", "flow"});
+    if (pump["pressure"].IsDefined()) {
+      mapping.pump.pressure = read_signal(r, pump["pressure"], "pump.pressure",
+                                          SignalUse::kPressure, kSignalKeys, nullptr);
+      const auto& sp = *mapping.pump.pressure;
+      occupancy.push_back(
+          {sp.id, sp.extended, occupied_bits(sp), "pump.pressure", pump["pressure"], false});
+    }
+    if (pump["flow"].IsDefined()) {
+      mapping.pump.flow =
+          read_signal(r, pump["flow"], "pump.flow", SignalUse::kFlow, kSignalKeys, nullptr);
+      const auto& sp = *mapping.pump.flow;
+      occupancy.push_back(
+          {sp.id, sp.extended, occupied_bits(sp), "pump.flow", pump["flow"], false});
+    }
+  }
+  if (root["heartbeat"].IsDefined()) {
+    const YAML::Node h = root["heartbeat"];
+    r.check_keys(h, "heartbeat", {"id", "extended", "cycle", "timeout"});
+    HeartbeatSpec hb;
+    hb.extended = r.flag(h, "extended", "heartbeat", true);
+    hb.id = static_cast<std::uint32_t>(
+        r.integer(h, "id", "heartbeat", hb.extended ? kMaxExtendedId : kMaxStandardId));
+    hb.cycle_s = r.time(h, "cycle", "heartbeat", 0.001, 0.1, "between 1 ms and 100 ms");
+    hb.timeout_s = r.time(h, "timeout", "heartbeat", 0.01, 1.0, "between 10 ms and 1 s");
+    if (hb.timeout_s < 2.0 * hb.cycle_s) {
+      r.fail(h["timeout"], "heartbeat.timeout", "must be at least two cycles");
+    }
+    for (const auto& jm : mapping.joints) {
+      CanFrame avc;
+      if (jm.valve.kind == ValveOutputKind::kIso11783Avc && encode_valve_block(jm.valve, avc) &&
+          avc.id == hb.id && avc.extended == hb.extended) {
+        r.fail(h["id"], "heartbeat.id",
+               "is the valve command identifier of joint '" + jm.name + "'");
+      }
+    }
+    // The whole frame is the heartbeat's: no signal may use its identifier.
+    occupancy.push_back({hb.id, hb.extended, ~std::uint64_t{0}, "heartbeat", h, true});
+    mapping.heartbeat = hb;
   }
   // Signals sharing a frame must not share bits; a frame is either sent or received.
   for (std::size_t a = 0; a < occupancy.size(); ++a) {

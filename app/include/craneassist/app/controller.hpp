@@ -69,7 +69,8 @@ class Controller {
 
   // One control period. An invalid measurement or a non-finite command brings the motion to a
   // jerk-limited stop along the current direction (kStopping, limit stale_input) and then holds
-  // with neutral valves (kStopped); the other modes stop at once.
+  // with neutral valves (kStopped); the other modes stop at once. The first valid cycle after
+  // kStopped restarts the reference at the measured configuration (as reset()).
   ControllerStatus update(const valves::MachineState& state, const Eigen::Vector3d& v_cmd_m_s,
                           ControllerOutput& out);
 
@@ -101,6 +102,7 @@ class Controller {
   JointVector dc_dq_, qddot_max_, cylinder_force_;
   JointVector q_ref_;
   double tip_error_filtered_m_ = 0.0;
+  bool neutral_ = false;  // the last update returned kStopped (valves neutral)
 };
 
 }  // namespace craneassist::app

@@ -32,6 +32,13 @@ struct LogRow {
   double ref_power_w = 0.0;       // pump power the model predicts for the reference
   const char* active_limit = "";  // static strings only (to_string of the enums)
   const char* pump_limit = "";
+  // Live-loop fields (the live loop and telemetry fill them; the CSV writer does not write them):
+  // joint rates, cylinder positions and velocities, loop and input status. Static strings only.
+  std::array<double, kMaxJoints> qdot{}, cylinder_pos{}, cylinder_vel{};
+  const char* status = "";       // "running", "stopping", "stopped"
+  const char* stop_reason = "";  // why the loop stops or holds ("" while running)
+  const char* input_source = "";
+  bool deadman = false;
 
   // The pump columns from a measurement.
   void set_pump(const valves::PumpMeasurement& pump) {

@@ -42,8 +42,10 @@ struct RunSummary {
   // Angle between commanded and reference tip velocity (what the controller asked for).
   double max_reference_direction_error_deg = 0.0;
   int pump_saturated_cycles = 0;
-  double peak_path_jerk = 0.0;  // max |sdddot| of the reference (full scaling)
-  int stopped_cycles = 0;
+  double peak_path_jerk = 0.0;   // max |sdddot| of the reference (full scaling)
+  int stopped_cycles = 0;        // the controller stopping or stopped (kStopping, kStopped)
+  int input_stop_cycles = 0;     // cycles in a stop row of the replay (a non-finite command)
+  int neutral_valve_cycles = 0;  // kStopped: at rest with every valve neutral
   std::array<int, scaling::kActiveLimitCount> limit_cycles{};  // indexed by scaling::ActiveLimit
   std::size_t log_rows_dropped = 0;
 };

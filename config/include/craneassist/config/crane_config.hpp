@@ -46,12 +46,30 @@ struct SimulationSettings {
   dynamics::JointVector q_initial;
 };
 
+// Which machine the loop drives (`backend: sim | can`) and, for can, where it is.
+enum class BackendKind { kSim, kCan };
+const char* to_string(BackendKind kind);
+
+struct CanSettings {
+  std::string interface;  // can0, vcan0; empty: must be given on the command line
+  // Signal mapping file (docs/can.md), resolved against the config file's folder; empty: the
+  // embedded K70M mapping (config/can/k70m_can.yaml).
+  std::string mapping;
+  double feedback_timeout_s = 0.05;  // a joint's position older than this is lost feedback
+};
+
+struct BackendSettings {
+  BackendKind kind = BackendKind::kSim;
+  CanSettings can;
+};
+
 struct CraneConfig {
   dynamics::CraneModel model;
   ControlSettings control;
   ScalingSettings scaling;
   RedundancySettings redundancy;
   SimulationSettings simulation;
+  BackendSettings backend;  // optional in the file: sim
   std::string source_name;  // file the config came from, or "<embedded k70m.yaml>"
   // Number of quantities in the file that do not state where they come from.
   int unsourced_quantities = 0;

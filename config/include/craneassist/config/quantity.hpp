@@ -27,6 +27,7 @@ enum class Dimension {
   kTime,
   kFrequency,
   kInverseTime,
+  kAngularVelocity,
 };
 
 const char* to_string(Dimension dimension);

@@ -15,10 +15,13 @@
 namespace craneassist::input {
 
 // One command: from time t_s on, the tip velocity command is v_m_s (crane frame: x forward, y up,
-// z lateral), held until the next row's time (zero-order hold).
+// z lateral), held until the next row's time (zero-order hold). stop: the operator input was not
+// valid from t_s on (the file's optional `stop` column); v_m_s is then zero and the loop gives the
+// controller a non-finite command: a jerk-limited stop, then neutral valves.
 struct ReplayRow {
   double t_s;
   Eigen::Vector3d v_m_s;
+  bool stop = false;
 };
 
 // A replay that was rejected. what() is "FILE:LINE: field 'NAME': REASON", or "FILE:LINE: REASON"
@@ -29,7 +32,8 @@ class ReplayError : public std::runtime_error {
 
   const std::string& file() const noexcept { return file_; }
   std::size_t line() const noexcept { return line_; }
-  // Column name ("t", "v_x", "v_y", "v_z"), or empty when the error concerns no single field.
+  // Column name ("t", "v_x", "v_y", "v_z", "stop"), or empty when the error concerns no single
+  // field.
   const std::string& field() const noexcept { return field_; }
   const std::string& reason() const noexcept { return reason_; }
 
@@ -47,7 +51,7 @@ struct ReplayLimits {
 };
 
 // A validated replay: at least one row, times finite, >= 0 and strictly increasing, velocity
-// components finite and within the limits.
+// components finite and within the limits, zero in stop rows.
 class Replay {
  public:
   // Reads and validates a file; the source name in errors is path.string(). Throws ReplayError,
@@ -80,6 +84,8 @@ class ReplayCursor {
 
   // Velocity of the last row with t_s <= query (a row applies from exactly its own time on); zero
   // before the first row's time and for a NaN query; the last row's value after the last row.
+  // A stop row gives a quiet-NaN vector (what the live loop gives the controller on an input
+  // fault: the controller's jerk-limited stop, then neutral valves).
   Eigen::Vector3d command_at(double t_s) noexcept;
 
  private:
@@ -89,8 +95,9 @@ class ReplayCursor {
 };
 
 // Writes the header and rows in the replay format ('\n' line endings, shortest round-trip number
-// form): parse() reads them back bit-exactly. Does not validate; rows that break the rules (e.g.
-// non-increasing times) produce a file that parse() rejects.
+// form): parse() reads them back bit-exactly. The stop column is written only when some row has
+// stop set, so a file without stop rows keeps the 4-column form. Does not validate; rows that break
+// the rules (e.g. non-increasing times) produce a file that parse() rejects.
 void write_replay(std::ostream& out, const std::vector<ReplayRow>& rows);
 
 }  // namespace craneassist::input

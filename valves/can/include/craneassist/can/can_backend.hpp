@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -67,6 +68,7 @@ struct CanBackendCounters {
   std::uint64_t watchdog_block_frames = 0;  // block commands the watchdog sent itself
   std::uint64_t faults = 0;
   std::uint64_t log_dropped = 0;
+  std::uint64_t heartbeats_sent = 0;
 };
 
 class CanBackend final : public valves::MachineInterface {
@@ -88,6 +90,9 @@ class CanBackend final : public valves::MachineInterface {
   bool wait_for_feedback(double timeout_s, valves::MachineState& state);
   // The deliberate (re-)enable: clears a latched fault and lets write() command the valves.
   void enable();
+  // The normal end of a run (control thread, non-blocking): sends block to every section at once
+  // and a heartbeat in state disabled; further write()s send block until the next enable().
+  void disable();
   bool enabled() const { return enabled_.load(std::memory_order_acquire); }
   bool faulted() const { return fault_.load(std::memory_order_acquire) == kLatched; }
   FaultReason fault_reason() const { return reason_.load(std::memory_order_acquire); }
@@ -103,6 +108,8 @@ class CanBackend final : public valves::MachineInterface {
   struct Impl;
   enum : int { kClear = 0, kLatching = 1, kLatched = 2 };
   void latch(FaultReason reason, const char* fmt, ...);
+  void send_heartbeat(std::int64_t now_us, std::int64_t now_rt_us);
+  void read_pump(valves::PumpMeasurement& pump, std::int64_t now_rt_us, std::int64_t timeout_us);
   void watchdog_loop();
   void log_loop();
 

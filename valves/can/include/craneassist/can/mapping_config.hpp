@@ -66,9 +66,28 @@ struct JointMapping {
   std::optional<SignalSpec> pressure_b;  // Pa, rod side
 };
 
+// craneassist's own alive message (docs/can.md, "Heartbeat"): sent by the control loop at
+// `cycle`; the machine side blocks every section when it has not seen the counter advance for
+// `timeout`. A frozen loop stops it, while the watchdog's block commands keep flowing.
+struct HeartbeatSpec {
+  std::uint32_t id = 0;
+  bool extended = true;
+  double cycle_s = 0.02;   // send period
+  double timeout_s = 0.1;  // the receiver's supervision time
+};
+
+// Pump measurements on the bus (optional; for the log and telemetry, the controller does not
+// use them): supply pressure and delivered flow.
+struct PumpMapping {
+  std::optional<SignalSpec> pressure;  // Pa
+  std::optional<SignalSpec> flow;      // m^3/s (unit L/min, m^3/s, ...)
+};
+
 struct CanMapping {
   std::string source;  // the file name, for messages
   std::vector<JointMapping> joints;
+  std::optional<HeartbeatSpec> heartbeat;
+  PumpMapping pump;
 };
 
 // Throws config::ConfigError (file:line: field 'joints[1].position.length': reason).

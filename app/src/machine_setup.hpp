@@ -1,0 +1,51 @@
+// The machine behind `craneassist replay` and `craneassist sim`: the simulated crane or a machine
+// on a CAN bus, chosen by --backend or the crane config's `backend:` and `can:` values. One
+// place for the options, the choice, the start-up and the normal end, used by both commands.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <optional>
+#include <string>
+
+#include "can_commands.hpp"
+#include "craneassist/config/crane_config.hpp"
+#include "craneassist/sim_backend/sim_backend.hpp"
+#include "craneassist/valves/machine_interface.hpp"
+
+namespace craneassist::cli {
+
+// Empty values take the config's `backend:` and `can:` values.
+struct BackendArgs {
+  std::string backend;                       // sim | can
+  std::string can_iface;                     // --backend can: the interface
+  std::string mapping_file;                  // --backend can: the mapping YAML
+  std::string can_log;                       // --backend can: candump -L log of all traffic
+  std::optional<double> feedback_timeout_s;  // --backend can: lost feedback after this long
+};
+
+// --backend, --can, --mapping, --can-log, --can-feedback-timeout.
+void add_backend_options(CLI::App& command, BackendArgs& args);
+
+// The resolved choice: --backend, else the config's `backend:`.
+bool uses_can_backend(const BackendArgs& args, const config::CraneConfig& cfg);
+
+// Holds the machine of a run: the simulator or the CAN machine (transport and backend).
+class Machine {
+ public:
+  valves::MachineInterface& get() { return *machine_; }
+  bool is_can() const { return can_.has_value(); }
+  can::CanBackend* can_backend() { return can_ ? &can_->backend() : nullptr; }
+  // Builds and starts the machine: the CAN backend waits up to 2 s for every joint's feedback
+  // and is enabled. Returns kExitOk, or logs why not and returns the exit code.
+  int open(const config::CraneConfig& cfg, const BackendArgs& args);
+  // The normal end of a run on CAN: every section blocked (CanBackend::disable), the backend
+  // stopped and its report printed. Returns kExitRuntime after a CAN fault, else kExitOk.
+  int finish();
+
+ private:
+  std::optional<sim_backend::SimBackend> sim_;
+  std::optional<CanMachine> can_;
+  valves::MachineInterface* machine_ = nullptr;
+};
+
+}  // namespace craneassist::cli

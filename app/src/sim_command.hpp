@@ -1,0 +1,32 @@
+// `craneassist sim`: the live loop, driven by an operator (keyboard in the terminal, an evdev or
+// SDL joystick) or a replay file, with optional log and recording. On the simulated crane by
+// default; with --backend can (or `backend: can` in the crane config) it drives the machine on
+// the CAN bus.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "machine_setup.hpp"
+
+namespace craneassist::cli {
+
+struct SimArgs {
+  std::string config_file;         // empty: the embedded reference crane
+  std::vector<std::string> input;  // keyboard | evdev | sdl | replay FILE; empty: keyboard
+  std::string joystick_file;       // mapping YAML; empty: the embedded gamepad default
+  std::string device;              // evdev: device path (overrides the mapping's)
+  double duration_s = 0.0;         // 0: until q, Ctrl-C or SIGTERM
+  std::string log_file;            // empty: no log
+  std::string record_file;         // empty: no recording
+  bool no_realtime = false;        // --input replay only: as fast as possible
+  std::optional<double> payload_kg;
+  BackendArgs machine;  // empty values: the config's backend: and can:
+};
+
+CLI::App* add_sim_command(CLI::App& cli, SimArgs& args);
+int run_sim_command(const SimArgs& args);
+
+}  // namespace craneassist::cli

@@ -1,0 +1,96 @@
+#include "craneassist/input/sdl_source.hpp"
+
+#include <SDL.h>
+
+#include <chrono>
+#include <stdexcept>
+#include <string>
+
+namespace craneassist::input {
+namespace {
+
+double steady_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+SdlSource::SdlSource(const JoystickMapping& mapping, const Options& options)
+    : mapper_(mapping), options_(options) {
+  SDL_SetHint(SDL_HINT_JOYSTICK_ALLOW_BACKGROUND_EVENTS, "1");
+  if (SDL_InitSubSystem(SDL_INIT_GAMECONTROLLER) != 0) {
+    throw std::runtime_error(std::string("SDL: cannot initialise game controllers: ") +
+                             SDL_GetError());
+  }
+  if (options_.own_thread) {
+    thread_ = std::thread([this] {
+      while (running_.load()) service();
+    });
+  }
+}
+
+SdlSource::~SdlSource() {
+  running_.store(false);
+  if (thread_.joinable()) thread_.join();
+  if (controller_ != nullptr) SDL_GameControllerClose(controller_);
+  SDL_QuitSubSystem(SDL_INIT_GAMECONTROLLER);
+}
+
+void SdlSource::open_first() {
+  for (int i = 0; i < SDL_NumJoysticks(); ++i) {
+    if (!SDL_IsGameController(i)) continue;
+    controller_ = SDL_GameControllerOpen(i);
+    if (controller_ != nullptr) {
+      instance_id_ = SDL_JoystickInstanceID(SDL_GameControllerGetJoystick(controller_));
+      return;
+    }
+  }
+}
+
+void SdlSource::service() {
+  SDL_Event e;
+  bool have_event = SDL_WaitEventTimeout(&e, options_.wait_ms) != 0;
+  while (have_event) {
+    if (e.type == SDL_CONTROLLERDEVICEREMOVED && controller_ != nullptr &&
+        e.cdevice.which == instance_id_) {
+      SDL_GameControllerClose(controller_);
+      controller_ = nullptr;
+      instance_id_ = -1;
+    }
+    have_event = SDL_PollEvent(&e) != 0;
+  }
+  if (controller_ == nullptr) open_first();  // at start and after SDL_CONTROLLERDEVICEADDED
+  published_.connected = controller_ != nullptr;
+  published_.has_state = controller_ != nullptr;
+  if (controller_ != nullptr) {
+    for (std::size_t a = 0; a < kGamepadAxisCount; ++a) {
+      const double raw =
+          SDL_GameControllerGetAxis(controller_, static_cast<SDL_GameControllerAxis>(a));
+      // Sticks -32768..32767, triggers 0..32767.
+      published_.pad.axes[a] = raw < 0.0 ? raw / 32768.0 : raw / 32767.0;
+    }
+    for (std::size_t b = 0; b < kGamepadButtonCount; ++b) {
+      published_.pad.buttons[b] =
+          SDL_GameControllerGetButton(controller_, static_cast<SDL_GameControllerButton>(b)) != 0;
+    }
+  } else {
+    published_.pad = {};
+  }
+  published_.stamp_s = steady_s();
+  latest_.publish(published_);
+}
+
+void SdlSource::begin_cycle(double /*now_s*/, const Eigen::Vector3d& tip_m) noexcept {
+  tip_ = tip_m;
+}
+
+SourceState SdlSource::poll(OperatorCommand& out) noexcept {
+  latest_.try_take(taken_);
+  if (!taken_.connected) return SourceState::kDisconnected;
+  out.v_m_s = mapper_.map(taken_.pad, tip_);
+  out.deadman = mapper_.deadman(taken_.pad);
+  out.stamp_s = taken_.stamp_s;
+  return SourceState::kOk;
+}
+
+}  // namespace craneassist::input

@@ -1,0 +1,84 @@
+#!/bin/sh
+# craneassist sim --input keyboard in a real terminal: a detached tmux session, keys sent with
+# send-keys, the screen read with capture-pane. Checks that the deadman and a held key (sent at
+# a terminal's auto-repeat rate) move the tip the commanded way, that q quits, that SIGTERM
+# stops it, and that the terminal settings are restored both times.
+# Usage: sim_keyboard_tmux.sh CRANEASSIST
+set -eu
+bin=$1
+command -v tmux >/dev/null || { echo "tmux is not installed (tools/install-deps.sh)"; exit 1; }
+work=$(mktemp -d)
+sock="$work/tmux.sock"
+session=craneassist_kb
+cleanup() { tmux -S "$sock" kill-server 2>/dev/null || true; rm -rf "$work"; }
+trap cleanup EXIT
+
+pane() { tmux -S "$sock" capture-pane -p -t "$session" | grep -v "^ *$"; }
+keys() { tmux -S "$sock" send-keys -t "$session" "$@"; }
+# wait_for TEXT SECONDS: until the pane shows TEXT.
+wait_for() {
+  i=0
+  while ! pane | grep -q -- "$1"; do
+    i=$((i + 1))
+    if [ $i -gt $(($2 * 10)) ]; then
+      echo "timed out waiting for '$1'; the pane:"; pane; exit 1
+    fi
+    sleep 0.1
+  done
+}
+# hold KEY SECONDS: the key as a terminal sends it while held (auto-repeat every 30 ms).
+hold() {
+  n=$(awk "BEGIN { print int($2 / 0.03) }")
+  i=0
+  while [ $i -lt $n ]; do keys "$1"; sleep 0.03; i=$((i + 1)); done
+}
+
+tmux -S "$sock" new-session -d -s "$session" -x 200 -y 40 sh
+keys "stty -g > $work/before.stty; $bin sim --input keyboard --log $work/kb.csv; stty -g > $work/after.stty; echo SESSION1-\$((40 + 2))" Enter
+wait_for "keys: space deadman" 10
+wait_for "stopped" 5
+hold w 0.5  # a key without the deadman: nothing moves
+pane | tail -1 | grep -q "stopped .*deadman off.* 0.00 m/s | deadman released" ||
+  { echo "moved without the deadman:"; pane | tail -1; exit 1; }
+keys Space
+wait_for "deadman ON" 3
+hold w 2.0        # reach out
+sleep 0.3
+hold r 1.0        # then up
+wait_for "running" 1
+pane | tail -3
+sleep 1.5
+keys q
+wait_for SESSION1-42 10
+pane | tail -12
+cmp "$work/before.stty" "$work/after.stty" || { echo "terminal settings not restored after q"; exit 1; }
+# Echo is back on: typed text appears on the screen.
+keys "echo-check-abc"
+wait_for "echo-check-abc" 3
+keys C-u
+
+# The log: at rest before the deadman; out (x) while w was held, then up (y); no slew (z).
+awk -F, -v out="$work/moves.txt" '
+  NR == 1 { next }
+  NR == 2 { x0 = $8; y0 = $9; z0 = $10 }
+  $1 <= 0.4 && ($11 * $11 + $12 * $12 + $13 * $13) > 1e-6 { early = 1 }
+  { x = $8; y = $9; z = $10; vx = $11; vy = $12
+    if (vx > peak_vx) peak_vx = vx
+    if (vy > peak_vy) peak_vy = vy }
+  END {
+    printf "tip moved dx %.3f dy %.3f dz %.3f m; peak vx %.3f vy %.3f m/s\n", x - x0, y - y0, z - z0, peak_vx, peak_vy
+    ok = (x - x0 > 0.3) && (y - y0 > 0.1) && (z - z0 < 0.02) && (z0 - z < 0.02) && !early
+    print ok > out
+  }' "$work/kb.csv"
+[ "$(cat "$work/moves.txt")" = 1 ] || { echo "the crane did not move as commanded"; exit 1; }
+
+# SIGTERM while the deadman is on: stops, restores the terminal.
+keys "stty -g > $work/before2.stty; sh -c 'echo \$\$ > $work/pid; exec $bin sim --input keyboard'; stty -g > $work/after2.stty; echo SESSION2-\$((40 + 2))" Enter
+wait_for "keys: space deadman" 10
+keys Space
+wait_for "deadman ON" 3
+kill -TERM "$(cat "$work/pid")"
+wait_for SESSION2-42 10
+cmp "$work/before2.stty" "$work/after2.stty" || { echo "terminal settings not restored after SIGTERM"; exit 1; }
+pane | grep -q "craneassist sim: keyboard input" || { echo "no summary after SIGTERM"; pane; exit 1; }
+echo "keyboard session OK"

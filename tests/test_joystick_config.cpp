@@ -1,0 +1,126 @@
+// The joystick mapping file: the shipped default reads back as the built-in gamepad layout, and
+// every mistake is reported with file, line and field.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "craneassist/config/joystick_config.hpp"
+
+using namespace craneassist;
+
+namespace {
+
+std::string default_text() {
+  std::ifstream in(std::string(CRANEASSIST_SOURCE_DIR) + "/config/joysticks/gamepad.yaml");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The error after replacing `from` by `to` in the default file.
+config::ConfigError error_after_edit(const std::string& from, const std::string& to) {
+  std::string text = default_text();
+  const auto pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  text.replace(pos, from.size(), to);
+  try {
+    config::parse_joystick_config(text, "pad.yaml");
+  } catch (const config::ConfigError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no error for " << to;
+  return config::ConfigError("", 0, "", "");
+}
+
+}  // namespace
+
+TEST(JoystickConfig, ShippedDefaultIsTheGamepadLayout) {
+  const auto c = config::default_joystick_config();
+  const auto d = input::default_gamepad_mapping();
+  EXPECT_EQ(c.mapping.frame, input::MappingFrame::kCylindrical);
+  EXPECT_EQ(c.mapping.deadman, input::GamepadButton::kRightShoulder);
+  for (std::size_t i = 0; i < input::kOperatorAxisCount; ++i) {
+    EXPECT_EQ(c.mapping.axes[i].axis, d.axes[i].axis) << i;
+    EXPECT_EQ(c.mapping.axes[i].invert, d.axes[i].invert) << i;
+    EXPECT_DOUBLE_EQ(c.mapping.axes[i].max, d.axes[i].max) << i;
+    EXPECT_DOUBLE_EQ(c.mapping.axes[i].deadband, d.axes[i].deadband) << i;
+    EXPECT_DOUBLE_EQ(c.mapping.axes[i].expo, d.axes[i].expo) << i;
+  }
+  EXPECT_DOUBLE_EQ(c.monitor.stale_timeout_s, 0.1);
+  EXPECT_DOUBLE_EQ(c.monitor.max_speed_m_s, 2.0);
+  EXPECT_DOUBLE_EQ(c.keyboard.first_hold_s, 0.55);
+  EXPECT_DOUBLE_EQ(c.keyboard.repeat_hold_s, 0.15);
+}
+
+TEST(JoystickConfig, AngularSlewAndCartesianFrame) {
+  std::string text = default_text();
+  text.replace(text.find("slew: tangential"), 16, "slew: angular");
+  text.replace(text.find("max: 0.5 m/s"), 12, "max: 20 deg/s");
+  text.replace(text.find("frame: cylindrical"), 18, "frame: cartesian");
+  const auto c = config::parse_joystick_config(text, "pad.yaml");
+  EXPECT_EQ(c.mapping.slew, input::SlewMode::kAngular);
+  EXPECT_EQ(c.mapping.frame, input::MappingFrame::kCartesian);
+  EXPECT_NEAR(c.mapping.axes[0].max, 20.0 * M_PI / 180.0, 1e-12);
+}
+
+TEST(JoystickConfig, ErrorsNameFileLineAndField) {
+  auto e = error_after_edit("axis: left_y", "axis: left_z");
+  EXPECT_EQ(e.file(), "pad.yaml");
+  EXPECT_EQ(e.field(), "joystick.axes.radial.axis");
+  EXPECT_EQ(e.line(), 26);
+  EXPECT_NE(e.reason().find("unknown axis 'left_z'"), std::string::npos) << e.what();
+
+  e = error_after_edit("deadman: right_shoulder", "deadman: right_shoe");
+  EXPECT_EQ(e.field(), "joystick.deadman");
+  EXPECT_EQ(e.line(), 14);
+
+  e = error_after_edit("stale_timeout: 100 ms", "stale_timeout: 100 m");
+  EXPECT_EQ(e.field(), "input.stale_timeout");
+  EXPECT_EQ(e.line(), 8);
+  EXPECT_NE(e.reason().find("not a time unit"), std::string::npos) << e.what();
+
+  e = error_after_edit("deadband: 0.12", "deadband: 0.95");
+  EXPECT_EQ(e.field(), "joystick.axes.lateral.deadband");
+  EXPECT_EQ(e.reason(), "must be 0 to 0.9");
+
+  e = error_after_edit("      expo: 0.4\n      max: 0.4 m/s",
+                       "      expo: 0.4\n      maxx: 0.4 m/s");
+  EXPECT_EQ(e.field(), "joystick.axes.vertical.maxx");
+  EXPECT_NE(e.reason().find("unknown field"), std::string::npos);
+
+  e = error_after_edit("invert: true", "invert: yes please");
+  EXPECT_EQ(e.field(), "joystick.axes.radial.invert");
+
+  e = error_after_edit("frame: cylindrical", "frame: polar");
+  EXPECT_EQ(e.field(), "joystick.frame");
+
+  e = error_after_edit("format: craneassist-joystick/1", "format: craneassist-crane/1");
+  EXPECT_EQ(e.field(), "format");
+  EXPECT_EQ(e.line(), 4);
+
+  e = error_after_edit("first_hold: 550 ms", "first_hold: 5 s");
+  EXPECT_EQ(e.field(), "keyboard.first_hold");
+
+  // The angular slew wants an angular velocity.
+  e = error_after_edit("slew: tangential", "slew: angular");
+  EXPECT_EQ(e.field(), "joystick.axes.lateral.max");
+  EXPECT_NE(e.reason().find("angular velocity"), std::string::npos) << e.what();
+}
+
+TEST(JoystickConfig, MissingFileAndYamlSyntax) {
+  try {
+    config::load_joystick_config("/nonexistent/pad.yaml");
+    FAIL();
+  } catch (const config::ConfigError& e) {
+    EXPECT_EQ(e.file(), "/nonexistent/pad.yaml");
+    EXPECT_EQ(e.line(), 0);
+  }
+  try {
+    config::parse_joystick_config("format: [\n", "x.yaml");
+    FAIL();
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("YAML syntax"), std::string::npos);
+  }
+}
