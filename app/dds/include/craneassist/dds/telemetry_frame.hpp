@@ -1,0 +1,48 @@
+// What the control loop hands to telemetry once per cycle: one plain, trivially copyable frame
+// (no allocation, static strings only), and what stays fixed for a run. Plain C++17: no Fast DDS
+// or Eigen types.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace craneassist::dds {
+
+inline constexpr int kMaxJoints = 8;
+
+struct TelemetryFrame {
+  std::uint64_t cycle = 0;
+  double t_s = 0.0;          // machine time
+  std::int64_t stamp_ns = 0;  // CLOCK_MONOTONIC at push() (set by the publisher)
+  int dof = 0;
+  std::array<double, kMaxJoints> q{}, q_ref{}, qdot{}, cylinder_pos_m{}, cylinder_vel_m_s{},
+      load_pressure_pa{}, spool{};
+  std::array<double, 3> tip_m{}, tip_v_m_s{}, command_m_s{}, reference_m_s{};
+  double pump_flow_m3_s = 0.0, pump_pressure_pa = 0.0, pump_power_w = 0.0, energy_j = 0.0;
+  double flow_demand_m3_s = 0.0, ref_power_w = 0.0;
+  double scale = 0.0, s = 0.0, sdot = 0.0, sddot = 0.0, sdddot = 0.0, sddot_min = 0.0,
+         sddot_max = 0.0, tip_error_m = 0.0;
+  // Static strings only (string literals, to_string of enums): never freed.
+  const char* status = "";
+  const char* stop_reason = "";
+  const char* active_limit = "";
+  const char* pump_limit = "";
+  const char* input_source = "";
+  bool deadman = false;
+};
+static_assert(std::is_trivially_copyable_v<TelemetryFrame>);
+
+// Fixed for a run: published in every sample where a dashboard needs it.
+struct TelemetryInfo {
+  std::string crane;    // model name
+  std::string backend;  // sim, can
+  std::string pump_mode;
+  std::vector<std::string> joint_names;
+  double flow_limit_m3_s = 0.0;
+  double power_limit_w = 0.0;
+};
+
+}  // namespace craneassist::dds

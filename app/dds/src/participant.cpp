@@ -1,0 +1,158 @@
+#include "participant.hpp"
+
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
+
+#include <mutex>
+#include <stdexcept>
+
+#include "craneassist_msgsPubSubTypes.h"
+#include "craneassist_msgsTypeObject.h"
+
+namespace craneassist::dds {
+
+namespace fdds = eprosima::fastdds::dds;
+
+ParticipantOptions participant_options(const config::TelemetryConfig& c) {
+  ParticipantOptions o;
+  o.domain_id = c.domain_id;
+  o.name = c.participant_name;
+  o.transport = c.transport;
+  return o;
+}
+
+void ParticipantDeleter::operator()(fdds::DomainParticipant* p) const {
+  if (p == nullptr) return;
+  p->delete_contained_entities();
+  fdds::DomainParticipantFactory::get_instance()->delete_participant(p);
+}
+
+namespace {
+
+void add_property(fdds::DomainParticipantQos& qos, const std::string& name,
+                  const std::string& value) {
+  qos.properties().properties().emplace_back(name, value);
+}
+
+template <typename PubSubType>
+void register_type(fdds::DomainParticipant& p) {
+  fdds::TypeSupport type(new PubSubType());
+  type->auto_fill_type_object(true);
+  type->auto_fill_type_information(true);
+  if (type.register_type(&p) != ReturnCode_t::RETCODE_OK) {
+    throw std::runtime_error("DDS: cannot register type " + std::string(type.get_type_name()));
+  }
+}
+
+}  // namespace
+
+ParticipantPtr make_participant(const ParticipantOptions& options) {
+  static std::once_flag type_objects;
+  std::call_once(type_objects, [] { registercraneassist_msgsTypes(); });
+
+  fdds::DomainParticipantQos qos = fdds::PARTICIPANT_QOS_DEFAULT;
+  qos.name(options.name);
+  if (options.transport != config::DdsTransport::kDefault) {
+    qos.transport().use_builtin_transports = false;
+    if (options.transport == config::DdsTransport::kUdp) {
+      qos.transport().user_transports.push_back(
+          std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>());
+    } else {
+      qos.transport().user_transports.push_back(
+          std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+    }
+  }
+  const auto& sec = options.security;
+  if (!sec.empty()) {
+    if (!sec.complete()) {
+      throw std::runtime_error(
+          "DDS Security: every file is needed (identity_ca, identity_certificate, private_key, "
+          "permissions_ca, governance, permissions)");
+    }
+    add_property(qos, "dds.sec.auth.plugin", "builtin.PKI-DH");
+    add_property(qos, "dds.sec.auth.builtin.PKI-DH.identity_ca", "file:" + sec.identity_ca);
+    add_property(qos, "dds.sec.auth.builtin.PKI-DH.identity_certificate",
+                 "file:" + sec.identity_certificate);
+    add_property(qos, "dds.sec.auth.builtin.PKI-DH.private_key", "file:" + sec.private_key);
+    add_property(qos, "dds.sec.access.plugin", "builtin.Access-Permissions");
+    add_property(qos, "dds.sec.access.builtin.Access-Permissions.permissions_ca",
+                 "file:" + sec.permissions_ca);
+    add_property(qos, "dds.sec.access.builtin.Access-Permissions.governance",
+                 "file:" + sec.governance);
+    add_property(qos, "dds.sec.access.builtin.Access-Permissions.permissions",
+                 "file:" + sec.permissions);
+    add_property(qos, "dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
+  }
+  ParticipantPtr p(fdds::DomainParticipantFactory::get_instance()->create_participant(
+      static_cast<fdds::DomainId_t>(options.domain_id), qos));
+  if (!p) {
+    throw std::runtime_error(
+        sec.empty() ? "DDS: cannot create the domain participant (domain " +
+                          std::to_string(options.domain_id) + ")"
+                    : "DDS Security: cannot create the secure participant (check the "
+                      "certificates, the key, and that governance and permissions are signed by "
+                      "the permissions CA; Fast DDS logs the reason above)");
+  }
+  register_type<craneassist::msg::StatusPubSubType>(*p);
+  register_type<craneassist::msg::JointStatePubSubType>(*p);
+  register_type<craneassist::msg::HydraulicsPubSubType>(*p);
+  register_type<craneassist::msg::CommandPathPubSubType>(*p);
+  register_type<craneassist::msg::OperatorCommandPubSubType>(*p);
+  return p;
+}
+
+fdds::Topic* get_topic(fdds::DomainParticipant& p, Topic topic) {
+  const TopicInfo& info = topic_info(topic);
+  const std::string name(info.dds_name);
+  if (fdds::TopicDescription* existing = p.lookup_topicdescription(name)) {
+    return static_cast<fdds::Topic*>(existing);
+  }
+  fdds::Topic* t = p.create_topic(name, std::string(info.type_name), fdds::TOPIC_QOS_DEFAULT);
+  if (t == nullptr) throw std::runtime_error("DDS: cannot create topic " + name);
+  return t;
+}
+
+fdds::DataWriterQos writer_qos(const config::TopicSettings& s) {
+  fdds::DataWriterQos q = fdds::DATAWRITER_QOS_DEFAULT;
+  q.reliability().kind = s.reliability == config::Reliability::kReliable
+                             ? fdds::RELIABLE_RELIABILITY_QOS
+                             : fdds::BEST_EFFORT_RELIABILITY_QOS;
+  // A reliable writer whose history is full waits at most this long (on the publisher thread,
+  // never the control loop), then the sample is counted as an error.
+  q.reliability().max_blocking_time = eprosima::fastrtps::Duration_t(0, 10000000);
+  q.durability().kind = s.durability == config::Durability::kTransientLocal
+                            ? fdds::TRANSIENT_LOCAL_DURABILITY_QOS
+                            : fdds::VOLATILE_DURABILITY_QOS;
+  q.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = s.depth;
+  return q;
+}
+
+fdds::DataReaderQos reader_qos(const config::TopicSettings& s) {
+  fdds::DataReaderQos q = fdds::DATAREADER_QOS_DEFAULT;
+  q.reliability().kind = s.reliability == config::Reliability::kReliable
+                             ? fdds::RELIABLE_RELIABILITY_QOS
+                             : fdds::BEST_EFFORT_RELIABILITY_QOS;
+  q.durability().kind = s.durability == config::Durability::kTransientLocal
+                            ? fdds::TRANSIENT_LOCAL_DURABILITY_QOS
+                            : fdds::VOLATILE_DURABILITY_QOS;
+  q.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = s.depth;
+  return q;
+}
+
+config::TopicSettings default_reader_settings(Topic topic) {
+  (void)topic;
+  // A best-effort, volatile reader matches every writer whatever its configured QoS (a reliable
+  // reader would not match a best-effort writer; a transient-local one not a volatile writer).
+  config::TopicSettings s;
+  s.reliability = config::Reliability::kBestEffort;
+  s.durability = config::Durability::kVolatile;
+  s.depth = 8;
+  return s;
+}
+
+}  // namespace craneassist::dds

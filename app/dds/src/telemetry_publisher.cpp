@@ -1,0 +1,275 @@
+#include "craneassist/dds/telemetry_publisher.hpp"
+
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/publisher/qos/PublisherQos.hpp>
+#include <semaphore.h>
+#include <time.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+#include "craneassist_msgs.h"
+#include "participant.hpp"
+
+namespace craneassist::dds {
+
+namespace fdds = eprosima::fastdds::dds;
+
+std::int64_t monotonic_ns() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+}
+
+namespace {
+
+constexpr int kTelemetryTopics = 4;  // status, joints, hydraulics, command_path
+
+template <typename Header>
+void fill_header(Header& h, const TelemetryFrame& f) {
+  h.cycle(f.cycle);
+  h.t_s(f.t_s);
+  h.stamp_ns(f.stamp_ns);
+}
+
+template <std::size_t N>
+std::vector<double> first(const std::array<double, N>& a, int n) {
+  return std::vector<double>(a.begin(), a.begin() + n);
+}
+
+}  // namespace
+
+struct TelemetryPublisher::Impl {
+  Impl(const config::TelemetryConfig& config, TelemetryInfo run_info, std::size_t capacity)
+      : info(std::move(run_info)), ring(capacity + 1) {
+    const config::TopicSettings* settings[kTelemetryTopics] = {
+        &config.status, &config.joints, &config.hydraulics, &config.command_path};
+    for (int i = 0; i < kTelemetryTopics; ++i) period_s[i] = 1.0 / settings[i]->rate_hz;
+    participant = make_participant(participant_options(config));
+    publisher = participant->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
+    if (publisher == nullptr) throw std::runtime_error("DDS: cannot create the publisher");
+    const Topic topics[kTelemetryTopics] = {Topic::kStatus, Topic::kJoints, Topic::kHydraulics,
+                                            Topic::kCommandPath};
+    for (int i = 0; i < kTelemetryTopics; ++i) {
+      writers[i] = publisher->create_datawriter(get_topic(*participant, topics[i]),
+                                                writer_qos(*settings[i]));
+      if (writers[i] == nullptr) {
+        throw std::runtime_error("DDS: cannot create the writer of " +
+                                 std::string(topic_info(topics[i]).dds_name));
+      }
+    }
+    joints.names(info.joint_names);
+    sem_init(&wake, 0, 0);
+    thread = std::thread([this] { run(); });
+  }
+
+  ~Impl() { close(); }
+
+  bool push(const TelemetryFrame& frame) noexcept {
+    const std::size_t h = head.load(std::memory_order_relaxed);
+    const std::size_t next = (h + 1) % ring.size();
+    pushed.fetch_add(1, std::memory_order_relaxed);
+    if (next == tail.load(std::memory_order_acquire)) {
+      dropped.fetch_add(1, std::memory_order_relaxed);
+      return false;
+    }
+    ring[h] = frame;
+    ring[h].stamp_ns = monotonic_ns();
+    head.store(next, std::memory_order_release);
+    sem_post(&wake);
+    return true;
+  }
+
+  void close() {
+    if (!thread.joinable()) return;
+    stop.store(true);
+    sem_post(&wake);
+    thread.join();
+    sem_destroy(&wake);
+    for (auto*& w : writers) w = nullptr;
+    participant.reset();
+  }
+
+  void run() {
+    TelemetryFrame latest;
+    bool have_latest = false;
+    while (true) {
+      timespec deadline{};
+      clock_gettime(CLOCK_REALTIME, &deadline);
+      deadline.tv_nsec += 100000000;
+      if (deadline.tv_nsec >= 1000000000) {
+        deadline.tv_sec += 1;
+        deadline.tv_nsec -= 1000000000;
+      }
+      while (sem_timedwait(&wake, &deadline) != 0 && errno == EINTR) {
+      }
+      const bool stopping = stop.load();
+      while (true) {
+        const std::size_t t = tail.load(std::memory_order_relaxed);
+        if (t == head.load(std::memory_order_acquire)) break;
+        latest = ring[t];
+        tail.store((t + 1) % ring.size(), std::memory_order_release);
+        have_latest = true;
+        publish(latest, false);
+      }
+      if (stopping) {
+        if (have_latest) publish(latest, true);  // the final state on every topic
+        return;
+      }
+    }
+  }
+
+  // Writes each topic whose period has passed (by machine time); force: every topic not yet
+  // written for this frame.
+  void publish(const TelemetryFrame& f, bool force) {
+    for (int i = 0; i < kTelemetryTopics; ++i) {
+      const bool due = !written_once[i] || f.t_s < last_t[i] ||
+                       f.t_s - last_t[i] >= period_s[i] - 1e-9;
+      if (!(due || (force && last_cycle[i] != f.cycle))) continue;
+      last_t[i] = f.t_s;
+      last_cycle[i] = f.cycle;
+      written_once[i] = true;
+      bool ok = false;
+      switch (i) {
+        case 0:
+          ok = write_status(f);
+          break;
+        case 1:
+          ok = write_joints(f);
+          break;
+        case 2:
+          ok = write_hydraulics(f);
+          break;
+        default:
+          ok = write_command_path(f);
+          break;
+      }
+      if (ok) {
+        written[i].fetch_add(1, std::memory_order_relaxed);
+      } else {
+        write_errors.fetch_add(1, std::memory_order_relaxed);
+      }
+    }
+  }
+
+  bool write_status(const TelemetryFrame& f) {
+    fill_header(status.header(), f);
+    status.crane(info.crane);
+    status.backend(info.backend);
+    status.status(f.status);
+    status.stop_reason(f.stop_reason);
+    status.active_limit(f.active_limit);
+    status.pump_limit(f.pump_limit);
+    status.input_source(f.input_source);
+    status.deadman(f.deadman);
+    status.scale(f.scale);
+    status.tip_speed_m_s(std::sqrt(f.tip_v_m_s[0] * f.tip_v_m_s[0] +
+                                   f.tip_v_m_s[1] * f.tip_v_m_s[1] +
+                                   f.tip_v_m_s[2] * f.tip_v_m_s[2]));
+    status.tip_error_m(f.tip_error_m);
+    return writers[0]->write(&status);
+  }
+
+  bool write_joints(const TelemetryFrame& f) {
+    fill_header(joints.header(), f);
+    const int n = std::min(f.dof, kMaxJoints);
+    joints.q(first(f.q, n));
+    joints.q_ref(first(f.q_ref, n));
+    joints.qdot(first(f.qdot, n));
+    joints.cylinder_pos_m(first(f.cylinder_pos_m, n));
+    joints.cylinder_vel_m_s(first(f.cylinder_vel_m_s, n));
+    joints.load_pressure_pa(first(f.load_pressure_pa, n));
+    joints.spool(first(f.spool, n));
+    joints.tip_m(f.tip_m);
+    joints.tip_v_m_s(f.tip_v_m_s);
+    return writers[1]->write(&joints);
+  }
+
+  bool write_hydraulics(const TelemetryFrame& f) {
+    fill_header(hydraulics.header(), f);
+    hydraulics.pump_mode(info.pump_mode);
+    hydraulics.flow_m3_s(f.pump_flow_m3_s);
+    hydraulics.pressure_pa(f.pump_pressure_pa);
+    hydraulics.power_w(f.pump_power_w);
+    hydraulics.energy_j(f.energy_j);
+    hydraulics.flow_limit_m3_s(info.flow_limit_m3_s);
+    hydraulics.power_limit_w(info.power_limit_w);
+    hydraulics.flow_demand_m3_s(f.flow_demand_m3_s);
+    hydraulics.ref_power_w(f.ref_power_w);
+    hydraulics.pump_limit(f.pump_limit);
+    return writers[2]->write(&hydraulics);
+  }
+
+  bool write_command_path(const TelemetryFrame& f) {
+    fill_header(command_path.header(), f);
+    command_path.input_source(f.input_source);
+    command_path.deadman(f.deadman);
+    command_path.command_m_s(f.command_m_s);
+    command_path.reference_m_s(f.reference_m_s);
+    command_path.scale(f.scale);
+    command_path.s(f.s);
+    command_path.sdot(f.sdot);
+    command_path.sddot(f.sddot);
+    command_path.sdddot(f.sdddot);
+    command_path.sddot_min(f.sddot_min);
+    command_path.sddot_max(f.sddot_max);
+    return writers[3]->write(&command_path);
+  }
+
+  PublisherStats stats() const {
+    PublisherStats s;
+    s.frames_pushed = pushed.load();
+    s.frames_dropped = dropped.load();
+    for (int i = 0; i < kTelemetryTopics; ++i) {
+      s.samples_written[i] = written[i].load();
+      fdds::PublicationMatchedStatus m;
+      if (writers[i] != nullptr &&
+          writers[i]->get_publication_matched_status(m) == ReturnCode_t::RETCODE_OK) {
+        s.matched_readers += m.current_count;
+      }
+    }
+    s.write_errors = write_errors.load();
+    return s;
+  }
+
+  TelemetryInfo info;
+  ParticipantPtr participant;
+  fdds::Publisher* publisher = nullptr;
+  fdds::DataWriter* writers[kTelemetryTopics] = {};
+  double period_s[kTelemetryTopics] = {};
+  // Publisher thread only:
+  double last_t[kTelemetryTopics] = {};
+  std::uint64_t last_cycle[kTelemetryTopics] = {};
+  bool written_once[kTelemetryTopics] = {};
+  craneassist::msg::Status status;
+  craneassist::msg::JointState joints;
+  craneassist::msg::Hydraulics hydraulics;
+  craneassist::msg::CommandPath command_path;
+  // The ring (loop thread produces, publisher thread consumes).
+  std::vector<TelemetryFrame> ring;
+  std::atomic<std::size_t> head{0}, tail{0};
+  sem_t wake{};
+  std::atomic<bool> stop{false};
+  std::atomic<std::uint64_t> pushed{0}, dropped{0}, write_errors{0};
+  std::atomic<std::uint64_t> written[kTelemetryTopics] = {};
+  std::thread thread;
+};
+
+TelemetryPublisher::TelemetryPublisher(const config::TelemetryConfig& config, TelemetryInfo info,
+                                       std::size_t capacity)
+    : impl_(std::make_unique<Impl>(config, std::move(info), capacity)) {}
+
+TelemetryPublisher::~TelemetryPublisher() = default;
+
+bool TelemetryPublisher::push(const TelemetryFrame& frame) noexcept { return impl_->push(frame); }
+
+void TelemetryPublisher::close() { impl_->close(); }
+
+PublisherStats TelemetryPublisher::stats() const { return impl_->stats(); }
+
+}  // namespace craneassist::dds

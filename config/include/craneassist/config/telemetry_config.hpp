@@ -1,0 +1,79 @@
+// The DDS settings (config/telemetry/default.yaml, docs/telemetry.md): domain, transport, each
+// telemetry topic's rate and QoS, and the DDS command input with its DDS Security files.
+// Strict reader: unknown fields, unknown QoS names and out-of-range values are errors naming
+// file, line and field.
+//
+// This header is plain C++17 (no Eigen, no yaml-cpp): the DDS module, compiled as C++17 because
+// Debian's Fast CDR 1.0 headers do not compile as C++20, includes it.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+namespace craneassist::config {
+
+enum class Reliability { kBestEffort, kReliable };
+enum class Durability { kVolatile, kTransientLocal };
+enum class DdsTransport { kDefault, kUdp, kShm };
+
+const char* to_string(Reliability r);
+const char* to_string(Durability d);
+const char* to_string(DdsTransport t);
+
+struct TopicSettings {
+  double rate_hz = 50.0;  // published at most this often (the loop runs at the control rate)
+  Reliability reliability = Reliability::kBestEffort;
+  Durability durability = Durability::kVolatile;
+  int depth = 1;  // KEEP_LAST history depth
+};
+
+// The DDS Security files of a participant (docs/telemetry.md#secure-remote-commands). Paths are
+// resolved against the config file's folder. All empty: no security.
+struct SecurityFiles {
+  std::string identity_ca;           // CA certificate that signed every identity (PEM)
+  std::string identity_certificate;  // this participant's certificate (PEM)
+  std::string private_key;           // its private key (PEM)
+  std::string permissions_ca;        // CA certificate that signed governance and permissions
+  std::string governance;            // signed governance document (S/MIME, .p7s)
+  std::string permissions;           // signed permissions document (S/MIME, .p7s)
+  bool empty() const {
+    return identity_ca.empty() && identity_certificate.empty() && private_key.empty() &&
+           permissions_ca.empty() && governance.empty() && permissions.empty();
+  }
+  bool complete() const {
+    return !identity_ca.empty() && !identity_certificate.empty() && !private_key.empty() &&
+           !permissions_ca.empty() && !governance.empty() && !permissions.empty();
+  }
+};
+
+struct CommandInputSettings {
+  // Off by default. When on, the command input needs DDS Security (every file of `security`):
+  // a participant without valid credentials cannot command the crane.
+  bool enabled = false;
+  TopicSettings topic{0.0, Reliability::kBestEffort, Durability::kVolatile, 1};
+  SecurityFiles security;
+};
+
+struct TelemetryConfig {
+  bool enabled = true;  // telemetry publishing (open, unauthenticated: read-only data)
+  int domain_id = 0;
+  std::string participant_name = "craneassist";
+  DdsTransport transport = DdsTransport::kDefault;
+  TopicSettings status{10.0, Reliability::kReliable, Durability::kTransientLocal, 1};
+  TopicSettings joints{50.0, Reliability::kBestEffort, Durability::kVolatile, 1};
+  TopicSettings hydraulics{50.0, Reliability::kBestEffort, Durability::kVolatile, 1};
+  TopicSettings command_path{50.0, Reliability::kBestEffort, Durability::kVolatile, 1};
+  CommandInputSettings commands;
+  std::string source_name;  // file the settings came from, or "<embedded ...>"
+};
+
+// Both throw ConfigError.
+TelemetryConfig load_telemetry_config(const std::filesystem::path& path);
+TelemetryConfig parse_telemetry_config(std::string_view yaml_text, std::string_view source_name,
+                                       const std::filesystem::path& base_dir = {});
+
+// The shipped default, embedded (config/telemetry/default.yaml).
+TelemetryConfig default_telemetry_config();
+
+}  // namespace craneassist::config

@@ -1,0 +1,244 @@
+#include "craneassist/config/telemetry_config.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "craneassist/config/quantity.hpp"
+#include "craneassist/config/yaml_reader.hpp"
+#include "embedded_configs.hpp"
+
+namespace craneassist::config {
+namespace {
+
+constexpr const char* kFormat = "craneassist-telemetry/1";
+
+class Reader : public YamlReader {
+ public:
+  Reader(std::string file, std::filesystem::path base_dir)
+      : YamlReader(std::move(file)), base_dir_(std::move(base_dir)) {}
+
+  std::string text(const YAML::Node& map, const std::string& key, const std::string& path) const {
+    const YAML::Node node = child(map, key, path);
+    if (!node.IsScalar()) fail(node, join(path, key), "expected a single value");
+    return node.Scalar();
+  }
+
+  // An optional scalar ("" when absent or null).
+  std::string optional_text(const YAML::Node& map, const std::string& key,
+                            const std::string& path) const {
+    const YAML::Node node = map[key];
+    if (!node.IsDefined() || node.IsNull()) return "";
+    if (!node.IsScalar()) fail(node, join(path, key), "expected a single value");
+    return node.Scalar();
+  }
+
+  bool flag(const YAML::Node& map, const std::string& key, const std::string& path,
+            bool fallback) const {
+    const YAML::Node node = map[key];
+    if (!node.IsDefined() || node.IsNull()) return fallback;
+    if (node.IsScalar() && (node.Scalar() == "true" || node.Scalar() == "false")) {
+      return node.Scalar() == "true";
+    }
+    fail(node, join(path, key), "expected true or false");
+  }
+
+  int integer(const YAML::Node& map, const std::string& key, const std::string& path, int lo,
+              int hi, int fallback) const {
+    const YAML::Node node = map[key];
+    if (!node.IsDefined() || node.IsNull()) return fallback;
+    const std::string field = join(path, key);
+    if (!node.IsScalar()) fail(node, field, "expected a whole number");
+    const std::string& s = node.Scalar();
+    std::size_t used = 0;
+    long v = 0;
+    try {
+      v = std::stol(s, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != s.size()) fail(node, field, "expected a whole number, got '" + s + "'");
+    if (v < lo || v > hi) {
+      fail(node, field, "must be in " + std::to_string(lo) + ".." + std::to_string(hi));
+    }
+    return static_cast<int>(v);
+  }
+
+  double rate(const YAML::Node& map, const std::string& key, const std::string& path,
+              double fallback) const {
+    const YAML::Node node = map[key];
+    if (!node.IsDefined() || node.IsNull()) return fallback;
+    const std::string field = join(path, key);
+    if (!node.IsScalar()) fail(node, field, "expected a rate, e.g. 50 Hz");
+    std::string error;
+    const auto q = parse_quantity(node.Scalar(), Dimension::kFrequency, error);
+    if (!q) fail(node, field, error);
+    if (q->si_values.size() != 1) fail(node, field, "expected one value");
+    const double v = q->si_values[0];
+    if (!(v > 0.0 && v <= 1000.0)) fail(node, field, "must be in (0, 1000] Hz");
+    return v;
+  }
+
+  template <typename Enum, std::size_t N>
+  Enum choice(const YAML::Node& map, const std::string& key, const std::string& path,
+              const std::pair<const char*, Enum> (&names)[N], Enum fallback) const {
+    const YAML::Node node = map[key];
+    if (!node.IsDefined() || node.IsNull()) return fallback;
+    const std::string field = join(path, key);
+    if (!node.IsScalar()) fail(node, field, "expected a single value");
+    std::string list;
+    for (const auto& [name, value] : names) {
+      if (node.Scalar() == name) return value;
+      list += list.empty() ? name : std::string(", ") + name;
+    }
+    fail(node, field, "unknown value '" + node.Scalar() + "' (expected one of: " + list + ")");
+  }
+
+  // A file path relative to the config file's folder; must exist when given.
+  std::string file_path(const YAML::Node& map, const std::string& key,
+                        const std::string& path) const {
+    std::string p = optional_text(map, key, path);
+    if (p.empty()) return p;
+    std::filesystem::path full(p);
+    if (full.is_relative() && !base_dir_.empty()) full = base_dir_ / full;
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(full, ec)) {
+      fail(map[key], join(path, key), "no such file: " + full.string());
+    }
+    return full.string();
+  }
+
+ private:
+  std::filesystem::path base_dir_;
+};
+
+constexpr std::pair<const char*, Reliability> kReliabilities[] = {
+    {"best_effort", Reliability::kBestEffort}, {"reliable", Reliability::kReliable}};
+constexpr std::pair<const char*, Durability> kDurabilities[] = {
+    {"volatile", Durability::kVolatile}, {"transient_local", Durability::kTransientLocal}};
+constexpr std::pair<const char*, DdsTransport> kTransports[] = {
+    {"default", DdsTransport::kDefault}, {"udp", DdsTransport::kUdp}, {"shm", DdsTransport::kShm}};
+
+TopicSettings read_topic(const Reader& r, const YAML::Node& node, const std::string& path,
+                         TopicSettings t, bool with_rate) {
+  if (with_rate) {
+    r.check_keys(node, path, {"rate", "reliability", "durability", "depth"});
+    t.rate_hz = r.rate(node, "rate", path, t.rate_hz);
+    t.durability = r.choice(node, "durability", path, kDurabilities, t.durability);
+  }
+  t.reliability = r.choice(node, "reliability", path, kReliabilities, t.reliability);
+  t.depth = r.integer(node, "depth", path, 1, 1000, t.depth);
+  return t;
+}
+
+TelemetryConfig read_config(const Reader& r, const YAML::Node& root, std::string_view source) {
+  TelemetryConfig c;
+  c.source_name = std::string(source);
+  r.check_keys(root, "",
+               {"format", "enabled", "domain_id", "participant_name", "transport", "topics",
+                "commands"});
+  const YAML::Node format = r.child(root, "format", "");
+  if (!format.IsScalar() || format.Scalar() != kFormat) {
+    r.fail(format, "format", std::string("expected ") + kFormat);
+  }
+  c.enabled = r.flag(root, "enabled", "", c.enabled);
+  c.domain_id = r.integer(root, "domain_id", "", 0, 232, c.domain_id);
+  if (const std::string name = r.optional_text(root, "participant_name", ""); !name.empty()) {
+    c.participant_name = name;
+  }
+  c.transport = r.choice(root, "transport", "", kTransports, c.transport);
+  if (const YAML::Node topics = root["topics"]; topics.IsDefined() && !topics.IsNull()) {
+    r.check_keys(topics, "topics", {"status", "joints", "hydraulics", "command_path"});
+    const std::pair<const char*, TopicSettings*> all[] = {{"status", &c.status},
+                                                          {"joints", &c.joints},
+                                                          {"hydraulics", &c.hydraulics},
+                                                          {"command_path", &c.command_path}};
+    for (const auto& [name, settings] : all) {
+      const YAML::Node t = topics[name];
+      if (t.IsDefined() && !t.IsNull()) {
+        *settings = read_topic(r, t, Reader::join("topics", name), *settings, true);
+      }
+    }
+  }
+  if (const YAML::Node cmd = root["commands"]; cmd.IsDefined() && !cmd.IsNull()) {
+    r.check_keys(cmd, "commands", {"enabled", "reliability", "depth", "security"});
+    c.commands.enabled = r.flag(cmd, "enabled", "commands", false);
+    c.commands.topic = read_topic(r, cmd, "commands", c.commands.topic, false);
+    if (const YAML::Node sec = cmd["security"]; sec.IsDefined() && !sec.IsNull()) {
+      const std::string p = "commands.security";
+      r.check_keys(sec, p,
+                   {"identity_ca", "identity_certificate", "private_key", "permissions_ca",
+                    "governance", "permissions"});
+      auto& s = c.commands.security;
+      s.identity_ca = r.file_path(sec, "identity_ca", p);
+      s.identity_certificate = r.file_path(sec, "identity_certificate", p);
+      s.private_key = r.file_path(sec, "private_key", p);
+      s.permissions_ca = r.file_path(sec, "permissions_ca", p);
+      s.governance = r.file_path(sec, "governance", p);
+      s.permissions = r.file_path(sec, "permissions", p);
+      if (!s.empty() && !s.complete()) {
+        r.fail(sec, p,
+               "give every file (identity_ca, identity_certificate, private_key, "
+               "permissions_ca, governance, permissions) or none");
+      }
+    }
+    if (c.commands.enabled && !c.commands.security.complete()) {
+      r.fail(cmd["enabled"], "commands.enabled",
+             "the DDS command input needs DDS Security: give every file of commands.security "
+             "(docs/telemetry.md#secure-remote-commands)");
+    }
+  }
+  return c;
+}
+
+}  // namespace
+
+const char* to_string(Reliability r) {
+  return r == Reliability::kReliable ? "reliable" : "best_effort";
+}
+const char* to_string(Durability d) {
+  return d == Durability::kTransientLocal ? "transient_local" : "volatile";
+}
+const char* to_string(DdsTransport t) {
+  switch (t) {
+    case DdsTransport::kUdp:
+      return "udp";
+    case DdsTransport::kShm:
+      return "shm";
+    case DdsTransport::kDefault:
+      break;
+  }
+  return "default";
+}
+
+TelemetryConfig parse_telemetry_config(std::string_view yaml_text, std::string_view source_name,
+                                       const std::filesystem::path& base_dir) {
+  const Reader reader{std::string(source_name), base_dir};
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(yaml_text));
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(std::string(source_name), e.mark.line + 1, "", "YAML syntax: " + e.msg);
+  }
+  try {
+    return read_config(reader, root, source_name);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(std::string(source_name), e.mark.line + 1, "", e.msg);
+  }
+}
+
+TelemetryConfig load_telemetry_config(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError(path.string(), 0, "", "cannot open the file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_telemetry_config(text.str(), path.string(), path.parent_path());
+}
+
+TelemetryConfig default_telemetry_config() {
+  return parse_telemetry_config(embedded::kTelemetryYaml,
+                                "<embedded config/telemetry/default.yaml>");
+}
+
+}  // namespace craneassist::config
