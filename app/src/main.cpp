@@ -29,6 +29,7 @@
 #include "machine_setup.hpp"
 #include "plan_command.hpp"
 #include "sim_command.hpp"
+#include "telemetry_setup.hpp"
 
 namespace {
 
@@ -39,11 +40,12 @@ using cli::kExitRuntime;
 using cli::kExitUsage;
 
 struct ReplayArgs {
-  std::string replay_file;      // empty: the bundled demo
-  std::string trajectory_file;  // a planned joint trajectory instead of a replay
-  std::string config_file;      // empty: the embedded reference crane
-  cli::BackendArgs machine;     // the machine (empty values: the config's backend: and can:)
-  double freeze_at_s = -1.0;    // test hook: freeze the loop at this machine time
+  std::string replay_file;       // empty: the bundled demo
+  std::string trajectory_file;   // a planned joint trajectory instead of a replay
+  std::string config_file;       // empty: the embedded reference crane
+  cli::BackendArgs machine;      // the machine (empty values: the config's backend: and can:)
+  cli::TelemetryArgs telemetry;  // --telemetry: publish DDS telemetry during the replay
+  double freeze_at_s = -1.0;     // test hook: freeze the loop at this machine time
   double freeze_for_s = 0.0;
   std::string log_file = "craneassist-log.csv";
   bool no_log = false;
@@ -213,6 +215,7 @@ int run_trajectory_command(const ReplayArgs& args, const config::CraneConfig& cf
 int run_replay_command(const ReplayArgs& args) {
   config::CraneConfig cfg;
   std::optional<input::Replay> loaded;
+  config::TelemetryConfig telemetry_settings;
   try {
     cfg = args.config_file.empty() ? config::default_crane_config()
                                    : config::load_crane_config(args.config_file);
@@ -265,6 +268,7 @@ int run_replay_command(const ReplayArgs& args) {
       }
       return run_trajectory_command(args, cfg);
     }
+    telemetry_settings = cli::load_telemetry_settings(args.telemetry);
     if (args.replay_file.empty()) {
       loaded = input::Replay::parse(app::embedded::kDemoReplayCsv,
                                     "<bundled examples/replays/demo.csv>");
@@ -289,9 +293,16 @@ int run_replay_command(const ReplayArgs& args) {
     if (const int rc = machines.open(cfg, args.machine); rc != kExitOk) return rc;
     valves::MachineInterface& machine = machines.get();
     const bool use_can = machines.is_can();
+    cli::Telemetry telemetry;
+    const bool telemetry_wanted = args.telemetry.on || !args.telemetry.config_file.empty();
+    if (const int rc = telemetry.open(telemetry_settings, telemetry_wanted, cfg, machine.name());
+        rc != kExitOk) {
+      return rc;
+    }
     std::optional<app::CsvLog> log;
     if (!args.no_log) log.emplace(args.log_file, cfg.model.dof());
     app::RunOptions options;
+    if (app::CycleObserver* o = telemetry.observer()) options.observers.push_back(o);
     options.controller.mode = args.no_scaling          ? app::ScalingMode::kNone
                               : args.scaling == "flow" ? app::ScalingMode::kFlowOnly
                               : args.scaling == "none" ? app::ScalingMode::kNone
@@ -307,6 +318,7 @@ int run_replay_command(const ReplayArgs& args) {
         app::run_replay(cfg, replay, machine, options, log ? &*log : nullptr);
     print_summary(summary, cfg, replay_name, options.controller.mode, log ? &*log : nullptr,
                   machine.name());
+    telemetry.finish();
     if (summary.log_rows_dropped > 0) {
       spdlog::warn("the log writer fell behind: {} rows dropped", summary.log_rows_dropped);
     }
@@ -406,6 +418,7 @@ int main(int argc, char** argv) {
                    "Crane config YAML (default: the embedded K70M reference crane)")
       ->check(CLI::ExistingFile);
   cli::add_backend_options(*replay, args.machine);
+  cli::add_telemetry_options(*replay, args.telemetry, false);
   replay->add_option("--test-freeze-at", args.freeze_at_s)->group("");
   replay->add_option("--test-freeze-for", args.freeze_for_s)->group("");
   replay->add_option("--log", args.log_file, "Per-cycle CSV log (docs/log-format.md)")

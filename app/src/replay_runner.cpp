@@ -84,14 +84,15 @@ RunSummary run_replay(const config::CraneConfig& config, const input::Replay& re
     summary.pump_saturated_cycles += state.pump.limit != valves::PumpLimit::kNone;
     ++summary.limit_cycles[static_cast<std::size_t>(out.limit)];
 
-    if (log != nullptr) {
+    if (log != nullptr || !options.observers.empty()) {
       builder.fill(row, t, cmd, out, state);
       row.status = status_word(status);
       row.stop_reason = input_stop                             ? "replay stop row"
                         : status == ControllerStatus::kRunning ? ""
                                                                : "measurement invalid";
       row.deadman = !input_stop;
-      log->push(row);
+      if (log != nullptr) log->push(row);
+      for (CycleObserver* o : options.observers) o->on_cycle(row);
     }
 
     machine.advance(period);

@@ -138,6 +138,7 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
   sim->add_option("--payload", args.payload_kg, "Payload mass in the grapple, kg")
       ->check(CLI::Range(0.0, 100000.0));
   add_backend_options(*sim, args.machine);
+  add_telemetry_options(*sim, args.telemetry, true);
   return sim;
 }
 
@@ -164,6 +165,7 @@ int run_sim_command(const SimArgs& args) {
   }
   config::CraneConfig cfg;
   config::JoystickConfig jcfg;
+  config::TelemetryConfig tcfg;
   std::optional<input::Replay> replay;
   try {
     cfg = args.config_file.empty() ? config::default_crane_config()
@@ -172,6 +174,7 @@ int run_sim_command(const SimArgs& args) {
     jcfg = args.joystick_file.empty() ? config::default_joystick_config()
                                       : config::load_joystick_config(args.joystick_file);
     if (kind == "replay") replay = input::Replay::load_file(args.input[1]);
+    tcfg = load_telemetry_settings(args.telemetry);
   } catch (const config::ConfigError& e) {
     spdlog::error("config: {}", e.what());
     return kExitUsage;
@@ -218,6 +221,11 @@ int run_sim_command(const SimArgs& args) {
     sigaction(SIGINT, &sa, nullptr);
     sigaction(SIGTERM, &sa, nullptr);
 
+    Telemetry telemetry;
+    if (const int rc = telemetry.open(tcfg, !args.telemetry.off, cfg, machine.name());
+        rc != kExitOk) {
+      return rc;
+    }
     std::optional<app::CsvLog> log;
     if (!args.log_file.empty()) log.emplace(args.log_file, cfg.model.dof());
     std::vector<input::ReplayRow> record;
@@ -230,6 +238,7 @@ int run_sim_command(const SimArgs& args) {
                                                : 0.0;
     options.stop = &g_stop;
     options.status_board = &board;
+    if (app::CycleObserver* o = telemetry.observer()) options.observers.push_back(o);
     if (!args.record_file.empty()) {
       options.record = &record;
       if (options.duration_s > 0.0) {
@@ -279,6 +288,7 @@ int run_sim_command(const SimArgs& args) {
       std::printf("  record: %s (%zu rows%s)\n", args.record_file.c_str(), record.size(),
                   s.record_rows_dropped > 0 ? ", SOME DROPPED" : "");
     }
+    telemetry.finish();
     if (s.log_rows_dropped > 0) spdlog::warn("{} log rows dropped", s.log_rows_dropped);
     if (s.machine_fault) spdlog::error("the machine reported a fault: run stopped");
     if (const int rc = machines.finish(); rc != kExitOk) return rc;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "machine_setup.hpp"
+#include "telemetry_setup.hpp"
 
 namespace craneassist::cli {
 
@@ -24,6 +25,7 @@ struct SimArgs {
   bool no_realtime = false;        // --input replay only: as fast as possible
   std::optional<double> payload_kg;
   BackendArgs machine;  // empty values: the config's backend: and can:
+  TelemetryArgs telemetry;
 };
 
 CLI::App* add_sim_command(CLI::App& cli, SimArgs& args);

@@ -58,7 +58,8 @@ class Reader : public YamlReader {
     } catch (const std::exception&) {
       used = 0;
     }
-    if (used == 0 || used != s.size()) fail(node, field, "expected a whole number, got '" + s + "'");
+    if (used == 0 || used != s.size())
+      fail(node, field, "expected a whole number, got '" + s + "'");
     if (v < lo || v > hi) {
       fail(node, field, "must be in " + std::to_string(lo) + ".." + std::to_string(hi));
     }
@@ -135,9 +136,9 @@ TopicSettings read_topic(const Reader& r, const YAML::Node& node, const std::str
 TelemetryConfig read_config(const Reader& r, const YAML::Node& root, std::string_view source) {
   TelemetryConfig c;
   c.source_name = std::string(source);
-  r.check_keys(root, "",
-               {"format", "enabled", "domain_id", "participant_name", "transport", "topics",
-                "commands"});
+  r.check_keys(
+      root, "",
+      {"format", "enabled", "domain_id", "participant_name", "transport", "topics", "commands"});
   const YAML::Node format = r.child(root, "format", "");
   if (!format.IsScalar() || format.Scalar() != kFormat) {
     r.fail(format, "format", std::string("expected ") + kFormat);
@@ -186,7 +187,7 @@ TelemetryConfig read_config(const Reader& r, const YAML::Node& root, std::string
     if (c.commands.enabled && !c.commands.security.complete()) {
       r.fail(cmd["enabled"], "commands.enabled",
              "the DDS command input needs DDS Security: give every file of commands.security "
-             "(docs/telemetry.md#secure-remote-commands)");
+             "(docs/remote-commands.md)");
     }
   }
   return c;

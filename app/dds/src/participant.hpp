@@ -38,8 +38,7 @@ using ParticipantPtr =
 ParticipantPtr make_participant(const ParticipantOptions& options);
 
 // The topic of `topic` on the participant (created on first use).
-eprosima::fastdds::dds::Topic* get_topic(eprosima::fastdds::dds::DomainParticipant& p,
-                                         Topic topic);
+eprosima::fastdds::dds::Topic* get_topic(eprosima::fastdds::dds::DomainParticipant& p, Topic topic);
 
 eprosima::fastdds::dds::DataWriterQos writer_qos(const config::TopicSettings& s);
 eprosima::fastdds::dds::DataReaderQos reader_qos(const config::TopicSettings& s);

@@ -1,14 +1,14 @@
 #include "craneassist/dds/telemetry_publisher.hpp"
 
-#include <fastdds/dds/publisher/DataWriter.hpp>
-#include <fastdds/dds/publisher/Publisher.hpp>
-#include <fastdds/dds/publisher/qos/PublisherQos.hpp>
 #include <semaphore.h>
 #include <time.h>
 
 #include <atomic>
 #include <cerrno>
 #include <cmath>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/publisher/qos/PublisherQos.hpp>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -64,6 +64,7 @@ struct TelemetryPublisher::Impl {
       }
     }
     joints.names(info.joint_names);
+    joints.prismatic(info.joint_prismatic);
     sem_init(&wake, 0, 0);
     thread = std::thread([this] { run(); });
   }
@@ -128,8 +129,8 @@ struct TelemetryPublisher::Impl {
   // written for this frame.
   void publish(const TelemetryFrame& f, bool force) {
     for (int i = 0; i < kTelemetryTopics; ++i) {
-      const bool due = !written_once[i] || f.t_s < last_t[i] ||
-                       f.t_s - last_t[i] >= period_s[i] - 1e-9;
+      const bool due =
+          !written_once[i] || f.t_s < last_t[i] || f.t_s - last_t[i] >= period_s[i] - 1e-9;
       if (!(due || (force && last_cycle[i] != f.cycle))) continue;
       last_t[i] = f.t_s;
       last_cycle[i] = f.cycle;
@@ -266,10 +267,16 @@ TelemetryPublisher::TelemetryPublisher(const config::TelemetryConfig& config, Te
 
 TelemetryPublisher::~TelemetryPublisher() = default;
 
-bool TelemetryPublisher::push(const TelemetryFrame& frame) noexcept { return impl_->push(frame); }
+bool TelemetryPublisher::push(const TelemetryFrame& frame) noexcept {
+  return impl_->push(frame);
+}
 
-void TelemetryPublisher::close() { impl_->close(); }
+void TelemetryPublisher::close() {
+  impl_->close();
+}
 
-PublisherStats TelemetryPublisher::stats() const { return impl_->stats(); }
+PublisherStats TelemetryPublisher::stats() const {
+  return impl_->stats();
+}
 
 }  // namespace craneassist::dds

@@ -3,9 +3,11 @@
 #pragma once
 
 #include <array>
+#include <vector>
 
 #include "craneassist/app/controller.hpp"
 #include "craneassist/app/csv_log.hpp"
+#include "craneassist/app/cycle_observer.hpp"
 #include "craneassist/input/replay.hpp"
 #include "craneassist/valves/machine_interface.hpp"
 
@@ -24,6 +26,7 @@ struct RunOptions {
   // without reading or writing, as a hung control thread would. Negative: never.
   double freeze_at_s = -1.0;
   double freeze_for_s = 0.0;
+  std::vector<CycleObserver*> observers;  // called each cycle with the log row (telemetry)
 };
 
 struct RunSummary {

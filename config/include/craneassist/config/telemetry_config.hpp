@@ -28,7 +28,7 @@ struct TopicSettings {
   int depth = 1;  // KEEP_LAST history depth
 };
 
-// The DDS Security files of a participant (docs/telemetry.md#secure-remote-commands). Paths are
+// The DDS Security files of a participant (docs/remote-commands.md). Paths are
 // resolved against the config file's folder. All empty: no security.
 struct SecurityFiles {
   std::string identity_ca;           // CA certificate that signed every identity (PEM)

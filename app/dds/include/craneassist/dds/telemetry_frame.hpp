@@ -15,7 +15,7 @@ inline constexpr int kMaxJoints = 8;
 
 struct TelemetryFrame {
   std::uint64_t cycle = 0;
-  double t_s = 0.0;          // machine time
+  double t_s = 0.0;           // machine time
   std::int64_t stamp_ns = 0;  // CLOCK_MONOTONIC at push() (set by the publisher)
   int dof = 0;
   std::array<double, kMaxJoints> q{}, q_ref{}, qdot{}, cylinder_pos_m{}, cylinder_vel_m_s{},
@@ -41,6 +41,7 @@ struct TelemetryInfo {
   std::string backend;  // sim, can
   std::string pump_mode;
   std::vector<std::string> joint_names;
+  std::vector<bool> joint_prismatic;  // per joint: q in m (true) or rad (false)
   double flow_limit_m3_s = 0.0;
   double power_limit_w = 0.0;
 };

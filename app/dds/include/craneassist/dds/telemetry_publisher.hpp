@@ -16,7 +16,7 @@ namespace craneassist::dds {
 
 struct PublisherStats {
   std::uint64_t frames_pushed = 0;
-  std::uint64_t frames_dropped = 0;  // the ring was full (the publisher fell behind)
+  std::uint64_t frames_dropped = 0;       // the ring was full (the publisher fell behind)
   std::uint64_t samples_written[4] = {};  // status, joints, hydraulics, command_path
   std::uint64_t write_errors = 0;
   int matched_readers = 0;  // over all topics, at the time of the call
