@@ -25,9 +25,11 @@
 #include "craneassist/dynamics/resolutions.hpp"
 #include "craneassist/input/replay.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
+#include "dds_commands.hpp"
 #include "exit_codes.hpp"
 #include "machine_setup.hpp"
 #include "plan_command.hpp"
+#include "remote_command.hpp"
 #include "sim_command.hpp"
 #include "telemetry_setup.hpp"
 
@@ -499,6 +501,12 @@ int main(int argc, char** argv) {
   auto* calibrate = cli::add_calibrate_command(cli, calibrate_args);
   cli::SimArgs sim_args;
   auto* sim = cli::add_sim_command(cli, sim_args);
+  cli::RemoteArgs remote_args;
+  auto* remote = cli::add_remote_command(cli, remote_args);
+  cli::EchoArgs echo_args;
+  auto* echo = cli::add_echo_command(cli, echo_args);
+  cli::DashboardArgs dashboard_args;
+  auto* dashboard = cli::add_dashboard_command(cli, dashboard_args);
 
   try {
     cli.parse(argc, argv);
@@ -533,6 +541,9 @@ int main(int argc, char** argv) {
     }
   }
   if (*sim) return cli::run_sim_command(sim_args);
+  if (*remote) return cli::run_remote_command(remote_args);
+  if (*echo) return cli::run_echo_command(echo_args);
+  if (*dashboard) return cli::run_dashboard_command(dashboard_args);
   if (*replay) {
     try {
       return run_replay_command(args);

@@ -15,6 +15,7 @@
 #include "craneassist/app/sim_setup.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/config/joystick_config.hpp"
+#include "craneassist/dds/command_source.hpp"
 #include "craneassist/input/evdev_source.hpp"
 #include "craneassist/input/keyboard_source.hpp"
 #include "craneassist/input/replay_source.hpp"
@@ -34,8 +35,9 @@ extern "C" void on_stop_signal(int) {
 // The status line and the device event messages, from the loop's status board (UI thread).
 class StatusReporter {
  public:
-  StatusReporter(const app::LiveStatusBoard& board, const input::KeyboardSource* keyboard)
-      : board_(board), keyboard_(keyboard), draw_(isatty(1) != 0) {}
+  StatusReporter(const app::LiveStatusBoard& board, const input::KeyboardSource* keyboard,
+                 const dds::DdsCommandSource* remote = nullptr)
+      : board_(board), keyboard_(keyboard), remote_(remote), draw_(isatty(1) != 0) {}
 
   void run(const std::atomic<bool>& done) {
     while (!done.load()) {
@@ -77,6 +79,16 @@ class StatusReporter {
       }
       fault_ = s.fault;
     }
+    char sender[64] = "";
+    if (remote_ != nullptr) {  // the remote operator (OperatorCommand.sender)
+      const std::string now_sender = remote_->stats().sender;
+      if (now_sender != sender_) {
+        clear_line();
+        spdlog::info("remote operator: '{}' (DDS)", now_sender);
+        sender_ = now_sender;
+      }
+      std::snprintf(sender, sizeof sender, " | from %.40s", sender_.c_str());
+    }
     if (!draw_) return;
     char speed_step[32] = "";
     if (keyboard_ != nullptr) {
@@ -88,15 +100,17 @@ class StatusReporter {
       std::snprintf(age, sizeof age, " %.0f ms", s.input_age_s * 1e3);
     }
     std::printf(
-        "\r\033[Kt %6.1f s | %-8s | deadman %s%s | tip x %5.2f y %5.2f z %5.2f m | %.2f m/s | "
+        "\r\033[Kt %6.1f s | %-8s | deadman %s%s%s | tip x %5.2f y %5.2f z %5.2f m | %.2f m/s | "
         "%s%s",
-        s.t, s.status, s.deadman ? "ON " : "off", speed_step, s.tip.x(), s.tip.y(), s.tip.z(),
-        s.tip_v.norm(), s.stop_reason, age);
+        s.t, s.status, s.deadman ? "ON " : "off", speed_step, sender, s.tip.x(), s.tip.y(),
+        s.tip.z(), s.tip_v.norm(), s.stop_reason, age);
     std::fflush(stdout);
   }
 
   const app::LiveStatusBoard& board_;
   const input::KeyboardSource* keyboard_;
+  const dds::DdsCommandSource* remote_;
+  std::string sender_;
   bool draw_;
   int disconnects_ = 0, reconnects_ = 0;
   input::InputFault fault_ = input::InputFault::kNone;
@@ -113,13 +127,15 @@ void print_keys() {
 CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
   auto* sim = cli.add_subcommand(
       "sim",
-      "Drive the crane live: keyboard, joystick (evdev, SDL) or a replay file; the simulated "
-      "crane, or with --backend can the machine on the CAN bus");
+      "Drive the crane live: keyboard, joystick (evdev, SDL), a remote operator over DDS "
+      "Security or a replay file; the simulated crane, or with --backend can the machine on the "
+      "CAN bus");
   sim->add_option("--config", args.config_file,
                   "Crane config YAML (default: the embedded K70M reference crane)")
       ->check(CLI::ExistingFile);
   sim->add_option("--input", args.input,
-                  "keyboard (default on a terminal), evdev, sdl, or replay FILE")
+                  "keyboard (default on a terminal), evdev, sdl, dds (a remote operator, "
+                  "docs/remote-commands.md), or replay FILE")
       ->expected(1, 2);
   sim->add_option("--joystick", args.joystick_file,
                   "Joystick mapping YAML (docs/joystick.md; default: the embedded "
@@ -144,8 +160,8 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
 
 int run_sim_command(const SimArgs& args) {
   std::string kind = args.input.empty() ? "keyboard" : args.input[0];
-  if (kind != "keyboard" && kind != "evdev" && kind != "sdl" && kind != "replay") {
-    spdlog::error("--input: unknown input '{}' (expected keyboard, evdev, sdl or replay FILE)",
+  if (kind != "keyboard" && kind != "evdev" && kind != "sdl" && kind != "dds" && kind != "replay") {
+    spdlog::error("--input: unknown input '{}' (expected keyboard, evdev, sdl, dds or replay FILE)",
                   kind);
     return kExitUsage;
   }
@@ -175,6 +191,7 @@ int run_sim_command(const SimArgs& args) {
                                       : config::load_joystick_config(args.joystick_file);
     if (kind == "replay") replay = input::Replay::load_file(args.input[1]);
     tcfg = load_telemetry_settings(args.telemetry);
+    if (kind == "dds") dds::check_command_input_settings(tcfg);
   } catch (const config::ConfigError& e) {
     spdlog::error("config: {}", e.what());
     return kExitUsage;
@@ -198,7 +215,16 @@ int run_sim_command(const SimArgs& args) {
     g_stop.store(false);
     std::unique_ptr<input::CommandSource> source;
     input::KeyboardSource* keyboard = nullptr;
-    if (kind == "keyboard") {
+    dds::DdsCommandSource* remote = nullptr;
+    if (kind == "dds") {
+      auto d = std::make_unique<dds::DdsCommandSource>(tcfg);
+      remote = d.get();
+      source = std::move(d);
+      spdlog::info(
+          "dds input: craneassist/operator_command on DDS domain {} with DDS Security "
+          "({}); waiting for an operator (craneassist remote)",
+          tcfg.domain_id, tcfg.source_name);
+    } else if (kind == "keyboard") {
       auto kb = std::make_unique<input::KeyboardSource>(0, jcfg.mapping, jcfg.keyboard, &g_stop);
       keyboard = kb.get();
       source = std::move(kb);
@@ -252,7 +278,7 @@ int run_sim_command(const SimArgs& args) {
     if (keyboard != nullptr) print_keys();
 
     std::atomic<bool> done{false};
-    StatusReporter reporter(board, keyboard);
+    StatusReporter reporter(board, keyboard, remote);
     std::thread ui([&] { reporter.run(done); });
     app::LiveSummary s;
     try {
@@ -266,7 +292,9 @@ int run_sim_command(const SimArgs& args) {
     if (can::CanBackend* can = machines.can_backend()) can->disable();
     done.store(true);
     ui.join();
-    source.reset();  // restores the terminal
+    std::optional<dds::CommandInputStats> remote_stats;
+    if (remote != nullptr) remote_stats = remote->stats();
+    source.reset();  // restores the terminal; ends the DDS input
     signal(SIGINT, SIG_DFL);
     signal(SIGTERM, SIG_DFL);
 
@@ -283,6 +311,22 @@ int run_sim_command(const SimArgs& args) {
     std::printf("  tip: path %.2f m, peak speed %.2f m/s; operator command passed in %d cycles\n",
                 s.tip_path_m, s.peak_tip_speed_m_s, s.enabled_cycles);
     std::printf("  input device: %d disconnects, %d re-attaches\n", s.disconnects, s.reconnects);
+    if (remote_stats) {
+      const dds::CommandInputStats& d = *remote_stats;
+      std::string from = " (no operator)";
+      if (d.first_sample_s >= 0.0) {
+        char first[32];
+        std::snprintf(first, sizeof first, "%.2f", d.first_sample_s);
+        from = " from '" + d.sender + "' (first " + first + " s after start)";
+      }
+      std::printf(
+          "  dds input: %llu samples%s, %llu lost, %llu non-finite, %llu from other senders; "
+          "writers matched %d (peak %d)\n",
+          static_cast<unsigned long long>(d.samples), from.c_str(),
+          static_cast<unsigned long long>(d.lost), static_cast<unsigned long long>(d.non_finite),
+          static_cast<unsigned long long>(d.other_senders), d.writer_matches,
+          d.peak_matched_writers);
+    }
     if (log) std::printf("  log: %s (%zu rows)\n", log->path().c_str(), log->rows_written());
     if (!args.record_file.empty()) {
       std::printf("  record: %s (%zu rows%s)\n", args.record_file.c_str(), record.size(),

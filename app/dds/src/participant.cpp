@@ -73,17 +73,17 @@ ParticipantPtr make_participant(const ParticipantOptions& options) {
           "permissions_ca, governance, permissions)");
     }
     add_property(qos, "dds.sec.auth.plugin", "builtin.PKI-DH");
-    add_property(qos, "dds.sec.auth.builtin.PKI-DH.identity_ca", "file:" + sec.identity_ca);
+    add_property(qos, "dds.sec.auth.builtin.PKI-DH.identity_ca", "file://" + sec.identity_ca);
     add_property(qos, "dds.sec.auth.builtin.PKI-DH.identity_certificate",
-                 "file:" + sec.identity_certificate);
-    add_property(qos, "dds.sec.auth.builtin.PKI-DH.private_key", "file:" + sec.private_key);
+                 "file://" + sec.identity_certificate);
+    add_property(qos, "dds.sec.auth.builtin.PKI-DH.private_key", "file://" + sec.private_key);
     add_property(qos, "dds.sec.access.plugin", "builtin.Access-Permissions");
     add_property(qos, "dds.sec.access.builtin.Access-Permissions.permissions_ca",
-                 "file:" + sec.permissions_ca);
+                 "file://" + sec.permissions_ca);
     add_property(qos, "dds.sec.access.builtin.Access-Permissions.governance",
-                 "file:" + sec.governance);
+                 "file://" + sec.governance);
     add_property(qos, "dds.sec.access.builtin.Access-Permissions.permissions",
-                 "file:" + sec.permissions);
+                 "file://" + sec.permissions);
     add_property(qos, "dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
   }
   ParticipantPtr p(fdds::DomainParticipantFactory::get_instance()->create_participant(

@@ -1,0 +1,84 @@
+// The subscriber side shared by `craneassist echo` and `craneassist dashboard` (internal to the
+// dds module: Fast DDS types, C++17): a participant with one best-effort, volatile reader per
+// topic (matches every writer), listeners that record discovery and wake the waiting thread.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "craneassist/dds/topics.hpp"
+#include "participant.hpp"
+
+namespace craneassist::dds {
+
+// Wakes the thread that waits for samples; the listeners notify it from Fast DDS's threads.
+class Wakeup {
+ public:
+  void notify();
+  // Returns when notified (since the last wait) or after max_s seconds.
+  void wait(double max_s);
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool pending_ = false;
+};
+
+// Called on a Fast DDS thread when a reader has data: take the samples there, or leave them to
+// the waiting thread (the reader keeps the latest ones, KEEP_LAST).
+using DataCallback = std::function<void(Topic, eprosima::fastdds::dds::DataReader&)>;
+
+class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
+ public:
+  TopicReader(Topic topic, Wakeup& wakeup, DataCallback on_data);
+
+  void on_data_available(eprosima::fastdds::dds::DataReader* reader) override;
+  void on_subscription_matched(eprosima::fastdds::dds::DataReader* reader,
+                               const eprosima::fastdds::dds::SubscriptionMatchedStatus& s) override;
+
+  Topic topic() const { return topic_; }
+  eprosima::fastdds::dds::DataReader& reader() { return *reader_; }
+  int matched_writers() const { return matched_.load(); }
+  // CLOCK_MONOTONIC of the first match with a writer; 0 while none has matched.
+  std::int64_t first_match_ns() const { return first_match_ns_.load(); }
+
+ private:
+  friend class SubscriberSession;
+  Topic topic_;
+  Wakeup& wakeup_;
+  DataCallback on_data_;
+  eprosima::fastdds::dds::DataReader* reader_ = nullptr;
+  std::atomic<int> matched_{0};
+  std::atomic<std::int64_t> first_match_ns_{0};
+};
+
+class SubscriberSession {
+ public:
+  // Throws std::runtime_error when DDS cannot be set up.
+  SubscriberSession(const ParticipantOptions& options, const std::vector<Topic>& topics,
+                    DataCallback on_data = nullptr);
+  ~SubscriberSession();
+  SubscriberSession(const SubscriberSession&) = delete;
+  SubscriberSession& operator=(const SubscriberSession&) = delete;
+
+  TopicReader& reader(Topic topic);
+  Wakeup& wakeup() { return wakeup_; }
+  std::int64_t start_ns() const { return start_ns_; }
+  double elapsed_s() const;
+
+ private:
+  Wakeup wakeup_;
+  std::int64_t start_ns_ = 0;
+  std::vector<std::unique_ptr<TopicReader>> readers_;
+  ParticipantPtr participant_;  // declared last: deleted (with its readers) before the listeners
+};
+
+}  // namespace craneassist::dds

@@ -1,0 +1,113 @@
+#include "dds_commands.hpp"
+
+#include <csignal>
+
+#include "craneassist/config/telemetry_config.hpp"
+#include "craneassist/dds/tools.hpp"
+#include "exit_codes.hpp"
+
+namespace craneassist::cli {
+namespace {
+
+static_assert(dds::kToolOk == kExitOk && dds::kToolUsage == kExitUsage &&
+              dds::kToolRuntime == kExitRuntime);
+
+extern "C" void on_dds_tool_stop_signal(int) {
+  dds::request_stop();
+}
+
+// SIGINT, SIGTERM and SIGHUP end the tool cleanly (exit 0) while it runs; the defaults after.
+class StopOnSignal {
+ public:
+  StopOnSignal() {
+    dds::reset_stop();
+    struct sigaction sa = {};
+    sa.sa_handler = on_dds_tool_stop_signal;  // no SA_RESTART: a wait ends at once
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+    sigaction(SIGHUP, &sa, nullptr);  // the terminal or the ssh session went away
+  }
+  ~StopOnSignal() {
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
+    std::signal(SIGHUP, SIG_DFL);
+  }
+  StopOnSignal(const StopOnSignal&) = delete;
+  StopOnSignal& operator=(const StopOnSignal&) = delete;
+};
+
+config::DdsTransport parse_transport(const std::string& name) {
+  if (name == "udp") return config::DdsTransport::kUdp;
+  if (name == "shm") return config::DdsTransport::kShm;
+  return config::DdsTransport::kDefault;
+}
+
+void add_common_options(CLI::App& app, int& domain_id, double& timeout_s, std::string& transport,
+                        const char* timeout_help) {
+  domain_id = config::default_telemetry_config().domain_id;
+  app.add_option("--domain", domain_id, "DDS domain id (the telemetry config's domain_id)")
+      ->check(CLI::Range(0, 232))
+      ->capture_default_str();
+  app.add_option("--timeout", timeout_s, timeout_help)->check(CLI::PositiveNumber);
+  app.add_option("--transport", transport,
+                 "default (shared memory and UDP), udp (UDPv4 only) or shm (shared memory only)")
+      ->check(CLI::IsMember({"default", "udp", "shm"}))
+      ->capture_default_str();
+}
+
+}  // namespace
+
+CLI::App* add_echo_command(CLI::App& cli, EchoArgs& args) {
+  auto* echo = cli.add_subcommand(
+      "echo", "Print the samples of one DDS topic as they arrive (docs/dashboard.md)");
+  echo->add_option("topic", args.topic,
+                   "status, joints, hydraulics, command_path, operator_command (or the DDS name, "
+                   "craneassist/status, ...)")
+      ->required();
+  echo->add_option("--count", args.count, "Exit after this many samples (default: until Ctrl-C)")
+      ->check(CLI::PositiveNumber);
+  echo->add_option("--format", args.format,
+                   "text: a block per sample, field names and SI units; csv: a header line, then "
+                   "one row per sample")
+      ->check(CLI::IsMember({"text", "csv"}))
+      ->capture_default_str();
+  add_common_options(*echo, args.domain_id, args.timeout_s, args.transport,
+                     "Fail (exit 3) when no sample arrives within this many seconds");
+  return echo;
+}
+
+int run_echo_command(const EchoArgs& args) {
+  dds::EchoOptions o;
+  o.topic = args.topic;
+  o.domain_id = args.domain_id;
+  o.count = args.count;
+  o.timeout_s = args.timeout_s;
+  o.format = args.format == "csv" ? dds::EchoFormat::kCsv : dds::EchoFormat::kText;
+  o.transport = parse_transport(args.transport);
+  StopOnSignal stop;
+  return dds::run_echo(o);
+}
+
+CLI::App* add_dashboard_command(CLI::App& cli, DashboardArgs& args) {
+  auto* dashboard = cli.add_subcommand(
+      "dashboard",
+      "Live terminal view of craneassist's DDS telemetry (docs/dashboard.md); q quits");
+  dashboard->add_flag("--once", args.once,
+                      "Print one plain snapshot once every telemetry topic has a sample, then "
+                      "exit (also when stdout is not a terminal)");
+  add_common_options(*dashboard, args.domain_id, args.timeout_s, args.transport,
+                     "Fail (exit 3) when a telemetry topic has no sample within this many seconds");
+  return dashboard;
+}
+
+int run_dashboard_command(const DashboardArgs& args) {
+  dds::DashboardOptions o;
+  o.domain_id = args.domain_id;
+  o.once = args.once;
+  o.timeout_s = args.timeout_s;
+  o.transport = parse_transport(args.transport);
+  StopOnSignal stop;
+  return dds::run_dashboard(o);
+}
+
+}  // namespace craneassist::cli

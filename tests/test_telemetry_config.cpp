@@ -1,0 +1,113 @@
+// The telemetry settings file (config/telemetry/default.yaml, docs/telemetry.md): the shipped
+// defaults, every field read, and errors that name file, line and field. The command input's
+// security fields are tested in test_command_input.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "craneassist/config/config_error.hpp"
+#include "craneassist/config/telemetry_config.hpp"
+
+namespace {
+
+using namespace craneassist::config;
+
+TEST(TelemetryConfig, ShippedDefaults) {
+  const TelemetryConfig c = default_telemetry_config();
+  EXPECT_TRUE(c.enabled);
+  EXPECT_EQ(c.domain_id, 0);
+  EXPECT_EQ(c.participant_name, "craneassist");
+  EXPECT_EQ(c.transport, DdsTransport::kDefault);
+  EXPECT_DOUBLE_EQ(c.status.rate_hz, 10.0);
+  EXPECT_EQ(c.status.reliability, Reliability::kReliable);
+  EXPECT_EQ(c.status.durability, Durability::kTransientLocal);
+  EXPECT_DOUBLE_EQ(c.joints.rate_hz, 50.0);
+  EXPECT_EQ(c.joints.reliability, Reliability::kBestEffort);
+  EXPECT_EQ(c.joints.durability, Durability::kVolatile);
+  EXPECT_DOUBLE_EQ(c.hydraulics.rate_hz, 50.0);
+  EXPECT_DOUBLE_EQ(c.command_path.rate_hz, 50.0);
+  EXPECT_FALSE(c.commands.enabled);
+  EXPECT_TRUE(c.commands.security.empty());
+  EXPECT_EQ(c.source_name, "<embedded config/telemetry/default.yaml>");
+}
+
+TEST(TelemetryConfig, EveryFieldIsRead) {
+  const TelemetryConfig c = parse_telemetry_config(R"(format: craneassist-telemetry/1
+enabled: false
+domain_id: 42
+participant_name: loader-7
+transport: udp
+topics:
+  status: {rate: 2 Hz, reliability: best_effort, durability: volatile, depth: 3}
+  joints: {rate: 100 Hz, reliability: reliable, durability: transient_local, depth: 10}
+  hydraulics: {rate: 0.5 Hz}
+commands:
+  reliability: reliable
+  depth: 4
+)",
+                                                   "t.yaml");
+  EXPECT_FALSE(c.enabled);
+  EXPECT_EQ(c.domain_id, 42);
+  EXPECT_EQ(c.participant_name, "loader-7");
+  EXPECT_EQ(c.transport, DdsTransport::kUdp);
+  EXPECT_DOUBLE_EQ(c.status.rate_hz, 2.0);
+  EXPECT_EQ(c.status.reliability, Reliability::kBestEffort);
+  EXPECT_EQ(c.status.durability, Durability::kVolatile);
+  EXPECT_EQ(c.status.depth, 3);
+  EXPECT_DOUBLE_EQ(c.joints.rate_hz, 100.0);
+  EXPECT_EQ(c.joints.reliability, Reliability::kReliable);
+  EXPECT_EQ(c.joints.durability, Durability::kTransientLocal);
+  EXPECT_EQ(c.joints.depth, 10);
+  EXPECT_DOUBLE_EQ(c.hydraulics.rate_hz, 0.5);
+  EXPECT_EQ(c.hydraulics.reliability, Reliability::kBestEffort);  // default kept
+  EXPECT_DOUBLE_EQ(c.command_path.rate_hz, 50.0);                 // not given: default
+  EXPECT_EQ(c.commands.topic.reliability, Reliability::kReliable);
+  EXPECT_EQ(c.commands.topic.depth, 4);
+}
+
+// Each bad value: the error names the file, the line and the field.
+void expect_error(const std::string& yaml, int line, const std::string& field,
+                  const std::string& reason_part) {
+  try {
+    parse_telemetry_config("format: craneassist-telemetry/1\n" + yaml, "bad.yaml");
+    FAIL() << "accepted: " << yaml;
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.file(), "bad.yaml");
+    EXPECT_EQ(e.line(), line) << e.what();
+    EXPECT_EQ(e.field(), field) << e.what();
+    EXPECT_NE(e.reason().find(reason_part), std::string::npos) << e.what();
+  }
+}
+
+TEST(TelemetryConfig, ErrorsNameFileLineAndField) {
+  expect_error("domain_id: 300\n", 2, "domain_id", "0..232");
+  expect_error("domain_id: one\n", 2, "domain_id", "whole number");
+  expect_error("transport: carrier-pigeon\n", 2, "transport", "expected one of: default, udp, shm");
+  expect_error("topics:\n  joints:\n    rate: 50 L/min\n", 4, "topics.joints.rate",
+               "not a frequency unit");
+  expect_error("topics:\n  joints:\n    rate: 0 Hz\n", 4, "topics.joints.rate", "(0, 1000]");
+  expect_error("topics:\n  joints:\n    reliability: sometimes\n", 4, "topics.joints.reliability",
+               "best_effort, reliable");
+  expect_error("topics:\n  status:\n    depth: 0\n", 4, "topics.status.depth", "1..1000");
+  expect_error("topics:\n  jionts:\n    depth: 1\n", 3, "topics.jionts", "unknown field");
+  expect_error("enabled: yes\n", 2, "enabled", "true or false");
+  expect_error("domian_id: 3\n", 2, "domian_id", "unknown field");
+  try {
+    parse_telemetry_config("format: craneassist-telemetry/9\n", "v.yaml");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.field(), "format");
+  }
+}
+
+TEST(TelemetryConfig, MissingFileIsAnError) {
+  try {
+    load_telemetry_config("/nonexistent/telemetry.yaml");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.file(), "/nonexistent/telemetry.yaml");
+    EXPECT_NE(std::string(e.what()).find("cannot open"), std::string::npos);
+  }
+}
+
+}  // namespace
