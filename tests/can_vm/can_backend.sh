@@ -63,7 +63,8 @@ start_capture /tmp/cap3.log
 ./craneassist replay can_short.csv --backend can --can vcan0 --no-log --settle 0 \
   --can-feedback-timeout 0.3 >/tmp/f3.out 2>&1 &
 rp=$!
-sleep 1
+./can_backend_check wait-motion vcan0 10 || fail "the replay did not start moving"
+sleep 0.2
 cangen vcan0 -I 555 -L r -D r -g 1 -n 100
 cangen vcan0 -e -I 1ABCDEF0 -L r -D r -g 1 -n 100
 cansend vcan0 18FF1022#01

@@ -5,13 +5,24 @@
 //   safe CAPTURE EVENT LIMIT_MS         time from EVENT to every section commanded to block;
 //        EVENT: last-feedback (the last position frame), bad-frame (the first position frame
 //        with a wrong dlc), last-motion (the last non-block command before the safe state)
+//   wait-motion IFACE TIMEOUT_S         waits until a command that is not block is on the bus:
+//                                       the run is moving
 // Prints the figures; exit 0 when they are within the bounds.
+#include <linux/can.h>
+#include <linux/can/raw.h>
+#include <net/if.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "craneassist/can/can_frame.hpp"
@@ -264,6 +275,40 @@ int safe(const char* path, const std::string& event, double limit_ms) {
 
 }  // namespace
 
+// Fault injection must wait for the run to move: a fixed sleep does not, when a loaded host
+// slows the emulated CPU's start-up (once the garbage went out before the backend listened).
+// Listens on the bus itself (a raw socket), not on a capture file that candump may buffer.
+int wait_motion(const char* iface, double timeout_s) {
+  const int fd = socket(PF_CAN, SOCK_RAW, CAN_RAW);
+  if (fd < 0) return 1;
+  ifreq ifr{};
+  std::snprintf(ifr.ifr_name, sizeof ifr.ifr_name, "%s", iface);
+  sockaddr_can addr{};
+  addr.can_family = AF_CAN;
+  if (ioctl(fd, SIOCGIFINDEX, &ifr) < 0) return 1;
+  addr.can_ifindex = ifr.ifr_ifindex;
+  if (bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) < 0) return 1;
+  timeval tv{0, 100000};
+  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (std::chrono::steady_clock::now() < end) {
+    can_frame raw{};
+    if (read(fd, &raw, sizeof raw) != static_cast<ssize_t>(sizeof raw)) continue;
+    CanFrame f;
+    f.extended = (raw.can_id & CAN_EFF_FLAG) != 0;
+    f.id = raw.can_id & (f.extended ? CAN_EFF_MASK : CAN_SFF_MASK);
+    f.dlc = static_cast<std::uint8_t>(raw.can_dlc > 8 ? 8 : raw.can_dlc);
+    for (int i = 0; i < f.dlc; ++i) f.data[static_cast<std::size_t>(i)] = raw.data[i];
+    if (section_of(f) >= 0 && !is_block(f)) {
+      close(fd);
+      return 0;
+    }
+  }
+  close(fd);
+  std::printf("no motion on %s within %.0f s\n", iface, timeout_s);
+  return 1;
+}
+
 int main(int argc, char** argv) {
   const std::string mode = argc > 1 ? argv[1] : "";
   if (mode == "compare" && (argc == 5 || argc == 6)) {
@@ -272,6 +317,8 @@ int main(int argc, char** argv) {
   }
   if (mode == "traffic" && argc == 3) return traffic(argv[2]);
   if (mode == "safe" && argc == 5) return safe(argv[2], argv[3], std::strtod(argv[4], nullptr));
-  std::fprintf(stderr, "usage: can_backend_check compare|traffic|safe ...\n");
+  if (mode == "wait-motion" && argc == 4)
+    return wait_motion(argv[2], std::strtod(argv[3], nullptr));
+  std::fprintf(stderr, "usage: can_backend_check compare|traffic|safe|wait-motion ...\n");
   return 2;
 }
