@@ -519,25 +519,12 @@ const char* to_string(BackendKind kind) {
 
 CraneConfig parse_crane_config(std::string_view yaml_text, std::string_view source_name) {
   Reader reader{std::string(source_name)};
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(yaml_text));
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(std::string(source_name), e.mark.line + 1, "", "YAML syntax: " + e.msg);
-  }
-  try {
-    return read_config(reader, root, source_name);
-  } catch (const YAML::Exception& e) {  // a conversion yaml-cpp refused; report where
-    throw ConfigError(std::string(source_name), e.mark.line + 1, "", e.msg);
-  }
+  return read_yaml(yaml_text, source_name,
+                   [&](const YAML::Node& root) { return read_config(reader, root, source_name); });
 }
 
 CraneConfig load_crane_config(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(path.string(), 0, "", "cannot open the file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_crane_config(text.str(), path.string());
+  return parse_crane_config(read_text_file(path), path.string());
 }
 
 CraneConfig default_crane_config() {

@@ -157,25 +157,12 @@ JoystickConfig read_config(const Reader& r, const YAML::Node& root, std::string_
 
 JoystickConfig parse_joystick_config(std::string_view yaml_text, std::string_view source_name) {
   const Reader reader{std::string(source_name)};
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(yaml_text));
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(std::string(source_name), e.mark.line + 1, "", "YAML syntax: " + e.msg);
-  }
-  try {
-    return read_config(reader, root, source_name);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(std::string(source_name), e.mark.line + 1, "", e.msg);
-  }
+  return read_yaml(yaml_text, source_name,
+                   [&](const YAML::Node& root) { return read_config(reader, root, source_name); });
 }
 
 JoystickConfig load_joystick_config(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(path.string(), 0, "", "cannot open the file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_joystick_config(text.str(), path.string());
+  return parse_joystick_config(read_text_file(path), path.string());
 }
 
 JoystickConfig default_joystick_config() {

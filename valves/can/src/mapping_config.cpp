@@ -387,25 +387,12 @@ CanMapping read_mapping(const Reader& r, const YAML::Node& root) {
 
 CanMapping parse_can_mapping(std::string_view yaml_text, std::string_view source_name) {
   const Reader reader{std::string(source_name)};
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(yaml_text));
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(std::string(source_name), e.mark.line + 1, "", "YAML syntax: " + e.msg);
-  }
-  try {
-    return read_mapping(reader, root);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(std::string(source_name), e.mark.line + 1, "", e.msg);
-  }
+  return config::read_yaml(yaml_text, source_name,
+                           [&](const YAML::Node& root) { return read_mapping(reader, root); });
 }
 
 CanMapping load_can_mapping(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(path.string(), 0, "", "cannot open the file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_can_mapping(text.str(), path.string());
+  return parse_can_mapping(config::read_text_file(path), path.string());
 }
 
 }  // namespace craneassist::can

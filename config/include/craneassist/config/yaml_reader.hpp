@@ -5,8 +5,12 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <filesystem>
+#include <fstream>
 #include <initializer_list>
+#include <sstream>
 #include <string>
+#include <string_view>
 #include <utility>
 
 #include "craneassist/config/config_error.hpp"
@@ -55,5 +59,32 @@ class YamlReader {
  private:
   std::string file_;
 };
+
+// Parses YAML text and reads it with read(root): a syntax error, or a conversion yaml-cpp refuses
+// inside read, becomes a ConfigError naming the source and the line.
+template <typename Read>
+auto read_yaml(std::string_view yaml_text, std::string_view source_name, Read&& read)
+    -> decltype(read(std::declval<const YAML::Node&>())) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(yaml_text));
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(std::string(source_name), e.mark.line + 1, "", "YAML syntax: " + e.msg);
+  }
+  try {
+    return read(root);
+  } catch (const YAML::Exception& e) {  // a conversion yaml-cpp refused; report where
+    throw ConfigError(std::string(source_name), e.mark.line + 1, "", e.msg);
+  }
+}
+
+// The whole file as text; ConfigError naming the file when it cannot be opened.
+inline std::string read_text_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError(path.string(), 0, "", "cannot open the file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
 
 }  // namespace craneassist::config
