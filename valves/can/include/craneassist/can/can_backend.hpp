@@ -10,7 +10,7 @@
 //     outside the signal's min/max),
 //   - bus-off or error-passive reported by the controller (error frames),
 //   - send errors on max_send_errors consecutive sends,
-//   - a frozen control loop: write() not called for loop_timeout_s (100 ms; the watchdog thread
+//   - a frozen control loop: write() not called for loop_timeout_s (80 ms; the watchdog thread
 //     notices and sends the block commands itself; armed by the first write() after enable())
 // latches a fault: every section is commanded to block (ISO 11783: state block, flow 0; signal
 // outputs: 0) on every cycle from then on, read() reports kFault and state.valid = false. The
@@ -36,7 +36,7 @@ namespace craneassist::can {
 
 struct CanBackendOptions {
   double feedback_timeout_s = 0.05;  // per joint: no position frame for this long -> fault
-  double loop_timeout_s = 0.1;       // write() not called for this long -> fault (watchdog)
+  double loop_timeout_s = 0.08;      // write() not called for this long -> fault (watchdog)
   double watchdog_period_s = 0.005;
   int max_send_errors = 3;           // consecutive failed sends -> fault
   std::string candump_log;           // candump -L file of all traffic; empty: none
