@@ -81,7 +81,16 @@ echo EXIT2-\$?
 stty -g > $work/after2.stty
 echo DONE2-\$((40 + 2))
 SCRIPT
-keys "clear; sh $work/ctrl_c.sh" Enter
+# Clear the pane first and see it cleared: the first run's last view stays on the screen, and a
+# Ctrl-C sent on it (before the second dashboard runs) would reach the wrong process.
+keys "clear" Enter
+i=0
+while pane | grep -q -F "Test crane"; do
+  i=$((i + 1))
+  [ $i -le 50 ] || fail "the pane was not cleared"
+  sleep 0.1
+done
+keys "sh $work/ctrl_c.sh" Enter
 wait_for "Test crane   backend sim" 10
 keys C-c
 wait_for DONE2-42 5
