@@ -37,10 +37,6 @@ namespace {
 namespace fs = std::filesystem;
 using input::SourceState;
 
-double steady_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
 fs::path temp_dir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("craneassist-test-command-input-" + name + "-" +
                                                     std::to_string(::getpid()));
@@ -171,9 +167,9 @@ dds::CommandWriterOptions writer_options(const std::string& identity, int domain
 // Polls until the state is `want` or `timeout_s` passes; the last sample in `out`.
 SourceState poll_until(dds::DdsCommandSource& source, SourceState want, double timeout_s,
                        input::OperatorCommand& out, dds::CommandWriter* writer = nullptr) {
-  const double end = steady_s() + timeout_s;
+  const double end = input::steady_now_s() + timeout_s;
   SourceState s = source.poll(out);
-  while (s != want && steady_s() < end) {
+  while (s != want && input::steady_now_s() < end) {
     if (writer != nullptr) writer->write({0.1, 0.0, 0.0}, false);
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
     s = source.poll(out);
@@ -196,7 +192,7 @@ TEST(DdsCommandSource, NoDataThenSamplesThenStaleThenDisconnected) {
 
   // A fresh sample: its values and a reception stamp on steady_clock.
   ASSERT_TRUE(writer->write({0.25, -0.1, 0.05}, true));
-  const double sent = steady_s();
+  const double sent = input::steady_now_s();
   double stamp = 0.0;
   for (int i = 0; i < 200; ++i) {
     source.poll(out);
@@ -214,7 +210,7 @@ TEST(DdsCommandSource, NoDataThenSamplesThenStaleThenDisconnected) {
   std::this_thread::sleep_for(std::chrono::milliseconds(150));
   EXPECT_EQ(source.poll(out), SourceState::kOk);
   EXPECT_EQ(out.stamp_s, stamp);
-  EXPECT_GT(steady_s() - out.stamp_s, 0.1);
+  EXPECT_GT(input::steady_now_s() - out.stamp_s, 0.1);
 
   const dds::CommandInputStats s = source.stats();
   EXPECT_GE(s.samples, 2u);
@@ -252,8 +248,8 @@ TEST(DdsCommandSource, AnInsecureWriterNeverMatches) {
   o.insecure = true;
   dds::CommandWriter writer(o);
   input::OperatorCommand out;
-  const double end = steady_s() + 2.0;
-  while (steady_s() < end) {
+  const double end = input::steady_now_s() + 2.0;
+  while (input::steady_now_s() < end) {
     writer.write({0.3, 0.0, 0.0}, true);
     EXPECT_EQ(source.poll(out), SourceState::kNoData);
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -273,8 +269,8 @@ TEST(DdsCommandSource, OneOperatorAtATime) {
   dds::CommandWriterOptions second_options = writer_options("operator", 184);
   second_options.sender = "second";
   dds::CommandWriter second(second_options);
-  const double end = steady_s() + 10.0;
-  while (source.stats().peak_matched_writers < 2 && steady_s() < end) {
+  const double end = input::steady_now_s() + 10.0;
+  while (source.stats().peak_matched_writers < 2 && input::steady_now_s() < end) {
     first.write({0.1, 0.0, 0.0}, false);
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }

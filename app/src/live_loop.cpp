@@ -9,10 +9,6 @@
 
 namespace craneassist::app {
 
-double steady_now_s() noexcept {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
 LiveSummary run_live(const config::CraneConfig& config, input::CommandSource& source,
                      valves::MachineInterface& machine, const LiveOptions& options, CsvLog* log) {
   Controller controller(config, options.controller);

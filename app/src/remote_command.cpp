@@ -36,10 +36,6 @@ extern "C" void on_remote_stop_signal(int) {
   input::KeyboardSource::restore_terminal();
 }
 
-double steady_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
 // Replay: the deadman is held released this long after a crane's reader matched, so the crane's
 // input monitor sees a release before the press (it arms only on a fresh release and press).
 constexpr double kLeadIn_s = 0.3;
@@ -53,18 +49,6 @@ std::string default_sender() {
   if (gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
   return std::string(user != nullptr && *user != '\0' ? user : "operator") + "@" +
          (host[0] != '\0' ? host : "localhost");
-}
-
-std::string missing_files(const config::SecurityFiles& s) {
-  std::string missing;
-  const std::pair<const char*, const std::string*> files[] = {
-      {"identity_ca", &s.identity_ca}, {"identity_certificate", &s.identity_certificate},
-      {"private_key", &s.private_key}, {"permissions_ca", &s.permissions_ca},
-      {"governance", &s.governance},   {"permissions", &s.permissions}};
-  for (const auto& [name, path] : files) {
-    if (path->empty()) missing += (missing.empty() ? "" : ", ") + std::string(name);
-  }
-  return missing;
 }
 
 void print_keys() {
@@ -145,7 +129,7 @@ int run_remote_command(const RemoteArgs& args) {
         "whose commands.security gives every file ({}: {} not given). "
         "tools/dds-security/make-certs.sh OUTDIR makes OUTDIR/operator.yaml; see "
         "docs/remote-commands.md",
-        tcfg.source_name, missing_files(sec));
+        tcfg.source_name, sec.missing());
     return kExitUsage;
   }
   if (!replay && !isatty(0)) {
@@ -208,7 +192,7 @@ int run_remote_command(const RemoteArgs& args) {
     if (replay) cursor.emplace(*replay);
     const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
         std::chrono::duration<double>(1.0 / args.rate_hz));
-    const double start = steady_s();
+    const double start = input::steady_now_s();
     auto next = std::chrono::steady_clock::now();
     double matched_since = -1.0;
     double play_start = -1.0;
@@ -216,7 +200,7 @@ int run_remote_command(const RemoteArgs& args) {
     const Eigen::Vector3d no_tip =
         Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
     while (!g_stop.load()) {
-      const double now = steady_s() - start;
+      const double now = input::steady_now_s() - start;
       if (args.duration_s > 0.0 && now >= args.duration_s) break;
       const int matched = writer->matched_readers();
       if (matched > 0 && matched_since < 0.0) matched_since = now;
@@ -244,7 +228,7 @@ int run_remote_command(const RemoteArgs& args) {
           }
         }
       } else {
-        keyboard->begin_cycle(steady_s(), no_tip);
+        keyboard->begin_cycle(input::steady_now_s(), no_tip);
         input::OperatorCommand c;
         if (keyboard->poll(c) == input::SourceState::kDisconnected) break;
         if (c.v_m_s.allFinite()) v = {c.v_m_s.x(), c.v_m_s.y(), c.v_m_s.z()};
@@ -267,7 +251,7 @@ int run_remote_command(const RemoteArgs& args) {
       writer->write({0.0, 0.0, 0.0}, false);
       std::this_thread::sleep_for(period);
     }
-    const double elapsed = steady_s() - start;
+    const double elapsed = input::steady_now_s() - start;
     keyboard.reset();  // restores the terminal
     signal(SIGINT, SIG_DFL);
     signal(SIGTERM, SIG_DFL);

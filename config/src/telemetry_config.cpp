@@ -179,20 +179,10 @@ TelemetryConfig read_config(const Reader& r, const YAML::Node& root, std::string
       s.governance = r.file_path(sec, "governance", p);
       s.permissions = r.file_path(sec, "permissions", p);
       if (!s.empty() && !s.complete()) {
-        std::string missing;
-        for (const auto& [name, value] :
-             {std::pair<const char*, const std::string*>{"identity_ca", &s.identity_ca},
-              {"identity_certificate", &s.identity_certificate},
-              {"private_key", &s.private_key},
-              {"permissions_ca", &s.permissions_ca},
-              {"governance", &s.governance},
-              {"permissions", &s.permissions}}) {
-          if (value->empty()) missing += (missing.empty() ? "" : ", ") + std::string(name);
-        }
         r.fail(sec, p,
                "give every file (identity_ca, identity_certificate, private_key, "
                "permissions_ca, governance, permissions) or none; missing: " +
-                   missing + " (docs/remote-commands.md)");
+                   s.missing() + " (docs/remote-commands.md)");
       }
     }
     if (c.commands.enabled && !c.commands.security.complete()) {

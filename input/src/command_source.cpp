@@ -1,5 +1,7 @@
 #include "craneassist/input/command_source.hpp"
 
+#include <chrono>
+
 namespace craneassist::input {
 
 const char* to_string(SourceState state) {
@@ -12,6 +14,10 @@ const char* to_string(SourceState state) {
       return "disconnected";
   }
   return "unknown";
+}
+
+double steady_now_s() noexcept {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 }  // namespace craneassist::input

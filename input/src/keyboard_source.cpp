@@ -4,7 +4,6 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <chrono>
 #include <stdexcept>
 
 namespace craneassist::input {
@@ -13,10 +12,6 @@ namespace {
 // The saved terminal state, for restore_terminal() from a signal handler.
 struct termios g_saved;
 std::atomic<int> g_saved_fd{-1};
-
-double steady_s() noexcept {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 
 }  // namespace
 
@@ -59,7 +54,7 @@ void KeyboardSource::begin_cycle(double /*now_s*/, const Eigen::Vector3d& tip_m)
 
 SourceState KeyboardSource::poll(OperatorCommand& out) noexcept {
   if (gone_) return SourceState::kDisconnected;
-  const double now = steady_s();
+  const double now = input::steady_now_s();
   for (int rounds = 0; rounds < 8; ++rounds) {  // bounded: at most 8 x 64 bytes per cycle
     struct pollfd p = {fd_, POLLIN, 0};
     const int ready = ::poll(&p, 1, 0);

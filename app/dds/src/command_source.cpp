@@ -1,7 +1,6 @@
 #include "craneassist/dds/command_source.hpp"
 
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
@@ -36,21 +35,17 @@ void check_command_input_settings(const config::TelemetryConfig& settings) {
 
 namespace {
 
-double steady_s() noexcept {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
 // The operator holds the command until its writer is gone or it is silent this long.
 constexpr double kOwnerSilence_s = 0.5;
 
 }  // namespace
 
 struct DdsCommandSource::Impl : public fdds::DataReaderListener {
-  explicit Impl(const config::TelemetryConfig& settings) : start_s(steady_s()) {
+  explicit Impl(const config::TelemetryConfig& settings) : start_s(input::steady_now_s()) {
     check_command_input_settings(settings);
     ParticipantOptions options = participant_options(settings);
     options.name = settings.participant_name + "-commands";
-    options.security = with_file_uri_paths(settings.commands.security);
+    options.security = settings.commands.security;
     participant = make_participant(options);
     fdds::Subscriber* subscriber = participant->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
     if (subscriber == nullptr) throw std::runtime_error("DDS: cannot create the subscriber");
@@ -86,7 +81,7 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
     if (s.current_count_change > 0) {
       writer_matches.fetch_add(s.current_count_change, std::memory_order_relaxed);
       if (first_match_s.load(std::memory_order_relaxed) < 0.0) {
-        first_match_s.store(steady_s() - start_s, std::memory_order_relaxed);
+        first_match_s.store(input::steady_now_s() - start_s, std::memory_order_relaxed);
       }
       if (s.current_count > peak_matched.load(std::memory_order_relaxed)) {
         peak_matched.store(s.current_count, std::memory_order_relaxed);
@@ -102,7 +97,7 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
   }
 
   void accept(const fdds::InstanceHandle_t& writer) {
-    const double now = steady_s();
+    const double now = input::steady_now_s();
     if (has_owner && writer != owner && now - owner_last_s <= kOwnerSilence_s) {
       other_senders.fetch_add(1, std::memory_order_relaxed);
       return;

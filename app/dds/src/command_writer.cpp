@@ -1,7 +1,6 @@
 #include "craneassist/dds/command_writer.hpp"
 
 #include <atomic>
-#include <chrono>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
@@ -9,6 +8,7 @@
 #include <stdexcept>
 
 #include "command_participant.hpp"
+#include "craneassist/input/command_source.hpp"
 #include "craneassist_msgs.h"
 #include "participant.hpp"
 
@@ -16,16 +16,8 @@ namespace craneassist::dds {
 
 namespace fdds = eprosima::fastdds::dds;
 
-namespace {
-
-double steady_s() noexcept {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-}  // namespace
-
 struct CommandWriter::Impl : public fdds::DataWriterListener {
-  explicit Impl(const CommandWriterOptions& options) : start_s(steady_s()) {
+  explicit Impl(const CommandWriterOptions& options) : start_s(input::steady_now_s()) {
     if (options.insecure && !options.security.empty()) {
       throw std::invalid_argument("insecure: DDS Security files given too");
     }
@@ -39,7 +31,7 @@ struct CommandWriter::Impl : public fdds::DataWriterListener {
     p.domain_id = options.domain_id;
     p.name = options.participant_name;
     p.transport = options.transport;
-    p.security = with_file_uri_paths(options.security);
+    p.security = options.security;
     participant = make_participant(p);
     fdds::Publisher* publisher = participant->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
     if (publisher == nullptr) throw std::runtime_error("DDS: cannot create the publisher");
@@ -64,7 +56,7 @@ struct CommandWriter::Impl : public fdds::DataWriterListener {
 
   void on_publication_matched(fdds::DataWriter*, const fdds::PublicationMatchedStatus& s) override {
     if (s.current_count > 0 && first_match_s.load() < 0.0) {
-      first_match_s.store(steady_s() - start_s);
+      first_match_s.store(input::steady_now_s() - start_s);
     }
     if (s.current_count > peak_matched.load()) peak_matched.store(s.current_count);
     matched.store(s.current_count);

@@ -6,6 +6,7 @@
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <filesystem>
 #include <mutex>
 #include <stdexcept>
 
@@ -35,6 +36,12 @@ namespace {
 void add_property(fdds::DomainParticipantQos& qos, const std::string& name,
                   const std::string& value) {
   qos.properties().properties().emplace_back(name, value);
+}
+
+// Fast DDS 2.9 takes security files as "file://PATH" (it drops the 7 characters of "file://"):
+// an absolute path, so that the participant does not depend on the working directory.
+std::string file_uri(const std::string& path) {
+  return "file://" + std::filesystem::absolute(path).lexically_normal().string();
 }
 
 template <typename PubSubType>
@@ -73,17 +80,17 @@ ParticipantPtr make_participant(const ParticipantOptions& options) {
           "permissions_ca, governance, permissions)");
     }
     add_property(qos, "dds.sec.auth.plugin", "builtin.PKI-DH");
-    add_property(qos, "dds.sec.auth.builtin.PKI-DH.identity_ca", "file://" + sec.identity_ca);
+    add_property(qos, "dds.sec.auth.builtin.PKI-DH.identity_ca", file_uri(sec.identity_ca));
     add_property(qos, "dds.sec.auth.builtin.PKI-DH.identity_certificate",
-                 "file://" + sec.identity_certificate);
-    add_property(qos, "dds.sec.auth.builtin.PKI-DH.private_key", "file://" + sec.private_key);
+                 file_uri(sec.identity_certificate));
+    add_property(qos, "dds.sec.auth.builtin.PKI-DH.private_key", file_uri(sec.private_key));
     add_property(qos, "dds.sec.access.plugin", "builtin.Access-Permissions");
     add_property(qos, "dds.sec.access.builtin.Access-Permissions.permissions_ca",
-                 "file://" + sec.permissions_ca);
+                 file_uri(sec.permissions_ca));
     add_property(qos, "dds.sec.access.builtin.Access-Permissions.governance",
-                 "file://" + sec.governance);
+                 file_uri(sec.governance));
     add_property(qos, "dds.sec.access.builtin.Access-Permissions.permissions",
-                 "file://" + sec.permissions);
+                 file_uri(sec.permissions));
     add_property(qos, "dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
   }
   ParticipantPtr p(fdds::DomainParticipantFactory::get_instance()->create_participant(

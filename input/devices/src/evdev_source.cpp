@@ -15,10 +15,6 @@
 namespace craneassist::input {
 namespace {
 
-double steady_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
 bool button_for(unsigned code, GamepadButton& out) {
   switch (code) {
     case BTN_SOUTH:
@@ -284,7 +280,7 @@ EvdevSource::~EvdevSource() {
 }
 
 void EvdevSource::service() {
-  const double now = steady_s();
+  const double now = steady_now_s();
   if (!reader_) {
     if (now >= next_open_s_) {
       next_open_s_ = now + options_.reopen_interval_s;
@@ -297,7 +293,7 @@ void EvdevSource::service() {
         published_.pad = decoder_.state();
         published_.has_state = true;
         published_.connected = true;
-        published_.stamp_s = steady_s();
+        published_.stamp_s = steady_now_s();
         latest_.publish(published_);
         return;
       }
@@ -313,10 +309,10 @@ void EvdevSource::service() {
     if (r == EventReader::Result::kNone) break;
     if (r == EventReader::Result::kGone) {
       reader_.reset();
-      next_open_s_ = steady_s() + options_.reopen_interval_s;
+      next_open_s_ = steady_now_s() + options_.reopen_interval_s;
       published_ = {};
       published_.connected = false;
-      published_.stamp_s = steady_s();
+      published_.stamp_s = steady_now_s();
       latest_.publish(published_);
       return;
     }
@@ -326,7 +322,7 @@ void EvdevSource::service() {
     }
   }
   // The state is confirmed now, events or not (a stick held still sends nothing).
-  published_.stamp_s = steady_s();
+  published_.stamp_s = steady_now_s();
   latest_.publish(published_);
 }
 

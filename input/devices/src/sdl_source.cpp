@@ -2,19 +2,10 @@
 
 #include <SDL.h>
 
-#include <chrono>
 #include <stdexcept>
 #include <string>
 
 namespace craneassist::input {
-namespace {
-
-double steady_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-}  // namespace
-
 SdlSource::SdlSource(const JoystickMapping& mapping, const Options& options)
     : mapper_(mapping), options_(options) {
   SDL_SetHint(SDL_HINT_JOYSTICK_ALLOW_BACKGROUND_EVENTS, "1");
@@ -76,7 +67,7 @@ void SdlSource::service() {
   } else {
     published_.pad = {};
   }
-  published_.stamp_s = steady_s();
+  published_.stamp_s = input::steady_now_s();
   latest_.publish(published_);
 }
 

@@ -91,8 +91,8 @@ struct LiveSummary {
   bool machine_fault = false;
 };
 
-// Reads the clock once; steady_clock seconds since its epoch (the stamps of device sources).
-double steady_now_s() noexcept;
+// The clock of device sources' stamps (input/command_source.hpp).
+using input::steady_now_s;
 
 LiveSummary run_live(const config::CraneConfig& config, input::CommandSource& source,
                      valves::MachineInterface& machine, const LiveOptions& options, CsvLog* log);

@@ -7,9 +7,11 @@
 // Debian's Fast CDR 1.0 headers do not compile as C++20, includes it.
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <utility>
 
 namespace craneassist::config {
 
@@ -37,13 +39,32 @@ struct SecurityFiles {
   std::string permissions_ca;        // CA certificate that signed governance and permissions
   std::string governance;            // signed governance document (S/MIME, .p7s)
   std::string permissions;           // signed permissions document (S/MIME, .p7s)
-  bool empty() const {
-    return identity_ca.empty() && identity_certificate.empty() && private_key.empty() &&
-           permissions_ca.empty() && governance.empty() && permissions.empty();
+  // The six files with their field names, in the settings file's order.
+  std::array<std::pair<const char*, const std::string*>, 6> files() const {
+    return {{{"identity_ca", &identity_ca},
+             {"identity_certificate", &identity_certificate},
+             {"private_key", &private_key},
+             {"permissions_ca", &permissions_ca},
+             {"governance", &governance},
+             {"permissions", &permissions}}};
   }
-  bool complete() const {
-    return !identity_ca.empty() && !identity_certificate.empty() && !private_key.empty() &&
-           !permissions_ca.empty() && !governance.empty() && !permissions.empty();
+  bool empty() const { return missing_count() == 6; }
+  bool complete() const { return missing_count() == 0; }
+  // The field names of the files not given, comma-separated, each after prefix ("" when every
+  // file is given).
+  std::string missing(const char* prefix = "") const {
+    std::string names;
+    for (const auto& [name, path] : files()) {
+      if (path->empty()) names += (names.empty() ? "" : ", ") + std::string(prefix) + name;
+    }
+    return names;
+  }
+
+ private:
+  int missing_count() const {
+    int n = 0;
+    for (const auto& file : files()) n += file.second->empty();
+    return n;
   }
 };
 

@@ -28,6 +28,9 @@ enum class SourceState {
 };
 const char* to_string(SourceState state);
 
+// The clock of real-time sources' stamps: std::chrono::steady_clock seconds since its epoch.
+double steady_now_s() noexcept;
+
 class CommandSource {
  public:
   virtual ~CommandSource() = default;
