@@ -25,12 +25,6 @@ class Reader : public YamlReader {
  public:
   using YamlReader::YamlReader;
 
-  std::string text(const YAML::Node& map, const std::string& key, const std::string& path) const {
-    const YAML::Node node = child(map, key, path);
-    if (!node.IsScalar()) fail(node, join(path, key), "expected a single value");
-    return node.Scalar();
-  }
-
   std::vector<double> values(const YAML::Node& map, const std::string& key, const std::string& path,
                              Dimension dimension, std::size_t count) {
     const YAML::Node node = child(map, key, path);
@@ -59,17 +53,6 @@ class Reader : public YamlReader {
     const double v = value(map, key, path, dimension);
     if (v < lo || v > hi) fail(map[key], join(path, key), "must be " + range_text);
     return v;
-  }
-
-  bool flag(const YAML::Node& map, const std::string& key, const std::string& path,
-            bool default_value) const {
-    const YAML::Node node = map[key];
-    if (!node.IsDefined()) return default_value;
-    if (node.IsScalar()) {
-      if (node.Scalar() == "true") return true;
-      if (node.Scalar() == "false") return false;
-    }
-    fail(node, join(path, key), "expected true or false");
   }
 
   int unsourced() const { return unsourced_; }

@@ -18,21 +18,6 @@ class Reader : public YamlReader {
  public:
   using YamlReader::YamlReader;
 
-  std::string text(const YAML::Node& map, const std::string& key, const std::string& path) const {
-    const YAML::Node node = child(map, key, path);
-    if (!node.IsScalar()) fail(node, join(path, key), "expected a single value");
-    return node.Scalar();
-  }
-
-  // An optional text field ("" when absent).
-  std::string optional_text(const YAML::Node& map, const std::string& key,
-                            const std::string& path) const {
-    const YAML::Node node = map[key];
-    if (!node.IsDefined() || node.IsNull()) return "";
-    if (!node.IsScalar()) fail(node, join(path, key), "expected a single value");
-    return node.Scalar();
-  }
-
   // A required value in [lo, hi].
   double value(const YAML::Node& map, const std::string& key, const std::string& path,
                Dimension dimension, double lo, double hi, const std::string& range_text) const {
@@ -46,15 +31,6 @@ class Reader : public YamlReader {
     const double v = q->si_values[0];
     if (!(v >= lo && v <= hi)) fail(node, field, "must be " + range_text);
     return v;
-  }
-
-  bool flag(const YAML::Node& map, const std::string& key, const std::string& path) const {
-    const YAML::Node node = map[key];
-    if (!node.IsDefined()) return false;
-    if (node.IsScalar() && (node.Scalar() == "true" || node.Scalar() == "false")) {
-      return node.Scalar() == "true";
-    }
-    fail(node, join(path, key), "expected true or false");
   }
 };
 
@@ -77,7 +53,7 @@ input::AxisShape read_axis(const Reader& r, const YAML::Node& node, const std::s
   } else {
     s.max = r.value(node, "max", path, Dimension::kVelocity, 0.0, 5.0, "0 to 5 m/s");
   }
-  s.invert = r.flag(node, "invert", path);
+  s.invert = r.flag(node, "invert", path, false);
   return s;
 }
 

@@ -19,31 +19,6 @@ class Reader : public YamlReader {
   Reader(std::string file, std::filesystem::path base_dir)
       : YamlReader(std::move(file)), base_dir_(std::move(base_dir)) {}
 
-  std::string text(const YAML::Node& map, const std::string& key, const std::string& path) const {
-    const YAML::Node node = child(map, key, path);
-    if (!node.IsScalar()) fail(node, join(path, key), "expected a single value");
-    return node.Scalar();
-  }
-
-  // An optional scalar ("" when absent or null).
-  std::string optional_text(const YAML::Node& map, const std::string& key,
-                            const std::string& path) const {
-    const YAML::Node node = map[key];
-    if (!node.IsDefined() || node.IsNull()) return "";
-    if (!node.IsScalar()) fail(node, join(path, key), "expected a single value");
-    return node.Scalar();
-  }
-
-  bool flag(const YAML::Node& map, const std::string& key, const std::string& path,
-            bool fallback) const {
-    const YAML::Node node = map[key];
-    if (!node.IsDefined() || node.IsNull()) return fallback;
-    if (node.IsScalar() && (node.Scalar() == "true" || node.Scalar() == "false")) {
-      return node.Scalar() == "true";
-    }
-    fail(node, join(path, key), "expected true or false");
-  }
-
   int integer(const YAML::Node& map, const std::string& key, const std::string& path, int lo,
               int hi, int fallback) const {
     const YAML::Node node = map[key];

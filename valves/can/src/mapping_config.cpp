@@ -59,17 +59,6 @@ class Reader : public config::YamlReader {
     return v;
   }
 
-  bool flag(const YAML::Node& map, const std::string& key, const std::string& path,
-            bool default_value) const {
-    const YAML::Node node = map[key];
-    if (!node.IsDefined()) return default_value;
-    if (node.IsScalar()) {
-      if (node.Scalar() == "true") return true;
-      if (node.Scalar() == "false") return false;
-    }
-    fail(node, join(path, key), "expected true or false");
-  }
-
   // A time such as "20 ms", in [lo, hi] seconds.
   double time(const YAML::Node& map, const std::string& key, const std::string& path, double lo,
               double hi, const std::string& range_text) const {

@@ -50,6 +50,33 @@ class YamlReader {
     return node;
   }
 
+  // A required single value.
+  std::string text(const YAML::Node& map, const std::string& key, const std::string& path) const {
+    const YAML::Node node = child(map, key, path);
+    if (!node.IsScalar()) fail(node, join(path, key), "expected a single value");
+    return node.Scalar();
+  }
+
+  // An optional single value ("" when absent or empty).
+  std::string optional_text(const YAML::Node& map, const std::string& key,
+                            const std::string& path) const {
+    const YAML::Node node = map[key];
+    if (!node.IsDefined() || node.IsNull()) return "";
+    if (!node.IsScalar()) fail(node, join(path, key), "expected a single value");
+    return node.Scalar();
+  }
+
+  // true or false; fallback when the key is absent.
+  bool flag(const YAML::Node& map, const std::string& key, const std::string& path,
+            bool fallback) const {
+    const YAML::Node node = map[key];
+    if (!node.IsDefined()) return fallback;
+    if (node.IsScalar() && (node.Scalar() == "true" || node.Scalar() == "false")) {
+      return node.Scalar() == "true";
+    }
+    fail(node, join(path, key), "expected true or false");
+  }
+
   static std::string join(const std::string& path, const std::string& key) {
     return path.empty() ? key : path + "." + key;
   }
