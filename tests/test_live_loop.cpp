@@ -5,6 +5,7 @@
 // times from the last fresh input to the stop command, to the tip at rest and to neutral valves.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -166,26 +167,38 @@ TEST(LiveLoop, RecordedSessionReplaysToTheSameLog) {
   const std::string a = read_file(live_log), b = read_file(replay_log);
   EXPECT_GT(a.size(), 100000u);
   EXPECT_TRUE(a == b) << "the replayed log differs from the live log";
-  // The log holds the fault intervals with neutral valves: the disconnect at 3.0..3.3 s stops
-  // the crane (the cmd columns hold nan) and, once at rest, every spool is exactly 0.
+  // The log holds the fault intervals (the cmd columns hold nan): the crane stops, and once the
+  // reference is at rest every spool is exactly 0.
   std::istringstream lines(a);
   std::string line;
-  int nan_rows = 0, neutral_rows = 0;
+  std::getline(lines, line);
+  std::vector<std::string> header;
+  {
+    std::istringstream names(line);
+    for (std::string x; std::getline(names, x, ',');) header.push_back(x);
+  }
+  auto column = [&](const std::string& name) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(it, header.end()) << name;
+    return static_cast<std::size_t>(it - header.begin());
+  };
+  const std::size_t cmd_vx = column("cmd_vx"), sdot = column("sdot"), spool1 = column("spool1");
+  int nan_rows = 0, at_rest_rows = 0, neutral_rows = 0;
   while (std::getline(lines, line)) {
-    const auto first = line.find(',');
-    if (line.compare(first + 1, 3, "nan") != 0) continue;
-    ++nan_rows;
-    // spool1..spool4 are the 4 columns before the last 4 (p_load).
     std::vector<std::string> f;
     std::istringstream fields(line);
     for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+    if (f[cmd_vx] != "nan") continue;
+    ++nan_rows;
+    if (std::stod(f[sdot]) != 0.0) continue;
+    ++at_rest_rows;
     bool neutral = true;
-    for (std::size_t i = f.size() - 8; i < f.size() - 4; ++i)
-      neutral = neutral && f[i] == "0.00000";
+    for (std::size_t i = spool1; i < spool1 + 4; ++i) neutral = neutral && f[i] == "0.00000";
     neutral_rows += neutral;
   }
   EXPECT_GT(nan_rows, 80);
-  EXPECT_GT(neutral_rows, 20);
+  EXPECT_GE(at_rest_rows, 3);
+  EXPECT_EQ(neutral_rows, at_rest_rows) << "at rest in a fault, every valve is neutral";
 }
 
 TEST(LiveLoop, StaleInputStopsJerkLimitedAndMotionResumesOnlyAfterReArm) {

@@ -79,12 +79,6 @@ double simulated_braking(double a, double jerk, double t) {
   return v;
 }
 
-// Stop distance of the continuous time-optimal stop from v (zero initial acceleration).
-double stop_distance(double v, double decel, double jerk) {
-  if (v >= decel * decel / jerk) return v * v / (2 * decel) + v * decel / (2 * jerk);
-  return v * std::sqrt(v / jerk);
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------

@@ -52,16 +52,23 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
   if (options_.mode == ScalingMode::kFull) {
     const auto& sc = config.scaling;
     terms_ = std::make_unique<dynamics::RigidBodyTerms>(model_);
-    tip_path_ = std::make_unique<scaling::TipPath>(
-        model_,
-        scaling::TipPathConfig{period_s_, sc.direction_change_acceleration_m_s2, sc.jerk_max_m_s3,
-                               sc.deceleration_max_m_s2, config.redundancy.resolution});
-    scaler_ = std::make_unique<scaling::PathScaler>(
-        model_,
-        scaling::PathScalerConfig{period_s_, sc.jerk_max_m_s3, sc.acceleration_max_m_s2,
-                                  flow_reserve_, to_power_bound(sc.power_bound), sc.power_reserve,
-                                  sc.deceleration_max_m_s2},
-        *terms_);
+    scaling::TipPathConfig path;
+    path.period_s = period_s_;
+    path.jerk_max = sc.jerk_max_m_s3;
+    path.deceleration_max = sc.deceleration_max_m_s2;
+    path.flow_reserve = flow_reserve_;
+    path.resolution = config.redundancy.resolution;
+    tip_path_ = std::make_unique<scaling::TipPath>(model_, path);
+    scaling::TipScalerConfig scaler;
+    scaler.period_s = period_s_;
+    scaler.jerk_max = sc.jerk_max_m_s3;
+    scaler.acceleration_max = sc.acceleration_max_m_s2;
+    scaler.deceleration_max = sc.deceleration_max_m_s2;
+    scaler.normal_acceleration_max = sc.direction_change_acceleration_m_s2;
+    scaler.flow_reserve = flow_reserve_;
+    scaler.power_bound = to_power_bound(sc.power_bound);
+    scaler.power_reserve = sc.power_reserve;
+    scaler_ = std::make_unique<scaling::TipScaler>(model_, scaler, *terms_);
   }
 }
 
@@ -101,7 +108,8 @@ ControllerStatus Controller::update(const valves::MachineState& state, const Eig
   }
   out.q_ref = q_ref_;
 
-  const bool at_rest = out.qdot_ref.isZero(0.0) && out.sddot == 0.0;
+  const bool at_rest = out.qdot_ref.isZero(0.0) && out.sddot == 0.0 &&
+                       (options_.mode != ScalingMode::kFull || scaler_out_.at_rest);
   if (stale && at_rest) {
     follower_.neutral(out.valves);  // stopped: valves neutral
     neutral_ = true;
@@ -131,37 +139,50 @@ void Controller::update_full(const valves::MachineState& state, const Eigen::Vec
     cylinder_force_ = scaler_out_.terms.b.cwiseQuotient(dc_dq_);
     forces = &cylinder_force_;
   }
-  const double s_before = scaler_->state().s;
-  tip_path_->update(q_ref_, v_cmd, scaler_->state().sdot, tip_out_, forces);
-  scaling::PathScalerInput in;
-  in.sdot_request = tip_out_.sdot_request;
+  const Eigen::Vector3d u = scaler_->direction(v_cmd);
+  scaling::TipPathInput path_in;
+  path_in.direction = u;
+  path_in.sdot = scaler_->speed();
+  path_in.intended_speed = stale ? path_in.sdot : scaler_->intended_speed(v_cmd);
+  path_in.cylinder_force = forces;
+  tip_path_->update(q_ref_, path_in, tip_out_);
+  scaling::TipScalerInput in;
+  in.command = v_cmd;
+  in.direction = u;
   in.tracking_factor = scaling::tracking_factor(tip_error_filtered_m_, tracking_error_ok_m_);
   in.sdot_joint_limit = tip_out_.sdot_joint_limit;
+  in.end_distance_m = tip_out_.end_distance_m;
+  in.stop_deceleration_m_s2 = tip_out_.stop_deceleration_m_s2;
+  in.stop_jerk_m_s3 = tip_out_.stop_jerk_m_s3;
+  in.singular_ahead = tip_out_.singular_ahead;
+  in.near_singular = tip_out_.near_singular;
   in.stale_input = stale;
   scaler_->update(q_ref_, tip_out_.geometry, in, scaler_out_);
 
+  // The reference moves along u by the tip displacement of this cycle.
   const auto& g = tip_out_.geometry;
-  const auto& st = scaler_out_.state;
-  const double ds = st.s - s_before;
+  const double ds = scaler_out_.ds;
   for (int i = 0; i < model_.dof(); ++i) {
     const auto& joint = model_.joints[static_cast<std::size_t>(i)];
     q_ref_[i] =
         std::clamp(q_ref_[i] + g.f1[i] * ds + 0.5 * g.f2[i] * ds * ds, joint.q_min, joint.q_max);
   }
-  out.qdot_ref = g.f1 * st.sdot;
-  out.ref_tip_velocity_m_s = tip_out_.direction * st.sdot;
+  const double along = scaler_out_.velocity.dot(u);
+  out.qdot_ref = g.f1 * along;
+  out.ref_tip_velocity_m_s = u * along;  // = J(q_ref) qdot_ref
   const double v_cmd_norm = v_cmd.norm();
-  out.scale = v_cmd_norm > 0.0 ? st.sdot / v_cmd_norm : 1.0;
+  out.scale = v_cmd_norm > 0.0 ? scaler_out_.sdot / v_cmd_norm : 1.0;
   out.flow_demand_m3_s = scaler_out_.speed.flow_per_speed_m3 * v_cmd_norm;
   out.limit = scaler_out_.limit;
-  out.s = st.s;
-  out.sdot = st.sdot;
-  out.sddot = st.sddot;
-  out.sdddot = st.sdddot;
+  out.s = scaler_out_.s;
+  out.sdot = scaler_out_.sdot;
+  out.sddot = scaler_out_.at_rest ? 0.0 : scaler_out_.sddot;
+  out.sdddot = scaler_out_.sdddot;
   out.sddot_min = scaler_out_.bounds.sddot_min;
   out.sddot_max = scaler_out_.bounds.sddot_max;
   out.tip_error_m = tip_error_filtered_m_;
-  out.ref_power_w = scaling::pump_power(model_, g, scaler_out_.terms, st.sdot, st.sddot);
+  out.ref_power_w =
+      scaling::pump_power(model_, g, scaler_out_.terms, std::abs(along), scaler_out_.sddot);
 }
 
 void Controller::update_rate_prescaled(const Eigen::Vector3d& v_cmd, ControllerOutput& out) {

@@ -24,6 +24,8 @@ const char* to_string(ActiveLimit limit) {
       return "cylinder_acceleration";
     case ActiveLimit::kStaleInput:
       return "stale_input";
+    case ActiveLimit::kSingularity:
+      return "singularity";
   }
   return "?";
 }

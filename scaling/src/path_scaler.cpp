@@ -10,6 +10,29 @@ double tracking_factor(double error_m, double error_ok_m) {
   return error_ok_m / error_m;
 }
 
+SpeedCap lowest_speed_cap(double sdot_request, double tracking_factor, double sdot_joint_limit,
+                          const SpeedLimits& speed, const AccelerationBounds& bounds,
+                          bool near_singular) {
+  const ActiveLimit cylinder_speed =
+      near_singular ? ActiveLimit::kSingularity : ActiveLimit::kCylinderSpeed;
+  const ActiveLimit cylinder_acceleration =
+      near_singular ? ActiveLimit::kSingularity : ActiveLimit::kCylinderAcceleration;
+  const SpeedCap candidates[] = {
+      {sdot_request * tracking_factor,
+       tracking_factor < 1.0 ? ActiveLimit::kTrackingError : ActiveLimit::kNone},
+      {speed.sdot_flow, ActiveLimit::kFlow},
+      {speed.sdot_cylinder, cylinder_speed},
+      {sdot_joint_limit, ActiveLimit::kJointLimit},
+      {bounds.sdot_power, ActiveLimit::kPower},
+      {bounds.sdot_acceleration, cylinder_acceleration},
+  };
+  SpeedCap lowest = candidates[0];
+  for (const auto& c : candidates) {
+    if (c.value < lowest.value) lowest = c;
+  }
+  return lowest;
+}
+
 PathScaler::PathScaler(const dynamics::CraneModel& model, const PathScalerConfig& config,
                        dynamics::RigidBodyTerms& terms)
     : model_(model),
@@ -35,23 +58,8 @@ void PathScaler::update(const JointVector& q, const PathGeometry& geometry,
   terms_.path_terms(q, geometry.f1, geometry.f2, sdot, out.terms);
   path_acceleration_bounds(model_, geometry, out.terms, sdot, acceleration_limits_, out.bounds);
 
-  struct Candidate {
-    double value;
-    ActiveLimit kind;
-  };
-  const Candidate candidates[] = {
-      {in.sdot_request * in.tracking_factor,
-       in.tracking_factor < 1.0 ? ActiveLimit::kTrackingError : ActiveLimit::kNone},
-      {out.speed.sdot_flow, ActiveLimit::kFlow},
-      {out.speed.sdot_cylinder, ActiveLimit::kCylinderSpeed},
-      {in.sdot_joint_limit, ActiveLimit::kJointLimit},
-      {out.bounds.sdot_power, ActiveLimit::kPower},
-      {out.bounds.sdot_acceleration, ActiveLimit::kCylinderAcceleration},
-  };
-  Candidate lowest = candidates[0];
-  for (const auto& c : candidates) {
-    if (c.value < lowest.value) lowest = c;
-  }
+  const SpeedCap lowest = lowest_speed_cap(in.sdot_request, in.tracking_factor, in.sdot_joint_limit,
+                                           out.speed, out.bounds);
   out.sdot_d = std::max(lowest.value, 0.0);
   if (in.stale_input) out.sdot_d = 0.0;
 

@@ -73,6 +73,25 @@ double max_speed_to_stop_within(double distance, double decel_max, double jerk_m
   return 2.0 * c / (b + std::sqrt(b * b + 4.0 * c));
 }
 
+double stop_distance(double speed, double decel_max, double jerk_max) {
+  if (!(speed > 0.0)) return 0.0;
+  if (!(decel_max > 0.0) || !(jerk_max > 0.0)) return kInf;
+  if (std::isinf(jerk_max)) return speed * speed / (2.0 * decel_max);
+  if (std::isinf(decel_max) || speed * jerk_max <= decel_max * decel_max) {
+    return std::sqrt(speed * speed * speed / jerk_max);
+  }
+  return speed * speed / (2.0 * decel_max) + speed * decel_max / (2.0 * jerk_max);
+}
+
+double braking_distance(double speed, double acceleration, double decel_max, double jerk_max) {
+  if (!(acceleration > 0.0) || std::isinf(jerk_max)) {
+    return stop_distance(speed, decel_max, jerk_max);
+  }
+  const double t = acceleration / jerk_max;  // until the acceleration is zero
+  const double ramp = speed * t + 0.5 * acceleration * t * t - jerk_max * t * t * t / 6.0;
+  return ramp + stop_distance(speed + 0.5 * acceleration * t, decel_max, jerk_max);
+}
+
 ScalingFilter::ScalingFilter(const ScalingFilterConfig& config)
     : config_(config),
       valid_(positive_finite(config.period_s) && positive_finite(config.jerk_max)) {}

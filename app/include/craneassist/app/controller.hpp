@@ -1,11 +1,13 @@
 // The per-cycle control pipeline, read top to bottom (MoveIt Servo's shape). With full scaling
 // (the default):
 //   tip-velocity command
-//   -> path-velocity decomposition: direction (blended) and speed    scaling::TipPath
-//   -> redundancy resolution of the direction (SNS), f' and f''      scaling::TipPath
-//   -> speed limits: flow, cylinder speeds, end damping, power, tracking error
+//   -> the path direction u: the reference velocity's (at rest: the command's)  scaling::TipScaler
+//   -> redundancy resolution of u, f' and f'', joints kept off their ends       scaling::TipPath
+//   -> speed limits along u: flow, cylinder speeds, end damping, power, tracking error,
+//      singularity: one factor on the whole command
 //   -> acceleration bounds from the ODE dynamics (load-sensing power, cylinder accelerations)
-//   -> jerk-bounded scaling filter: s, sdot, sddot, sdddot           scaling::PathScaler
+//   -> the reference tip velocity moved towards the scaled command along the straight segment
+//      between them, jerk-limited                                                scaling::TipScaler
 //   -> reference integration along the path (the reference runs on its own joint state q_ref)
 //   -> valve commands: dead-zone inverse of the cylinder velocity reference plus P feedback on
 //      the cylinder position error against the reference of one valve delay ago
@@ -23,8 +25,8 @@
 #include "craneassist/dynamics/rigid_body_terms.hpp"
 #include "craneassist/scaling/active_limit.hpp"
 #include "craneassist/scaling/flow_prescaling.hpp"
-#include "craneassist/scaling/path_scaler.hpp"
 #include "craneassist/scaling/tip_path.hpp"
+#include "craneassist/scaling/tip_scaler.hpp"
 #include "craneassist/valves/machine_interface.hpp"
 #include "craneassist/valves/reference_follower.hpp"
 
@@ -90,7 +92,7 @@ class Controller {
   valves::ReferenceFollower follower_;
   std::unique_ptr<dynamics::RigidBodyTerms> terms_;
   std::unique_ptr<scaling::TipPath> tip_path_;
-  std::unique_ptr<scaling::PathScaler> scaler_;
+  std::unique_ptr<scaling::TipScaler> scaler_;
   // Per-cycle working data (Pinocchio's Data), preallocated.
   dynamics::KinematicsData kin_;
   dynamics::TaskJacobian jacobian_;
@@ -98,7 +100,7 @@ class Controller {
   dynamics::SnsResult sns_;
   scaling::FlowPrescalingResult prescale_;
   scaling::TipPathOutput tip_out_;
-  scaling::PathScalerOutput scaler_out_;
+  scaling::TipScalerOutput scaler_out_;
   JointVector dc_dq_, qddot_max_, cylinder_force_;
   JointVector q_ref_;
   double tip_error_filtered_m_ = 0.0;

@@ -13,8 +13,9 @@ enum class ActiveLimit {
   kJointLimit,            // a joint or cylinder end is near
   kStaleInput,            // no valid operator input
   kCylinderAcceleration,  // a cylinder's maximum acceleration (path curvature at speed)
+  kSingularity,           // a near-singular pose: the direction needs very fast joints
 };
-inline constexpr int kActiveLimitCount = 8;
+inline constexpr int kActiveLimitCount = 9;
 
 const char* to_string(ActiveLimit limit);
 

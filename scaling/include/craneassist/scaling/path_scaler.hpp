@@ -72,4 +72,16 @@ class PathScaler {
 // delta(|e|) of algorithms.md section 6: 1 below e_ok, e_ok / |e| above.
 double tracking_factor(double error_m, double error_ok_m);
 
+// The lowest of the velocity-level limits on the path speed and what sets it: the operator's
+// request times the tracking factor, pump flow, cylinder speeds, end damping, the quasi-static
+// power and the path curvature (cylinder accelerations). near_singular reports the cylinder
+// limits as kSingularity: the pose, not the cylinder, is what makes them low.
+struct SpeedCap {
+  double value = 0.0;
+  ActiveLimit kind = ActiveLimit::kNone;
+};
+SpeedCap lowest_speed_cap(double sdot_request, double tracking_factor, double sdot_joint_limit,
+                          const SpeedLimits& speed, const AccelerationBounds& bounds,
+                          bool near_singular = false);
+
 }  // namespace craneassist::scaling

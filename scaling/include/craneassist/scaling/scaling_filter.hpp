@@ -151,4 +151,14 @@ double braking_velocity_change(double sddot, double jerk_max, double period_s);
 // non-positive or NaN arguments (no speed is safe then).
 double max_speed_to_stop_within(double distance, double decel_max, double jerk_max);
 
+// The distance a stop from speed v >= 0 and acceleration a covers when the acceleration is first
+// brought to zero at full jerk (a > 0) and the stop_distance below follows; for a <= 0 the
+// stop_distance from v (an upper bound). Continuous time.
+double braking_distance(double speed, double acceleration, double decel_max, double jerk_max);
+
+// Its inverse: the distance a stop from speed v with zero initial acceleration, jerk <= jerk_max
+// and deceleration <= decel_max covers (continuous time): sqrt(v^3 / J) below v = A^2/J,
+// v^2/(2A) + v A/(2J) above. 0 for v <= 0; +inf for non-positive or NaN limits.
+double stop_distance(double speed, double decel_max, double jerk_max);
+
 }  // namespace craneassist::scaling

@@ -1,0 +1,117 @@
+// The scaling of tip teleoperation: the reference tip velocity, a vector, moved each cycle towards
+// the operator's command scaled by one factor, along the straight segment between them.
+//
+// Each cycle:
+//   1. The path runs along u, the direction of the present reference velocity v (at rest: the
+//      command's). TipPath resolves u into f', f''.
+//   2. Velocity-level limits along u (pump flow, cylinder speeds, quasi-static power, path
+//      curvature, end damping, tracking error; lowest_speed_cap) give one factor k <= 1 on the
+//      whole command: the target is c* = k c, so the tip keeps the commanded direction.
+//   3. The reference velocity moves from v towards c* along the segment between them, as a
+//      jerk-limited scalar motion along e = (c* - v)/|c* - v| (the ScalingFilter: minimum time,
+//      no overshoot, acceleration inside moving bounds); Ruckig calls this phase
+//      synchronisation. A turn therefore rounds inside the plane of the two commands. A reversal
+//      (the segment passes through rest, or within 5 % of the speed of it) decelerates to rest on
+//      the line, acceleration included, and accelerates back along it. Acceleration left over
+//      from an earlier segment, across the new one, is brought to zero at half the jerk bound.
+//   4. The acceleration along e is bounded so that the tangential part (along u) stays within the
+//      path's acceleration bounds (the load-sensing power limit with m(s), b(s) from the ODE
+//      model, cylinder accelerations, path acceleration and deceleration; path_constraints.hpp)
+//      and the normal part within normal_acceleration_max.
+//
+// A stale input stops along the present direction (target 0) within the same bounds; at rest
+// with a zero target the reference stays exactly at rest. No allocation, no exceptions, bounded
+// work per cycle.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "craneassist/dynamics/rigid_body_terms.hpp"
+#include "craneassist/scaling/path_constraints.hpp"
+#include "craneassist/scaling/path_scaler.hpp"
+#include "craneassist/scaling/scaling_filter.hpp"
+
+namespace craneassist::scaling {
+
+struct TipScalerConfig {
+  double period_s = 0.01;
+  double jerk_max = 5.0;                 // tip jerk bound, m/s^3
+  double acceleration_max = 1.0;         // path acceleration, m/s^2
+  double deceleration_max = 1.0;         // path deceleration, m/s^2
+  double normal_acceleration_max = 0.6;  // tip acceleration across u (turning), m/s^2
+  double flow_reserve = 0.0;
+  PowerBound power_bound = PowerBound::kLoadSensing;
+  double power_reserve = 0.0;
+};
+
+struct TipScalerInput {
+  Eigen::Vector3d command = Eigen::Vector3d::Zero();     // finite, m/s; zero: stop
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();  // u this cycle (direction())
+  double tracking_factor = 1.0;
+  double sdot_joint_limit = 1e300;  // end damping along u
+  // Path length left before a joint end along u, and the stop a brake there may use
+  // (TipPathOutput): the scaler brakes when a stop from its speed and acceleration needs it.
+  double end_distance_m = 1e300;
+  double stop_deceleration_m_s2 = 1.0;
+  double stop_jerk_m_s3 = 1.0;
+  bool singular_ahead = false;  // the end distance is to a singular pose (status: singularity)
+  bool near_singular = false;
+  bool stale_input = false;
+};
+
+struct TipScalerOutput {
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();      // after this cycle, m/s
+  Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();  // after this cycle, m/s^2
+  double ds = 0.0;            // tip displacement along u this cycle (signed), m
+  double s = 0.0;             // path length covered since reset, m
+  double sdot = 0.0;          // |velocity|
+  double sddot = 0.0;         // acceleration along the velocity's direction
+  double sdddot = 0.0;        // |jerk| of this cycle
+  double target_speed = 0.0;  // |c*|: the scaled command speed
+  double scale = 1.0;         // k = |c*| / |c| (1 without a command)
+  SpeedLimits speed;
+  AccelerationBounds bounds;
+  dynamics::PathTerms terms;  // m(s), b(s) along u at the start of the cycle
+  ActiveLimit limit = ActiveLimit::kNone;
+  bool at_rest = true;  // velocity and acceleration exactly zero
+};
+
+class TipScaler {
+ public:
+  // terms: the ODE dynamics probe of the same model; used every cycle, not owned.
+  TipScaler(const dynamics::CraneModel& model, const TipScalerConfig& config,
+            dynamics::RigidBodyTerms& terms);
+
+  // At rest.
+  void reset();
+
+  // The direction the path runs along this cycle: the present velocity's, or at rest the
+  // command's (or the last direction without a command).
+  Eigen::Vector3d direction(const Eigen::Vector3d& command) const;
+  // The speed the motion heads for with this command: the bounds of the redundancy resolution
+  // are shaped for it (ahead of the present speed by a margin, never beyond the command).
+  double intended_speed(const Eigen::Vector3d& command) const;
+  double speed() const { return velocity_.norm(); }
+  const Eigen::Vector3d& velocity() const { return velocity_; }
+
+  // geometry: TipPath's resolution of in.direction at q.
+  void update(const JointVector& q, const PathGeometry& geometry, const TipScalerInput& in,
+              TipScalerOutput& out);
+
+ private:
+  const dynamics::CraneModel& model_;
+  TipScalerConfig config_;
+  dynamics::RigidBodyTerms& terms_;
+  AccelerationLimits acceleration_limits_;
+  Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d acceleration_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d last_direction_ = Eigen::Vector3d::UnitX();
+  double s_ = 0.0;
+  bool reversing_ = false;  // coming to rest before leaving the other way
+  bool end_brake_ = false;  // braked at a joint end, holding until the end damping frees it
+  bool end_brake_singular_ = false;  // ... or before a singular pose
+  double rest_time_s_ = 0.0;         // at rest since the brake
+  Eigen::Vector3d end_brake_command_ = Eigen::Vector3d::Zero();
+};
+
+}  // namespace craneassist::scaling

@@ -1,0 +1,213 @@
+#include "craneassist/scaling/tip_scaler.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace craneassist::scaling {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kSegmentEpsilon = 1e-12;  // m/s: a target this close is reached
+// The scalar filter runs on progress along the segment offset by this, so that its target is
+// never zero (a zero target means "stop" to the filter, here it means "arrived").
+constexpr double kProgressOffset = 1.0;
+// The intended speed runs ahead of the present one by this much (and this share).
+constexpr double kIntendedMargin = 0.2;
+constexpr double kIntendedShare = 1.25;
+// A change of command whose straight segment passes this close to rest (share of the larger
+// speed) is a reversal.
+constexpr double kReversalShare = 0.05;
+// After braking at a joint end: restart once the end damping allows this share of the request
+// (at least kRestartSpeed), or when the command changes by more than kCommandChange of itself.
+constexpr double kRestartShare = 0.3;
+constexpr double kRestartSpeed = 0.05;  // m/s
+constexpr double kCommandChange = 0.02;
+constexpr double kMinRestTime = 0.4;  // s: valve delay and lag with margin
+
+}  // namespace
+
+TipScaler::TipScaler(const dynamics::CraneModel& model, const TipScalerConfig& config,
+                     dynamics::RigidBodyTerms& terms)
+    : model_(model), config_(config), terms_(terms) {
+  acceleration_limits_.path_acceleration_max = config.acceleration_max;
+  acceleration_limits_.power_bound = config.power_bound;
+  acceleration_limits_.power_reserve = config.power_reserve;
+  acceleration_limits_.path_deceleration_max = config.deceleration_max;
+}
+
+void TipScaler::reset() {
+  velocity_.setZero();
+  acceleration_.setZero();
+  reversing_ = false;
+  end_brake_ = false;
+  s_ = 0.0;
+}
+
+Eigen::Vector3d TipScaler::direction(const Eigen::Vector3d& command) const {
+  const double speed = velocity_.norm();
+  if (speed > 0.0) return velocity_ / speed;
+  const double accel = acceleration_.norm();
+  if (accel > 0.0) return acceleration_ / accel;  // leaving rest (a reversal through zero)
+  const double c = command.norm();
+  if (c > 0.0 && std::isfinite(c)) return command / c;
+  return last_direction_;
+}
+
+double TipScaler::intended_speed(const Eigen::Vector3d& command) const {
+  const double speed = velocity_.norm();
+  const double c = command.allFinite() ? command.norm() : 0.0;
+  return std::max(speed, std::min(c, std::max(kIntendedShare * speed, speed + kIntendedMargin)));
+}
+
+void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const TipScalerInput& in,
+                       TipScalerOutput& out) {
+  const double period = config_.period_s;
+  const double jerk = config_.jerk_max;
+  const Eigen::Vector3d& u = in.direction;
+  const double speed = velocity_.norm();
+
+  // Velocity-level limits along u and the acceleration bounds at the present speed.
+  path_speed_limits(model_, geometry, config_.flow_reserve, out.speed);
+  terms_.path_terms(q, geometry.f1, geometry.f2, speed, out.terms);
+  path_acceleration_bounds(model_, geometry, out.terms, speed, acceleration_limits_, out.bounds);
+
+  // One factor on the whole command.
+  const double request = in.command.norm();
+  const SpeedCap cap = lowest_speed_cap(request, in.tracking_factor, in.sdot_joint_limit, out.speed,
+                                        out.bounds, in.near_singular);
+  double target = in.stale_input ? 0.0 : std::clamp(cap.value, 0.0, request);
+  // Braking trigger at a joint end: the end damping cap assumes braking from zero acceleration;
+  // while the path still accelerates, braking must begin earlier.
+  // Once braked there, the reference stays at rest until the end damping would allow a useful
+  // speed again or the stick moves elsewhere: no creeping in stop-and-go steps, which makes the
+  // valves chatter through their dead zones.
+  if (speed > 0.0 && braking_distance(speed, acceleration_.dot(u), in.stop_deceleration_m_s2,
+                                      in.stop_jerk_m_s3) >= in.end_distance_m) {
+    end_brake_ = true;
+    rest_time_s_ = 0.0;
+    end_brake_singular_ = in.singular_ahead;
+    end_brake_command_ = in.command;
+  } else if (end_brake_) {
+    // Having come to rest, it stays there long enough for the valves to settle (a restart right
+    // after the stop, with the machine still moving, would swing spools across their dead
+    // zones).
+    rest_time_s_ = speed == 0.0 ? rest_time_s_ + period : 0.0;
+    const double restart = std::max(kRestartShare * request, kRestartSpeed);
+    const bool moved = (in.command - end_brake_command_).norm() > kCommandChange * request;
+    const bool settled = speed > 0.0 || rest_time_s_ >= kMinRestTime;
+    if ((in.sdot_joint_limit >= restart && settled) || moved || request == 0.0) end_brake_ = false;
+  }
+  const bool end_brake = end_brake_;
+  if (end_brake) target = 0.0;
+  Eigen::Vector3d goal =
+      request > 0.0 ? Eigen::Vector3d(in.command * (target / request)) : Eigen::Vector3d::Zero();
+  out.target_speed = target;
+  out.scale = request > 0.0 ? target / request : 1.0;
+
+  // A reversal (the segment to the goal passes through rest, or within kReversalShare of it)
+  // comes to rest first, acceleration included, and leaves towards the goal from rest: every
+  // valve then crosses its dead zone at rest instead of at full deceleration.
+  if (speed > 0.0 && !reversing_) {
+    const Eigen::Vector3d span = goal - velocity_;
+    const double span2 = span.squaredNorm();
+    const double t = span2 > 0.0 ? std::clamp(-velocity_.dot(span) / span2, 0.0, 1.0) : 0.0;
+    const double closest = (velocity_ + t * span).norm();
+    reversing_ =
+        goal.dot(velocity_) < 0.0 && closest < kReversalShare * std::max(speed, goal.norm());
+  }
+  if (reversing_) goal.setZero();
+
+  // The segment from the present velocity to the goal.
+  Eigen::Vector3d d = goal - velocity_;
+  double distance = d.norm();
+  const double accel = acceleration_.norm();
+  Eigen::Vector3d v_new = velocity_, a_new = acceleration_;
+  ScalingFilterStatus status = ScalingFilterStatus::kTracking;
+  if (distance == 0.0 && accel == 0.0) {
+    status = ScalingFilterStatus::kStopped;  // holding: nothing changes
+  } else {
+    Eigen::Vector3d e;
+    if (distance > kSegmentEpsilon) {
+      e = d / distance;
+    } else {
+      distance = 0.0;
+      e = accel > 0.0 ? Eigen::Vector3d(-acceleration_ / accel) : u;
+    }
+    const double a_par = acceleration_.dot(e);
+    const Eigen::Vector3d a_perp = acceleration_ - a_par * e;
+    const double perp = a_perp.norm();
+    const double perp_step = std::min(perp, 0.5 * jerk * period);
+    const Eigen::Vector3d a_perp_new = perp > perp_step
+                                           ? Eigen::Vector3d(a_perp * (1.0 - perp_step / perp))
+                                           : Eigen::Vector3d::Zero();
+
+    // Bounds on the acceleration along e: its tangential part within the path's bounds (no
+    // constraint may force the path to speed up), its normal part within the turning limit.
+    double lo = -kInf, hi = kInf;
+    const double eu = e.dot(u);
+    const double perp_u = a_perp_new.dot(u);
+    const double s_min = std::min(out.bounds.sddot_min, 0.0), s_max = out.bounds.sddot_max;
+    if (std::abs(eu) > 1e-9) {
+      double t1 = (s_min - perp_u) / eu, t2 = (s_max - perp_u) / eu;
+      if (std::isnan(t1)) t1 = -kInf;
+      if (std::isnan(t2)) t2 = kInf;
+      lo = std::min(t1, t2);
+      hi = std::max(t1, t2);
+    }
+    const double en = (e - eu * u).norm();
+    if (en > 1e-9) {
+      const double h = config_.normal_acceleration_max / en;
+      lo = std::max(lo, -h);
+      hi = std::min(hi, h);
+    }
+
+    // Jerk-limited scalar motion along the segment.
+    const double jerk_par =
+        std::sqrt(std::max(jerk * jerk - (perp_step / period) * (perp_step / period), 0.0));
+    ScalingFilter filter(ScalingFilterConfig{period, jerk_par > 0.0 ? jerk_par : jerk});
+    filter.reset({0.0, kProgressOffset, a_par, 0.0});
+    ScalingFilterState st;
+    const double goal_progress = kProgressOffset + distance;
+    status = filter.update({goal_progress, lo, hi}, st);
+    const double progress = st.sdot - kProgressOffset;
+    v_new = velocity_ + progress * e + 0.5 * period * (a_perp + a_perp_new);
+    a_new = st.sddot * e + a_perp_new;
+    if (st.sdot == goal_progress && st.sddot == 0.0 && a_perp_new.isZero(0.0)) {
+      v_new = goal;  // arrived: exactly on the goal, at rest when the goal is zero
+      a_new.setZero();
+    }
+  }
+
+  const Eigen::Vector3d step = 0.5 * period * (velocity_ + v_new);
+  out.ds = step.dot(u);
+  s_ += step.norm();
+  out.s = s_;
+  out.sdddot = (a_new - acceleration_).norm() / period;
+  velocity_ = v_new;
+  acceleration_ = a_new;
+  out.velocity = v_new;
+  out.acceleration = a_new;
+  out.sdot = v_new.norm();
+  if (out.sdot > 0.0) last_direction_ = v_new / out.sdot;
+  out.sddot = a_new.dot(out.sdot > 0.0 ? last_direction_ : u);
+  out.at_rest = v_new.isZero(0.0) && a_new.isZero(0.0);
+  if (out.at_rest) reversing_ = false;
+
+  // What holds the motion back: the stale input, a power bound the tangential acceleration is
+  // pressed against, or the lowest velocity-level limit when it is below the request.
+  out.limit = ActiveLimit::kNone;
+  if (in.stale_input) {
+    out.limit = ActiveLimit::kStaleInput;
+  } else if (status == ScalingFilterStatus::kAccelerationLimited &&
+             out.bounds.limit_max == ActiveLimit::kPower &&
+             a_new.dot(u) >= out.bounds.sddot_max - 1e-9) {
+    out.limit = ActiveLimit::kPower;
+  } else if (end_brake) {
+    out.limit = end_brake_singular_ ? ActiveLimit::kSingularity : ActiveLimit::kJointLimit;
+  } else if (cap.kind != ActiveLimit::kNone && cap.value < request) {
+    out.limit = cap.kind;
+  }
+}
+
+}  // namespace craneassist::scaling
