@@ -154,7 +154,6 @@ void Controller::update_full(const valves::MachineState& state, const Eigen::Vec
   in.end_distance_m = tip_out_.end_distance_m;
   in.stop_deceleration_m_s2 = tip_out_.stop_deceleration_m_s2;
   in.stop_jerk_m_s3 = tip_out_.stop_jerk_m_s3;
-  in.singular_ahead = tip_out_.singular_ahead;
   in.near_singular = tip_out_.near_singular;
   in.stale_input = stale;
   scaler_->update(q_ref_, tip_out_.geometry, in, scaler_out_);

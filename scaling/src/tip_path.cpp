@@ -30,8 +30,6 @@ constexpr double kHandoverMargin = 0.02;  // of a joint's range: hand-overs end 
 constexpr double kMinLeverage = 1e-3;     // null-vector component of a joint the null space moves
 constexpr double kMaxWeight = 1e6;
 constexpr double kNegligibleRate = 1e-9;  // rad or m per metre of path: not moving
-constexpr double kCrawlSpeed = 0.02;      // m/s: the path speed near a singular pose stops at
-constexpr double kSingularShare = 0.25;   // of a cylinder's speed: only then can it be singular
 
 }  // namespace
 
@@ -204,6 +202,12 @@ void TipPath::update(const JointVector& q, const TipPathInput& in, TipPathOutput
   heading_f1_ = target_f1_;  // where the null-space filter is heading
   g.dc_dq = arms_;
   jacobian_at_q_ = jacobian_;
+  for (int i = 0; i < n; ++i) {
+    // At an end, and the resolution does not move it away (so it is pinned there).
+    const auto& joint = model_.joints[static_cast<std::size_t>(i)];
+    at_end_[i] = (q[i] >= joint.q_max - kAtLimit && g.f1[i] >= 0.0) ||
+                 (q[i] <= joint.q_min + kAtLimit && g.f1[i] <= 0.0);
+  }
   // f'' = d f'/ds = (df'/dq) f', central difference along the path.
   dynamics::NullSpaceStatus ignored;
   q_shift_ = q + kDifferenceStep * g.f1;
@@ -266,32 +270,6 @@ void TipPath::update(const JointVector& q, const TipPathInput& in, TipPathOutput
       }
     }
   }
-  // Singular poses ahead: a joint rate per metre that grows along the path like 1/distance
-  // reaches a singular pose after |f'/f''| metres (the hyperbola through f' and f''; a straight
-  // extrapolation would see it far too late). The path stops before the rate exceeds what the
-  // cylinder delivers at a crawl.
-  out.singular_ahead = false;
-  for (int i = 0; i < n; ++i) {
-    const double rate = std::abs(g.f1[i]);
-    if (rate < kNegligibleRate || !(g.f1[i] * g.f2[i] > 0.0)) continue;
-    // Only a cylinder already using a good share of its speed at the intended path speed can
-    // be running into a singular pose (a joint starting from rest also has f' f'' > 0).
-    const double rate_max =
-        model_.cylinders[static_cast<std::size_t>(i)].v_max_m_s / std::abs(g.dc_dq[i]);
-    if (rate * shape.intended_speed < kSingularShare * rate_max) continue;
-    const double to_singular = rate / std::abs(g.f2[i]);
-    const double crawl_rate = rate_max / kCrawlSpeed;
-    const double length = std::max(to_singular * (1.0 - rate / crawl_rate), 0.0);
-    if (length < out.end_distance_m) {
-      out.end_distance_m = length;
-      out.singular_ahead = true;
-      const double cap = max_speed_to_stop_within(length, stop_decel, stop_jerk);
-      if (cap < out.sdot_joint_limit) {
-        out.sdot_joint_limit = cap;
-        out.limiting_joint = i;
-      }
-    }
-  }
   weakest_direction(u, g.dc_dq, out);
 }
 
@@ -299,8 +277,12 @@ void TipPath::weakest_direction(const Eigen::Vector3d& u, const JointVector& arm
                                 TipPathOutput& out) {
   // The tip velocities the cylinders can give at full speed form an ellipsoid J D (D: the joint
   // rate limits); its smallest semi-axis is the slowest direction.
+  // Joints at an end count only when u moves them away from it: at the end they cannot help in
+  // the other direction, so e.g. the boom stretched straight with the extension at its end is
+  // singular for a radial motion.
   Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
   for (Eigen::Index i = 0; i < jacobian_at_q_.cols(); ++i) {
+    if (at_end_[i]) continue;
     const double rate_max = model_.cylinders[static_cast<std::size_t>(i)].v_max_m_s /
                             std::max(std::abs(arms[i]), 1e-12);
     const Eigen::Vector3d c = jacobian_at_q_.col(i) * rate_max;

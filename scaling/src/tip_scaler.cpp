@@ -60,6 +60,35 @@ double TipScaler::intended_speed(const Eigen::Vector3d& command) const {
   return std::max(speed, std::min(c, std::max(kIntendedShare * speed, speed + kIntendedMargin)));
 }
 
+double TipScaler::cylinder_speed_ahead(const PathGeometry& g, double speed,
+                                       double acceleration) const {
+  auto cap_at = [&](double x) {  // the lowest growing cylinder cap x metres ahead
+    double cap = kInf;
+    for (int i = 0; i < model_.dof(); ++i) {
+      const double rate = g.f1[i];
+      if (!(rate * g.f2[i] > 0.0)) continue;  // not growing along the path
+      const double v_max =
+          (1.0 - config_.flow_reserve) * model_.cylinders[static_cast<std::size_t>(i)].v_max_m_s;
+      cap =
+          std::min(cap, v_max / (std::abs(g.dc_dq[i]) * (std::abs(rate) + std::abs(g.f2[i]) * x)));
+    }
+    return cap;
+  };
+  // The path length a slow-down from the present speed and acceleration to the cap needs: the
+  // swing of the acceleration to full deceleration at the jerk bound, then the deceleration, plus
+  // two cycles. The cap is read there; a few fixed-point steps settle the distance.
+  const double decel = config_.deceleration_max, jerk = config_.jerk_max;
+  const double swing = (std::max(acceleration, 0.0) + decel) / jerk;
+  double cap = cap_at(0.0);
+  if (!std::isfinite(cap)) return cap;
+  double ahead = cap;
+  for (int k = 0; k < 3; ++k) {
+    const double slow_down = std::max(speed * speed - ahead * ahead, 0.0) / (2.0 * decel);
+    ahead = cap_at(speed * (swing + 2.0 * config_.period_s) + slow_down);
+  }
+  return std::min(cap, ahead);
+}
+
 void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const TipScalerInput& in,
                        TipScalerOutput& out) {
   const double period = config_.period_s;
@@ -74,8 +103,12 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
 
   // One factor on the whole command.
   const double request = in.command.norm();
-  const SpeedCap cap = lowest_speed_cap(request, in.tracking_factor, in.sdot_joint_limit, out.speed,
-                                        out.bounds, in.near_singular);
+  SpeedCap cap = lowest_speed_cap(request, in.tracking_factor, in.sdot_joint_limit, out.speed,
+                                  out.bounds, in.near_singular);
+  const double ahead = cylinder_speed_ahead(geometry, speed, acceleration_.dot(u));
+  if (ahead < cap.value) {
+    cap = {ahead, in.near_singular ? ActiveLimit::kSingularity : ActiveLimit::kCylinderSpeed};
+  }
   double target = in.stale_input ? 0.0 : std::clamp(cap.value, 0.0, request);
   // Braking trigger at a joint end: the end damping cap assumes braking from zero acceleration;
   // while the path still accelerates, braking must begin earlier.
@@ -86,7 +119,6 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
                                       in.stop_jerk_m_s3) >= in.end_distance_m) {
     end_brake_ = true;
     rest_time_s_ = 0.0;
-    end_brake_singular_ = in.singular_ahead;
     end_brake_command_ = in.command;
   } else if (end_brake_) {
     // Having come to rest, it stays there long enough for the valves to settle (a restart right
@@ -204,7 +236,7 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
              a_new.dot(u) >= out.bounds.sddot_max - 1e-9) {
     out.limit = ActiveLimit::kPower;
   } else if (end_brake) {
-    out.limit = end_brake_singular_ ? ActiveLimit::kSingularity : ActiveLimit::kJointLimit;
+    out.limit = ActiveLimit::kJointLimit;
   } else if (cap.kind != ActiveLimit::kNone && cap.value < request) {
     out.limit = cap.kind;
   }

@@ -29,11 +29,15 @@
 // path.
 //
 // Singular poses. The tip over the slew axis makes the lateral direction unreachable (J loses
-// rank); near it, the joint rates per unit path speed grow without bound and the cylinder-speed
-// and cylinder-acceleration caps of the scaling slow the path smoothly. near_singular says so.
+// rank); the boom stretched straight with the extension at its end does the same for a radial
+// motion. Near them the joint rates per unit path speed grow without bound: the cylinder-speed
+// caps of the scaling fall to zero with the distance (TipScaler reads them ahead along f''), so
+// the tip slows smoothly and approaches the pose asymptotically; every joint stays within its
+// speed, and moving away is never limited. near_singular says so.
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 
 #include "craneassist/dynamics/kinematics.hpp"
 #include "craneassist/dynamics/null_space_resolution.hpp"
@@ -75,10 +79,9 @@ struct TipPathOutput {
   double end_distance_m = 0.0;
   double stop_deceleration_m_s2 = 0.0;
   double stop_jerk_m_s3 = 0.0;
-  bool singular_ahead = false;  // end_distance_m is the distance to a singular pose
   dynamics::NullSpaceStatus status = dynamics::NullSpaceStatus::kOptimal;
-  // Tip speed in the weakest direction with every cylinder at full speed, m/s, and whether the
-  // direction leans into it at a near-singular pose.
+  // Tip speed in the weakest direction with every cylinder at full speed (joints pinned at an end
+  // left out), m/s, and whether the direction leans into it at a near-singular pose.
   double weakest_speed_m_s = 0.0;
   bool near_singular = false;
 };
@@ -114,7 +117,8 @@ class TipPath {
   Eigen::Vector3d previous_u_ = Eigen::Vector3d::UnitX();
   const JointVector* cylinder_force_ = nullptr;  // of the present update
   // Working data.
-  JointVector joint_accel_max_;  // at the configuration being resolved
+  JointVector joint_accel_max_;                      // at the configuration being resolved
+  std::array<bool, dynamics::kMaxJoints> at_end_{};  // pinned at an end
   dynamics::KinematicsData kin_;
   dynamics::TaskJacobian jacobian_, jacobian_at_q_;
   dynamics::SolutionLine line_;

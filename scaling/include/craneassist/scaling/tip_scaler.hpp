@@ -14,6 +14,9 @@
 //      (the segment passes through rest, or within 5 % of the speed of it) decelerates to rest on
 //      the line, acceleration included, and accelerates back along it. Acceleration left over
 //      from an earlier segment, across the new one, is brought to zero at half the jerk bound.
+//      Cylinder speeds are read ahead: where a joint's rate per metre grows along the path (f',
+//      f'' of the same sign; near a singular pose without bound), the cap is taken where a
+//      brake would take effect, after the acceleration has swung to full deceleration.
 //   4. The acceleration along e is bounded so that the tangential part (along u) stays within the
 //      path's acceleration bounds (the load-sensing power limit with m(s), b(s) from the ODE
 //      model, cylinder accelerations, path acceleration and deceleration; path_constraints.hpp)
@@ -54,7 +57,6 @@ struct TipScalerInput {
   double end_distance_m = 1e300;
   double stop_deceleration_m_s2 = 1.0;
   double stop_jerk_m_s3 = 1.0;
-  bool singular_ahead = false;  // the end distance is to a singular pose (status: singularity)
   bool near_singular = false;
   bool stale_input = false;
 };
@@ -99,6 +101,9 @@ class TipScaler {
               TipScalerOutput& out);
 
  private:
+  // The lowest cylinder-speed cap ahead along the path (see the header comment), m/s.
+  double cylinder_speed_ahead(const PathGeometry& g, double speed, double acceleration) const;
+
   const dynamics::CraneModel& model_;
   TipScalerConfig config_;
   dynamics::RigidBodyTerms& terms_;
@@ -107,10 +112,9 @@ class TipScaler {
   Eigen::Vector3d acceleration_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d last_direction_ = Eigen::Vector3d::UnitX();
   double s_ = 0.0;
-  bool reversing_ = false;  // coming to rest before leaving the other way
-  bool end_brake_ = false;  // braked at a joint end, holding until the end damping frees it
-  bool end_brake_singular_ = false;  // ... or before a singular pose
-  double rest_time_s_ = 0.0;         // at rest since the brake
+  bool reversing_ = false;    // coming to rest before leaving the other way
+  bool end_brake_ = false;    // braked at a joint end, holding until the end damping frees it
+  double rest_time_s_ = 0.0;  // at rest since the brake
   Eigen::Vector3d end_brake_command_ = Eigen::Vector3d::Zero();
 };
 
