@@ -31,6 +31,7 @@
 #include "plan_command.hpp"
 #include "remote_command.hpp"
 #include "sim_command.hpp"
+#include "suite_command.hpp"
 #include "telemetry_setup.hpp"
 
 namespace {
@@ -58,6 +59,7 @@ struct ReplayArgs {
   bool realtime = false;
   double settle_s = 1.0;
   std::optional<double> payload_kg;
+  std::string initial;            // start pose, "NAME=VALUE UNIT, ..."; empty: the config's
   std::string pump_max_flow;      // quantity text, e.g. "120 L/min"
   std::string prime_mover_power;  // quantity text, e.g. "60 kW"
   std::string pump_mode;          // empty: the config's; ls or cp
@@ -113,13 +115,26 @@ void print_pump_line(double energy_j, double peak_power_w, double peak_flow_m3_s
       peak_flow_m3_s * 60e3, saturated_cycles);
 }
 
+// Stall events and, on a one-line replay, the lateral tip speed (docs/scaling.md#operator-feel).
+void print_feel_line(const app::MotionQualityResult& f) {
+  if (f.one_line) {
+    std::printf(
+        "  operator feel: %d stall events; tip speed across the command line: peak %.3f m/s over "
+        "50 ms at %.2f s (%.3f m/s in one cycle)\n",
+        f.stall_events, f.lateral_peak_m_s, f.lateral_peak_t_s, f.lateral_peak_cycle_m_s);
+  } else {
+    std::printf("  operator feel: %d stall events (commands not on one line: no lateral figure)\n",
+                f.stall_events);
+  }
+}
+
 void print_summary(const app::RunSummary& s, const config::CraneConfig& cfg,
                    const std::string& replay_name, app::ScalingMode mode, const app::CsvLog* log,
                    const char* backend) {
   const double speedup = s.wall_time_s > 0.0 ? s.duration_s / s.wall_time_s : 0.0;
   std::printf("craneassist replay: %s on %s\n", replay_name.c_str(), cfg.model.name.c_str());
   std::printf("  backend %s, resolution %s, scaling %s, control %.0f Hz, payload %.0f kg\n",
-              backend, dynamics::to_string(cfg.redundancy.resolution),
+              backend, config::resolution_description(cfg).c_str(),
               mode == app::ScalingMode::kFull
                   ? (std::string("full (power bound: ") +
                      power_bound_name(cfg.scaling.power_bound, cfg.model.pump.mode) + ")")
@@ -145,6 +160,7 @@ void print_summary(const app::RunSummary& s, const config::CraneConfig& cfg,
     std::printf("  path jerk: peak %.2f m/s^3 (bound %.2f)\n", s.peak_path_jerk,
                 cfg.scaling.jerk_max_m_s3);
   }
+  print_feel_line(s.feel);
   std::printf("  active limit (cycles):");
   for (std::size_t i = 0; i < s.limit_cycles.size(); ++i) {
     if (s.limit_cycles[i] > 0) {
@@ -222,14 +238,24 @@ int run_replay_command(const ReplayArgs& args) {
     cfg = args.config_file.empty() ? config::default_crane_config()
                                    : config::load_crane_config(args.config_file);
     if (args.payload_kg) config::set_payload_mass(cfg.model, *args.payload_kg);
-    if (!args.resolution.empty() &&
-        !dynamics::parse_resolution(args.resolution.c_str(), cfg.redundancy.resolution)) {
-      throw CLI::ValidationError("--resolution", "unknown resolution '" + args.resolution + "'");
+    if (!args.initial.empty()) {
+      if (cli::uses_can_backend(args.machine, cfg)) {
+        throw CLI::ValidationError(
+            "--initial", "the can backend starts where the machine is (use --backend sim)");
+      }
+      try {
+        cfg.simulation.q_initial =
+            config::parse_joint_pose(cfg.model, args.initial, cfg.simulation.q_initial);
+      } catch (const std::invalid_argument& e) {
+        throw CLI::ValidationError("--initial", e.what());
+      }
     }
-    if (cfg.redundancy.resolution != dynamics::Resolution::kPinvJoint &&
-        !dynamics::is_loader_structure(cfg.model)) {
-      throw CLI::ValidationError("--resolution",
-                                 "the extension-rate resolutions need a loader crane");
+    if (!args.resolution.empty()) {
+      try {
+        config::set_resolution(cfg, args.resolution);
+      } catch (const std::invalid_argument& e) {
+        throw CLI::ValidationError("--resolution", e.what());
+      }
     }
     if (args.power_bound == "load_sensing") {
       cfg.scaling.power_bound = config::PowerBoundSetting::kLoadSensing;
@@ -258,6 +284,7 @@ int run_replay_command(const ReplayArgs& args) {
         throw CLI::ValidationError("--supply-pressure", why.str());
       }
     }
+    config::apply_energy_optimal(cfg);  // the pump mode may have changed
     if (pump.mode == dynamics::PumpMode::kConstantPressure && !(pump.supply_pressure_pa > 0.0)) {
       throw CLI::ValidationError("--pump-mode",
                                  "constant-pressure needs a supply pressure "
@@ -441,9 +468,11 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"load_sensing", "actuator_sum", "none"}));
   replay
       ->add_option("--resolution", args.resolution,
-                   "Override the config's redundancy resolution: pinv-joint, pinv-actuator, "
-                   "min-flow or min-ls-power")
-      ->check(CLI::IsMember({"pinv-joint", "pinv-actuator", "min-flow", "min-ls-power"}));
+                   "Override the config's redundancy resolution: energy-optimal (min-ls-power "
+                   "with a load-sensing pump, min-flow with a constant-pressure one), "
+                   "pinv-joint, pinv-actuator, min-flow or min-ls-power")
+      ->check(CLI::IsMember(
+          {"energy-optimal", "pinv-joint", "pinv-actuator", "min-flow", "min-ls-power"}));
   replay->add_flag("--realtime", args.realtime,
                    "Pace the loop at real time (default: as fast as possible)");
   replay->add_option("--settle", args.settle_s, "Seconds to keep running after the last replay row")
@@ -451,6 +480,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   replay->add_option("--payload", args.payload_kg, "Payload mass in the grapple, kg")
       ->check(CLI::Range(0.0, 100000.0));
+  replay->add_option("--initial", args.initial,
+                     "Start pose of the simulated crane, e.g. \"lift=0 deg, tilt=-125 deg, "
+                     "extension=0.2 m\" (joints left out keep the config's simulation.initial)");
   replay->add_option("--pump-max-flow", args.pump_max_flow,
                      "Override the pump's maximum flow, e.g. \"120 L/min\"");
   replay->add_option("--prime-mover-power", args.prime_mover_power,
@@ -507,6 +539,8 @@ int main(int argc, char** argv) {
   auto* echo = cli::add_echo_command(cli, echo_args);
   cli::DashboardArgs dashboard_args;
   auto* dashboard = cli::add_dashboard_command(cli, dashboard_args);
+  cli::SuiteArgs suite_args;
+  auto* suite = cli::add_suite_command(cli, suite_args);
 
   try {
     cli.parse(argc, argv);
@@ -541,6 +575,7 @@ int main(int argc, char** argv) {
     }
   }
   if (*sim) return cli::run_sim_command(sim_args);
+  if (*suite) return cli::run_suite_command(suite_args);
   if (*remote) return cli::run_remote_command(remote_args);
   if (*echo) return cli::run_echo_command(echo_args);
   if (*dashboard) return cli::run_dashboard_command(dashboard_args);

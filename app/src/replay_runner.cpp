@@ -29,6 +29,7 @@ RunSummary run_replay(const config::CraneConfig& config, const input::Replay& re
   LogRow row;
   row.input_source = "replay";
   RunSummary summary;
+  MotionQuality quality(period);
   double sum_sq_direction = 0.0;
   Eigen::Vector3d last_cmd = Eigen::Vector3d::Zero();
   double cmd_since_s = 0.0;
@@ -59,6 +60,7 @@ RunSummary run_replay(const config::CraneConfig& config, const input::Replay& re
       last_cmd = cmd;
       cmd_since_s = t;
     }
+    quality.add(t, cmd, tip, tip_v);
     const double speed = tip_v.norm();
     summary.peak_tip_speed_m_s = std::max(summary.peak_tip_speed_m_s, speed);
     if (k > 0) summary.tip_path_m += (tip - last_tip).norm();
@@ -108,6 +110,7 @@ RunSummary run_replay(const config::CraneConfig& config, const input::Replay& re
     }
   }
   machine.read(state);
+  summary.feel = quality.result();
   summary.cycles = cycles;
   summary.duration_s = cycles * period;
   summary.energy_j = state.pump.energy_j;

@@ -153,6 +153,9 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
                 "--input replay only: run as fast as possible on machine time");
   sim->add_option("--payload", args.payload_kg, "Payload mass in the grapple, kg")
       ->check(CLI::Range(0.0, 100000.0));
+  sim->add_option("--initial", args.initial,
+                  "Start pose of the simulated crane, e.g. \"lift=0 deg, tilt=-125 deg, "
+                  "extension=0.2 m\" (joints left out keep the config's simulation.initial)");
   add_backend_options(*sim, args.machine);
   add_telemetry_options(*sim, args.telemetry, true);
   return sim;
@@ -187,6 +190,19 @@ int run_sim_command(const SimArgs& args) {
     cfg = args.config_file.empty() ? config::default_crane_config()
                                    : config::load_crane_config(args.config_file);
     if (args.payload_kg) config::set_payload_mass(cfg.model, *args.payload_kg);
+    if (!args.initial.empty()) {
+      if (uses_can_backend(args.machine, cfg)) {
+        spdlog::error("--initial: the can backend starts where the machine is (use --backend sim)");
+        return kExitUsage;
+      }
+      try {
+        cfg.simulation.q_initial =
+            config::parse_joint_pose(cfg.model, args.initial, cfg.simulation.q_initial);
+      } catch (const std::invalid_argument& e) {
+        spdlog::error("--initial: {}", e.what());
+        return kExitUsage;
+      }
+    }
     jcfg = args.joystick_file.empty() ? config::default_joystick_config()
                                       : config::load_joystick_config(args.joystick_file);
     if (kind == "replay") replay = input::Replay::load_file(args.input[1]);

@@ -2,11 +2,13 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
 #include <sstream>
+#include <stdexcept>
 
 #include "craneassist/config/quantity.hpp"
 #include "craneassist/config/yaml_reader.hpp"
@@ -449,15 +451,10 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   const YAML::Node redundancy = r.child(root, "redundancy", "");
   r.check_keys(redundancy, "redundancy", {"resolution"});
   const std::string resolution = r.text(redundancy, "resolution", "redundancy");
-  if (!dynamics::parse_resolution(resolution.c_str(), cfg.redundancy.resolution)) {
-    r.fail(
-        redundancy["resolution"], "redundancy.resolution",
-        "expected pinv-joint, pinv-actuator, min-flow or min-ls-power, got '" + resolution + "'");
-  }
-  if (cfg.redundancy.resolution != dynamics::Resolution::kPinvJoint &&
-      !dynamics::is_loader_structure(model)) {
-    r.fail(redundancy["resolution"], "redundancy.resolution",
-           "the extension-rate resolutions need a loader crane (slew, lift, tilt, extension)");
+  try {
+    set_resolution(cfg, resolution);
+  } catch (const std::invalid_argument& e) {
+    r.fail(redundancy["resolution"], "redundancy.resolution", e.what());
   }
 
   const YAML::Node sim = r.child(root, "simulation", "");
@@ -516,6 +513,107 @@ CraneConfig default_crane_config() {
 
 CraneConfig planar_2r_config() {
   return parse_crane_config(embedded::kPlanar2rYaml, "<embedded config/cranes/planar_2r.yaml>");
+}
+
+void apply_energy_optimal(CraneConfig& cfg) {
+  if (cfg.redundancy.energy_optimal) {
+    cfg.redundancy.resolution = dynamics::energy_optimal_resolution(cfg.model.pump.mode);
+  }
+}
+
+void set_resolution(CraneConfig& cfg, std::string_view name) {
+  dynamics::Resolution r = dynamics::Resolution::kPinvJoint;
+  const bool energy_optimal = name == "energy-optimal";
+  if (energy_optimal) {
+    r = dynamics::energy_optimal_resolution(cfg.model.pump.mode);
+  } else if (!dynamics::parse_resolution(std::string(name).c_str(), r)) {
+    throw std::invalid_argument(
+        "expected energy-optimal, pinv-joint, pinv-actuator, min-flow or min-ls-power, got '" +
+        std::string(name) + "'");
+  }
+  if (r != dynamics::Resolution::kPinvJoint && !dynamics::is_loader_structure(cfg.model)) {
+    throw std::invalid_argument(
+        "the resolutions other than pinv-joint need a loader crane (slew, lift, tilt, "
+        "extension)");
+  }
+  cfg.redundancy.resolution = r;
+  cfg.redundancy.energy_optimal = energy_optimal;
+}
+
+std::string resolution_description(const CraneConfig& cfg) {
+  std::string text = dynamics::to_string(cfg.redundancy.resolution);
+  if (cfg.redundancy.energy_optimal) {
+    text += cfg.model.pump.mode == dynamics::PumpMode::kConstantPressure
+                ? " (energy-optimal for a constant-pressure pump)"
+                : " (energy-optimal for load sensing)";
+  }
+  return text;
+}
+
+dynamics::JointVector parse_joint_pose(const dynamics::CraneModel& model, std::string_view text,
+                                       const dynamics::JointVector& base) {
+  if (base.size() != model.dof()) throw std::invalid_argument("pose: base has the wrong size");
+  dynamics::JointVector q = base;
+  std::vector<bool> given(static_cast<std::size_t>(model.dof()), false);
+  std::size_t start = 0;
+  bool any = false;
+  while (start <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    std::string_view part = text.substr(start, comma - start);
+    start = comma + 1;
+    while (!part.empty() && std::isspace(static_cast<unsigned char>(part.front()))) {
+      part.remove_prefix(1);
+    }
+    while (!part.empty() && std::isspace(static_cast<unsigned char>(part.back()))) {
+      part.remove_suffix(1);
+    }
+    if (part.empty()) {
+      if (comma == text.size()) break;
+      throw std::invalid_argument("empty part between commas");
+    }
+    const std::size_t eq = part.find('=');
+    if (eq == std::string_view::npos) {
+      throw std::invalid_argument("'" + std::string(part) + "': expected NAME=VALUE UNIT");
+    }
+    std::string name(part.substr(0, eq));
+    while (!name.empty() && std::isspace(static_cast<unsigned char>(name.back()))) name.pop_back();
+    const std::string_view value = part.substr(eq + 1);
+    int index = -1;
+    std::string names;
+    for (int i = 0; i < model.dof(); ++i) {
+      const auto& joint = model.joints[static_cast<std::size_t>(i)];
+      if (joint.name == name) index = i;
+      names += (names.empty() ? "" : ", ") + joint.name;
+    }
+    if (index < 0) {
+      throw std::invalid_argument("'" + name + "': no joint of that name (the joints: " + names +
+                                  ")");
+    }
+    if (given[static_cast<std::size_t>(index)]) {
+      throw std::invalid_argument("'" + name + "' given twice");
+    }
+    given[static_cast<std::size_t>(index)] = true;
+    const auto& joint = model.joints[static_cast<std::size_t>(index)];
+    const Dimension dim =
+        joint.type == dynamics::JointType::kRevolute ? Dimension::kAngle : Dimension::kLength;
+    std::string error;
+    const auto quantity = parse_quantity(value, dim, error);
+    if (!quantity || quantity->si_values.size() != 1) {
+      throw std::invalid_argument("'" + name +
+                                  "': " + (error.empty() ? "expected one value" : error));
+    }
+    const double v = quantity->si_values[0];
+    if (!(v >= joint.q_min && v <= joint.q_max)) {
+      std::ostringstream why;
+      why << "'" << name << "': outside the joint range [" << joint.q_min << ", " << joint.q_max
+          << "] " << (dim == Dimension::kAngle ? "rad" : "m");
+      throw std::invalid_argument(why.str());
+    }
+    q[index] = v;
+    any = true;
+  }
+  if (!any) throw std::invalid_argument("no joint given (expected NAME=VALUE UNIT, ...)");
+  return q;
 }
 
 void set_payload_mass(dynamics::CraneModel& model, double mass_kg) {

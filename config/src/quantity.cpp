@@ -163,7 +163,9 @@ std::optional<Quantity> parse_quantity(std::string_view text, Dimension dimensio
   double scale = 1.0;
   if (unit.empty()) {
     if (dimension != Dimension::kDimensionless) {
-      error = std::string("missing unit: a ") + to_string(dimension) + " needs one of " +
+      const std::string name = to_string(dimension);
+      const bool vowel = name.find_first_of("aeiou") == 0;
+      error = std::string("missing unit: ") + (vowel ? "an " : "a ") + name + " needs one of " +
               accepted_units(dimension);
       return std::nullopt;
     }

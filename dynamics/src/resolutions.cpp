@@ -40,6 +40,10 @@ bool parse_resolution(const char* text, Resolution& out) {
   return false;
 }
 
+Resolution energy_optimal_resolution(PumpMode mode) {
+  return mode == PumpMode::kConstantPressure ? Resolution::kMinFlow : Resolution::kMinLsPower;
+}
+
 double resolution_cost(const CraneModel& model, Resolution resolution, const JointVector& qdot,
                        const JointVector& dc_dq, const JointVector* cylinder_force) {
   double squares = 0.0, flow = 0.0, p_max = 0.0;

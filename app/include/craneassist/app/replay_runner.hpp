@@ -8,6 +8,7 @@
 #include "craneassist/app/controller.hpp"
 #include "craneassist/app/csv_log.hpp"
 #include "craneassist/app/cycle_observer.hpp"
+#include "craneassist/app/motion_quality.hpp"
 #include "craneassist/input/replay.hpp"
 #include "craneassist/valves/machine_interface.hpp"
 
@@ -51,6 +52,7 @@ struct RunSummary {
   int neutral_valve_cycles = 0;  // kStopped: at rest with every valve neutral
   std::array<int, scaling::kActiveLimitCount> limit_cycles{};  // indexed by scaling::ActiveLimit
   std::size_t log_rows_dropped = 0;
+  MotionQualityResult feel;  // stall events and lateral speed (motion_quality.hpp)
 };
 
 RunSummary run_replay(const config::CraneConfig& config, const input::Replay& replay,

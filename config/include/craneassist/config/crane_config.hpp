@@ -39,6 +39,9 @@ struct ScalingSettings {
 
 struct RedundancySettings {
   dynamics::Resolution resolution = dynamics::Resolution::kPinvJoint;
+  // "energy-optimal": the resolution follows the pump mode (dynamics::energy_optimal_resolution);
+  // call apply_energy_optimal after changing the pump mode.
+  bool energy_optimal = false;
 };
 
 struct SimulationSettings {
@@ -83,7 +86,25 @@ CraneConfig parse_crane_config(std::string_view yaml_text, std::string_view sour
 CraneConfig default_crane_config();
 CraneConfig planar_2r_config();
 
+// With redundancy.energy_optimal, sets the resolution for the model's present pump mode.
+void apply_energy_optimal(CraneConfig& cfg);
+
+// Sets the redundancy resolution from its name: pinv-joint, pinv-actuator, min-flow, min-ls-power
+// or energy-optimal. Throws std::invalid_argument for an unknown name, or a resolution other than
+// pinv-joint on a model without the loader structure (slew, lift, tilt, extension).
+void set_resolution(CraneConfig& cfg, std::string_view name);
+
+// "min-ls-power (energy-optimal for load sensing)", "pinv-joint", ...
+std::string resolution_description(const CraneConfig& cfg);
+
 // Sets the payload body's mass (kg); throws std::invalid_argument outside [0, 100000].
 void set_payload_mass(dynamics::CraneModel& model, double mass_kg);
+
+// A joint pose written as "NAME=VALUE UNIT, ..." with the model's joint names, e.g.
+// "lift=0 deg, tilt=-125 deg, extension=0.2 m" (angles in deg or rad, lengths in m, mm, cm).
+// Joints left out keep their value in `base`. Throws std::invalid_argument naming the part that
+// is wrong: an unknown joint, a joint given twice, a bad quantity, a value outside the range.
+dynamics::JointVector parse_joint_pose(const dynamics::CraneModel& model, std::string_view text,
+                                       const dynamics::JointVector& base);
 
 }  // namespace craneassist::config

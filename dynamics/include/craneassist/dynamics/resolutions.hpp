@@ -26,6 +26,11 @@ const char* to_string(Resolution r);
 // "pinv-joint", "pinv-actuator", "min-flow", "min-ls-power"; false when unknown.
 bool parse_resolution(const char* text, Resolution& out);
 
+// The energy-optimal online resolution for a pump: min-ls-power for a load-sensing pump (the
+// pump's power follows the highest load pressure), min-flow for a constant-pressure pump (its
+// power is p_s times the flow). Paper 000 sections 2.1, 4.
+Resolution energy_optimal_resolution(PumpMode mode);
+
 struct ExtensionResolutionInput {
   const TaskJacobian* jacobian = nullptr;  // tip Jacobian at q (loader structure)
   Eigen::Vector3d v_tip = Eigen::Vector3d::Zero();

@@ -1,0 +1,24 @@
+// `craneassist suite MANIFEST`: run a scenario suite (examples/replays/suite.yaml) on the simulated
+// crane, print each run's operator-feel figures against its targets, and the pump energy over the
+// suite per resolution (docs/suite-format.md, docs/scaling.md#operator-feel).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace craneassist::cli {
+
+struct SuiteArgs {
+  std::string manifest;
+  std::string config_file;  // empty: the embedded reference crane
+  std::string resolution;   // empty: the config's; a name, or "all"
+  std::string log_dir;      // empty: no logs
+  std::string only;         // run only the runs whose name contains this
+};
+
+CLI::App* add_suite_command(CLI::App& cli, SuiteArgs& args);
+// 0: every run met its targets; 1: some missed; 2: a bad manifest, config or option; 3: a failure
+// during a run.
+int run_suite_command(const SuiteArgs& args);
+
+}  // namespace craneassist::cli
