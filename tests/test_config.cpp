@@ -270,3 +270,70 @@ TEST(CraneConfig, BackendAndCanSettings) {
             "can.feedback_timeout");
   EXPECT_EQ(error_after_edit("interface: can0", "iface: can0").field(), "can.iface");
 }
+
+TEST(CraneConfig, EnergyOptimalFollowsThePumpMode) {
+  using craneassist::dynamics::PumpMode;
+  using craneassist::dynamics::Resolution;
+  auto cfg = craneassist::config::default_crane_config();
+  EXPECT_TRUE(cfg.redundancy.energy_optimal);
+  EXPECT_EQ(cfg.redundancy.resolution, Resolution::kMinLsPower);
+  EXPECT_EQ(craneassist::config::resolution_description(cfg),
+            "min-ls-power (energy-optimal for load sensing)");
+  cfg.model.pump.mode = PumpMode::kConstantPressure;
+  craneassist::config::apply_energy_optimal(cfg);
+  EXPECT_EQ(cfg.redundancy.resolution, Resolution::kMinFlow);
+  // A named resolution stays what it is.
+  craneassist::config::set_resolution(cfg, "pinv-actuator");
+  EXPECT_FALSE(cfg.redundancy.energy_optimal);
+  cfg.model.pump.mode = PumpMode::kLoadSensing;
+  craneassist::config::apply_energy_optimal(cfg);
+  EXPECT_EQ(cfg.redundancy.resolution, Resolution::kPinvActuator);
+  // In the file, a constant-pressure pump makes energy-optimal min-flow.
+  const auto cp = config_after_edit("mode: load-sensing ", "mode: constant-pressure ");
+  EXPECT_EQ(cp.redundancy.resolution, Resolution::kMinFlow);
+}
+
+TEST(CraneConfig, BadResolutionNamesLineFieldAndTheChoices) {
+  const auto e = error_after_edit("resolution: energy-optimal", "resolution: fastest");
+  EXPECT_EQ(e.field(), "redundancy.resolution");
+  EXPECT_EQ(e.line(), line_of("resolution: energy-optimal"));
+  EXPECT_NE(e.reason().find("energy-optimal, pinv-joint"), std::string::npos) << e.reason();
+  auto two = craneassist::config::planar_2r_config();
+  EXPECT_THROW(craneassist::config::set_resolution(two, "energy-optimal"), std::invalid_argument);
+  EXPECT_NO_THROW(craneassist::config::set_resolution(two, "pinv-joint"));
+}
+
+TEST(JointPose, NamedJointsWithUnitsOverrideTheBase) {
+  const auto cfg = craneassist::config::default_crane_config();
+  const auto q = craneassist::config::parse_joint_pose(
+      cfg.model, "lift=0 deg, tilt = -125 deg ,extension=200 mm", cfg.simulation.q_initial);
+  EXPECT_EQ(q[0], cfg.simulation.q_initial[0]);
+  EXPECT_NEAR(q[1], 0.0, 1e-15);
+  EXPECT_NEAR(q[2], -125.0 * M_PI / 180.0, 1e-12);
+  EXPECT_NEAR(q[3], 0.2, 1e-15);
+  EXPECT_NEAR(
+      craneassist::config::parse_joint_pose(cfg.model, "slew=0.5 rad", cfg.simulation.q_initial)[0],
+      0.5, 1e-15);
+}
+
+TEST(JointPose, EveryMistakeIsNamed) {
+  const auto cfg = craneassist::config::default_crane_config();
+  auto reason = [&](const char* text) {
+    try {
+      craneassist::config::parse_joint_pose(cfg.model, text, cfg.simulation.q_initial);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(reason("boom=1 rad").find("'boom': no joint of that name (the joints: slew, lift"),
+            std::string::npos);
+  EXPECT_NE(reason("lift=2 rad").find("'lift': outside the joint range"), std::string::npos);
+  EXPECT_NE(reason("lift=0.2").find("'lift': missing unit: an angle"), std::string::npos);
+  EXPECT_NE(reason("extension=1 deg").find("'extension'"), std::string::npos);
+  EXPECT_NE(reason("lift=0.1 rad, lift=0.2 rad").find("given twice"), std::string::npos);
+  EXPECT_NE(reason("lift 0.1 rad").find("expected NAME=VALUE UNIT"), std::string::npos);
+  EXPECT_NE(reason("").find("no joint given"), std::string::npos);
+  EXPECT_NE(reason("lift=0.1 rad,,tilt=-1 rad").find("empty part"), std::string::npos);
+  EXPECT_NE(reason("lift=nan rad").find("'lift'"), std::string::npos);
+}

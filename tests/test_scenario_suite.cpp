@@ -1,0 +1,91 @@
+// Scenario-suite manifests (app/scenario_suite.hpp, docs/suite-format.md): the shipped suite,
+// targets merged per run, and every mistake named by file, line and field.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "craneassist/app/scenario_suite.hpp"
+#include "craneassist/config/crane_config.hpp"
+
+using namespace craneassist;
+
+namespace {
+
+const std::filesystem::path kReplays =
+    std::filesystem::path(CRANEASSIST_SOURCE_DIR) / "examples/replays";
+
+config::ConfigError error_of(const std::string& yaml) {
+  try {
+    const auto suite = app::parse_suite(yaml, "test.yaml", kReplays);
+    app::check_suite(suite, config::default_crane_config());
+  } catch (const config::ConfigError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no error for:\n" << yaml;
+  return config::ConfigError("", 0, "", "");
+}
+
+}  // namespace
+
+TEST(ScenarioSuite, TheShippedSuiteExpandsEveryPose) {
+  const auto suite = app::load_suite(kReplays / "suite.yaml");
+  app::check_suite(suite, config::default_crane_config());
+  ASSERT_EQ(suite.runs.size(), 25u);
+  EXPECT_EQ(suite.runs[0].name(), "suite/push_x_plus.csv @default");
+  EXPECT_EQ(suite.runs[1].name(), "suite/push_x_plus.csv @folded");
+  EXPECT_EQ(suite.runs[1].pose_text, "lift=0 deg, tilt=-125 deg, extension=0.2 m");
+  ASSERT_TRUE(suite.runs[0].targets.lateral_speed_m_s);
+  EXPECT_DOUBLE_EQ(*suite.runs[0].targets.lateral_speed_m_s, 0.03);
+  const auto& heavy = suite.runs.back();
+  EXPECT_EQ(heavy.payload_kg, 650.0);
+  ASSERT_TRUE(heavy.targets.peak_power_share && heavy.targets.direction_error_rad &&
+              heavy.targets.stall_events);
+  EXPECT_DOUBLE_EQ(*heavy.targets.peak_power_share, 1.02);
+  EXPECT_NEAR(*heavy.targets.direction_error_rad, 2.0 * M_PI / 180.0, 1e-15);
+  EXPECT_EQ(*heavy.targets.stall_events, 0);  // the default, merged
+}
+
+TEST(ScenarioSuite, MistakesNameFileLineAndField) {
+  const std::string head = "format: craneassist-suite/1\n";
+  auto e = error_of("format: craneassist-suite/9\nruns:\n  - replay: demo.csv\n");
+  EXPECT_EQ(e.field(), "format");
+  EXPECT_EQ(e.line(), 1);
+  e = error_of(head + "runs:\n  - replay: nowhere.csv\n");
+  EXPECT_EQ(e.field(), "runs[0].replay");
+  EXPECT_EQ(e.line(), 3);
+  EXPECT_NE(e.reason().find("no such file"), std::string::npos);
+  e = error_of(head + "runs:\n  - replay: demo.csv\n    poses: [folded]\n");
+  EXPECT_EQ(e.field(), "runs[0].poses");
+  EXPECT_NE(e.reason().find("no pose named 'folded'"), std::string::npos);
+  e = error_of(head +
+               "poses:\n  low: lift=5 deg, boom=1 m\nruns:\n  - replay: demo.csv\n"
+               "    poses: [low]\n");
+  EXPECT_EQ(e.field(), "poses.low");
+  EXPECT_EQ(e.line(), 3);
+  EXPECT_NE(e.reason().find("'boom': no joint of that name"), std::string::npos);
+  e = error_of(head + "targets:\n  lateral_speed: 3 cm\nruns:\n  - replay: demo.csv\n");
+  EXPECT_EQ(e.field(), "targets.lateral_speed");
+  e = error_of(head + "targets:\n  stall_events: -1\nruns:\n  - replay: demo.csv\n");
+  EXPECT_EQ(e.field(), "targets.stall_events");
+  e = error_of(head + "runs:\n  - replay: demo.csv\n    payload: 650 km\n");
+  EXPECT_EQ(e.field(), "runs[0].payload");
+  e = error_of(head + "runs:\n  - replay: demo.csv\n    speed: 2\n");
+  EXPECT_EQ(e.field(), "runs[0].speed");
+  e = error_of(head + "runs: []\n");
+  EXPECT_EQ(e.field(), "runs");
+  e = error_of(head + "runs:\n  - replay: [demo.csv\n");
+  EXPECT_GT(e.line(), 0);
+}
+
+TEST(ScenarioSuite, ARunMissingATargetSaysWhichAndByHowMuch) {
+  auto suite = app::parse_suite(
+      "format: craneassist-suite/1\nruns:\n  - replay: heavy_lift.csv\n    payload: 650 kg\n"
+      "    targets: {peak_power: 0.1, direction_error: 0.001 deg}\n",
+      "tight.yaml", kReplays);
+  const auto out = app::run_suite_run(config::default_crane_config(), suite.runs[0], "", {});
+  ASSERT_EQ(out.missed.size(), 2u);
+  EXPECT_NE(out.missed[0].find("peak power"), std::string::npos) << out.missed[0];
+  EXPECT_NE(out.missed[0].find("> 0.100"), std::string::npos) << out.missed[0];
+  EXPECT_NE(out.missed[1].find("direction error"), std::string::npos) << out.missed[1];
+  EXPECT_FALSE(out.ok());
+}
