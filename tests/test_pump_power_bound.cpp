@@ -92,3 +92,32 @@ TEST(PumpPowerBound, PumpPowerFollowsTheMode) {
   EXPECT_NEAR(scaling::pump_power(f.model, f.path, f.terms, sdot, sddot), ls, 1e-6);
   EXPECT_NEAR(scaling::load_sensing_power(f.model, f.path, f.terms, sdot, sddot), ls, 1e-6);
 }
+
+// Slowing down is never held back by the pump: where decelerating raises the load pressure
+// (negative m: e.g. a heavy load being lowered fast) past what P_max / Q or relief leave, the
+// bound still allows the path's full deceleration. Before, it asked for sddot > 0 there and a
+// released stick could not stop the reference.
+TEST(PumpPowerBound, NeverBoundsTheDeceleration) {
+  for (const auto mode : {kLs, kCp}) {
+    for (const double static_pa : {10e6, 16e6, 21e6}) {
+      Fixture f(static_pa);
+      f.terms.m[1] = -3.5e6 * f.model.cylinders[1].area_a_m2;  // slowing raises the pressure
+      f.limits.path_deceleration_max = 1.0;
+      for (const double sdot : {0.1, 1.0, 5.0}) {
+        const auto b = f.bounds(mode, sdot);
+        SCOPED_TRACE(testing::Message() << "mode " << static_cast<int>(mode) << " static "
+                                        << static_pa << " sdot " << sdot);
+        EXPECT_DOUBLE_EQ(b.sddot_min, -1.0);
+        EXPECT_EQ(b.limit_min, scaling::ActiveLimit::kNone);
+        // It still caps the acceleration side where it binds.
+        EXPECT_LE(b.sddot_max, f.limits.path_acceleration_max);
+      }
+    }
+  }
+  // The actuator-power-sum baseline likewise.
+  Fixture f(16e6);
+  f.terms.m[1] = -3.5e6 * f.model.cylinders[1].area_a_m2;
+  f.limits.path_deceleration_max = 1.0;
+  f.limits.power_bound = scaling::PowerBound::kActuatorPowerSum;
+  EXPECT_DOUBLE_EQ(f.bounds(kLs, 5.0).sddot_min, -1.0);
+}

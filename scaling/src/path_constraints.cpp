@@ -39,6 +39,17 @@ void apply_upper(double k, double c, double limit, ActiveLimit kind, Acceleratio
   }
 }
 
+// A pump-power (or supply-pressure) constraint k x + c <= limit: it only ever caps the
+// acceleration. Where slowing down would raise a load pressure past what the pump gives (k < 0:
+// decelerating an over-running or heavy load), the constraint is left out: a pump short of
+// power slows the motion, it never forces it to go faster, and a stop must always be possible.
+// At sddot = 0 over the limit with no acceleration to help (k = 0), it asks for the strongest
+// deceleration, as apply_upper does.
+void apply_power(double k, double c, double limit, AccelerationBounds& b) {
+  if (k < -kTinyRate) return;
+  apply_upper(k, c, limit, ActiveLimit::kPower, b);
+}
+
 // The pump-power bound for a constant-pressure pump: P = p_s Q(sdot) does not depend on the
 // acceleration, so it is a speed limit alone, sdot <= P_max / (p_s Q / sdot); and a cylinder
 // keeps its full flow while its load pressure stays dp_c below p_s, one inequality in sddot per
@@ -55,8 +66,7 @@ void constant_pressure_bounds(const dynamics::CraneModel& model, const PathGeome
     const double area = dynamics::flow_area_m2(model.cylinders[static_cast<std::size_t>(i)],
                                                path.dc_dq[i] * path.f1[i]);
     const double scale = sign / (path.dc_dq[i] * area);
-    apply_upper(scale * terms.m[i], scale * terms.b[i], b.pressure_limit_pa, ActiveLimit::kPower,
-                b);
+    apply_power(scale * terms.m[i], scale * terms.b[i], b.pressure_limit_pa, b);
   }
   if (flow_per_speed > 0.0 && p_supply > 0.0) {
     b.sdot_power =
@@ -121,8 +131,8 @@ void path_acceleration_bounds(const dynamics::CraneModel& model, const PathGeome
     if (std::abs(curvature) > 0.0) {
       b.sdot_acceleration = std::min(b.sdot_acceleration, std::sqrt(a_max / std::abs(curvature)));
     }
-    apply_upper(k, c, a_max, ActiveLimit::kNone, b);
-    apply_upper(-k, -c, a_max, ActiveLimit::kNone, b);
+    apply_upper(k, c, a_max, ActiveLimit::kCylinderAcceleration, b);
+    apply_upper(-k, -c, a_max, ActiveLimit::kCylinderAcceleration, b);
   }
 
   const auto& pump = model.pump;
@@ -153,8 +163,7 @@ void path_acceleration_bounds(const dynamics::CraneModel& model, const PathGeome
       const double area = dynamics::flow_area_m2(model.cylinders[static_cast<std::size_t>(i)],
                                                  path.dc_dq[i] * path.f1[i]);
       const double scale = sign / (path.dc_dq[i] * area);
-      apply_upper(scale * terms.m[i], scale * terms.b[i], b.pressure_limit_pa, ActiveLimit::kPower,
-                  b);
+      apply_power(scale * terms.m[i], scale * terms.b[i], b.pressure_limit_pa, b);
     }
     // Quasi-static limit: the speed at which the current loads take exactly P_max at sddot = 0.
     if (flow_per_speed > 0.0) {
@@ -166,8 +175,8 @@ void path_acceleration_bounds(const dynamics::CraneModel& model, const PathGeome
     // |sdot f1 . (m sddot + b)| <= P_max
     const double k = speed * path.f1.dot(terms.m);
     const double c = speed * path.f1.dot(terms.b);
-    apply_upper(k, c, p_max_w, ActiveLimit::kPower, b);
-    apply_upper(-k, -c, p_max_w, ActiveLimit::kPower, b);
+    apply_power(k, c, p_max_w, b);
+    apply_power(-k, -c, p_max_w, b);
     const double static_power_per_speed = std::abs(path.f1.dot(terms.b));
     if (static_power_per_speed > 0.0) {
       b.sdot_power = p_max_w / static_power_per_speed;

@@ -10,6 +10,10 @@ double tracking_factor(double error_m, double error_ok_m) {
   return error_ok_m / error_m;
 }
 
+double stop_bound(const AccelerationBounds& bounds, double deceleration_max) {
+  return bounds.sddot_min < 0.0 ? bounds.sddot_min : -deceleration_max;
+}
+
 SpeedCap lowest_speed_cap(double sdot_request, double tracking_factor, double sdot_joint_limit,
                           const SpeedLimits& speed, const AccelerationBounds& bounds,
                           bool near_singular) {
@@ -63,11 +67,10 @@ void PathScaler::update(const JointVector& q, const PathGeometry& geometry,
   out.sdot_d = std::max(lowest.value, 0.0);
   if (in.stale_input) out.sdot_d = 0.0;
 
-  // No constraint may force the path to speed up: slowing down always lowers the pump flow, so a
-  // lower bound above zero (the actuator-power-sum bound gives one when over-running loads make
-  // the power sum strongly negative) is lowered to zero.
-  const ScalingFilterInput filter_in{out.sdot_d, std::min(out.bounds.sddot_min, 0.0),
-                                     out.bounds.sddot_max};
+  // No constraint may force the path to speed up or keep it from stopping (stop_bound).
+  const ScalingFilterInput filter_in{
+      out.sdot_d, stop_bound(out.bounds, acceleration_limits_.path_deceleration_max),
+      out.bounds.sddot_max};
   out.filter_status = filter_.update(filter_in, out.state);
 
   // What holds the motion back: the stale input, a power bound the filter is pressed against,

@@ -175,11 +175,13 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
                                            : Eigen::Vector3d::Zero();
 
     // Bounds on the acceleration along e: its tangential part within the path's bounds (no
-    // constraint may force the path to speed up), its normal part within the turning limit.
+    // constraint may force the path to speed up or keep it from stopping), its normal part
+    // within the turning limit.
     double lo = -kInf, hi = kInf;
     const double eu = e.dot(u);
     const double perp_u = a_perp_new.dot(u);
-    const double s_min = std::min(out.bounds.sddot_min, 0.0), s_max = out.bounds.sddot_max;
+    const double s_min = stop_bound(out.bounds, acceleration_limits_.path_deceleration_max);
+    const double s_max = out.bounds.sddot_max;
     if (std::abs(eu) > 1e-9) {
       double t1 = (s_min - perp_u) / eu, t2 = (s_max - perp_u) / eu;
       if (std::isnan(t1)) t1 = -kInf;

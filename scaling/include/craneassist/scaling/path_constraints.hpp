@@ -54,7 +54,8 @@ void path_speed_limits(const dynamics::CraneModel& model, const PathGeometry& pa
 struct AccelerationBounds {
   double sddot_min = 0.0;
   double sddot_max = 0.0;
-  ActiveLimit limit_min = ActiveLimit::kNone;  // what sets each side
+  // What sets each side: kCylinderAcceleration, kPower, or kNone for the path's own bound.
+  ActiveLimit limit_min = ActiveLimit::kNone;
   ActiveLimit limit_max = ActiveLimit::kNone;
   // min(P_max / Q - dp_LS, p_relief - dp_LS) (LS bound); p_s - dp_c (constant pressure).
   double pressure_limit_pa = 0.0;

@@ -72,6 +72,12 @@ class PathScaler {
 // delta(|e|) of algorithms.md section 6: 1 below e_ok, e_ok / |e| above.
 double tracking_factor(double error_m, double error_ok_m);
 
+// The lower bound on sddot the scalers use: the constraints' own where it allows slowing down;
+// where it does not (a lower bound at or above zero: the cylinder accelerations on a sharply
+// curved joint path at speed), the path's deceleration bound: no constraint may force the path
+// to speed up or keep it from stopping.
+double stop_bound(const AccelerationBounds& bounds, double deceleration_max);
+
 // The lowest of the velocity-level limits on the path speed and what sets it: the operator's
 // request times the tracking factor, pump flow, cylinder speeds, end damping, the quasi-static
 // power and the path curvature (cylinder accelerations). near_singular reports the cylinder
