@@ -195,6 +195,12 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
       lo = std::max(lo, -h);
       hi = std::min(hi, h);
     }
+    // Nothing may push the velocity past its goal: a bound that asks for more acceleration
+    // towards the goal than zero (the power bound asking for deceleration while the reference
+    // comes to rest, possibly beyond what the other bounds allow) yields to landing on it
+    // without overshoot; a stop never turns into a reversal.
+    lo = std::min(lo, 0.0);
+    hi = std::max(hi, lo);
 
     // Jerk-limited scalar motion along the segment.
     const double jerk_par =
