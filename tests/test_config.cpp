@@ -74,6 +74,19 @@ TEST(Quantity, ParsesValuesUnitsAndSource) {
   EXPECT_FALSE(craneassist::config::parse_quantity("1 m, guessed", Dimension::kLength, err));
   EXPECT_FALSE(craneassist::config::parse_quantity("1", Dimension::kLength, err));
   EXPECT_FALSE(craneassist::config::parse_quantity("1 m m", Dimension::kLength, err));
+  // A unit written against its number, as people type on a command line.
+  q = craneassist::config::parse_quantity("-125deg", Dimension::kAngle, err);
+  ASSERT_TRUE(q) << err;
+  EXPECT_NEAR(q->si_values[0], -125.0 * M_PI / 180.0, 1e-15);
+  q = craneassist::config::parse_quantity("21.5MPa, paper", Dimension::kPressure, err);
+  ASSERT_TRUE(q) << err;
+  EXPECT_NEAR(q->si_values[0], 21.5e6, 1e-6);
+  q = craneassist::config::parse_quantity("1e-3m", Dimension::kLength, err);
+  ASSERT_TRUE(q) << err;
+  EXPECT_NEAR(q->si_values[0], 1e-3, 1e-18);
+  EXPECT_FALSE(craneassist::config::parse_quantity("2e", Dimension::kLength, err));
+  EXPECT_FALSE(craneassist::config::parse_quantity("1mm m", Dimension::kLength, err));
+  EXPECT_FALSE(craneassist::config::parse_quantity("deg5", Dimension::kAngle, err));
 }
 
 TEST(CraneConfig, ReferenceCraneMatchesTheSpec) {

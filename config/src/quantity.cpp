@@ -1,5 +1,6 @@
 #include "craneassist/config/quantity.hpp"
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <numbers>
@@ -60,6 +61,21 @@ std::optional<double> parse_number(std::string_view token) {
   const auto [ptr, ec] = std::from_chars(first, last, value);
   if (ec != std::errc() || ptr != last || !std::isfinite(value)) return std::nullopt;
   return value;
+}
+
+// A number written against its unit ("21.5MPa", "-125deg"): the number and the unit, or
+// nothing unless the token is a number followed by a letter ("1/s" is a unit, not 1 per s).
+std::optional<std::pair<double, std::string_view>> split_number_unit(std::string_view token) {
+  double value = 0.0;
+  const char* first = token.data();
+  const char* last = token.data() + token.size();
+  if (first != last && *first == '+') ++first;
+  const auto [ptr, ec] = std::from_chars(first, last, value);
+  if (ec != std::errc() || ptr == last || ptr == first || !std::isfinite(value) ||
+      !std::isalpha(static_cast<unsigned char>(*ptr))) {
+    return std::nullopt;
+  }
+  return std::pair{value, token.substr(static_cast<std::size_t>(ptr - token.data()))};
 }
 
 }  // namespace
@@ -149,6 +165,9 @@ std::optional<Quantity> parse_quantity(std::string_view text, Dimension dimensio
     }
     if (const auto value = parse_number(token)) {
       q.si_values.push_back(*value);
+    } else if (const auto joined = split_number_unit(token)) {
+      q.si_values.push_back(joined->first);  // "0deg": the number, then its unit
+      unit = joined->second;
     } else if (q.si_values.empty()) {
       error = "'" + std::string(token) + "' is not a finite number";
       return std::nullopt;
