@@ -11,6 +11,7 @@
 #include <sstream>
 #include <string>
 
+#include "bound_command.hpp"
 #include "calibrate_command.hpp"
 #include "can_commands.hpp"
 #include "craneassist/app/csv_log.hpp"
@@ -541,6 +542,8 @@ int main(int argc, char** argv) {
   auto* dashboard = cli::add_dashboard_command(cli, dashboard_args);
   cli::SuiteArgs suite_args;
   auto* suite = cli::add_suite_command(cli, suite_args);
+  cli::BoundArgs bound_args;
+  auto* bound = cli::add_bound_command(cli, bound_args);
 
   try {
     cli.parse(argc, argv);
@@ -576,6 +579,7 @@ int main(int argc, char** argv) {
   }
   if (*sim) return cli::run_sim_command(sim_args);
   if (*suite) return cli::run_suite_command(suite_args);
+  if (*bound) return cli::run_bound_command(bound_args);
   if (*remote) return cli::run_remote_command(remote_args);
   if (*echo) return cli::run_echo_command(echo_args);
   if (*dashboard) return cli::run_dashboard_command(dashboard_args);
