@@ -11,6 +11,7 @@
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/config/yaml_reader.hpp"
 #include "exit_codes.hpp"
+#include "resolution_option.hpp"
 
 namespace craneassist::cli {
 namespace {
@@ -93,11 +94,7 @@ CLI::App* add_bound_command(CLI::App& cli, BoundArgs& args) {
       ->check(CLI::ExistingFile);
   bound->add_option("--payload", args.payload_kg, "Payload mass in the grapple, kg")
       ->check(CLI::Range(0.0, 100000.0));
-  bound
-      ->add_option("--resolution", args.resolution,
-                   "Redundancy resolution for a path file's joint path (default: the config's)")
-      ->check(CLI::IsMember(
-          {"energy-optimal", "pinv-joint", "pinv-actuator", "min-flow", "min-ls-power"}));
+  add_resolution_option(*bound, args.resolution, "of the controller that drives the path");
   bound
       ->add_option("--start", args.start,
                    "A path file's start configuration: the shortest feasible extension or the "

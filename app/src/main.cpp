@@ -31,6 +31,7 @@
 #include "machine_setup.hpp"
 #include "plan_command.hpp"
 #include "remote_command.hpp"
+#include "resolution_option.hpp"
 #include "sim_command.hpp"
 #include "suite_command.hpp"
 #include "telemetry_setup.hpp"
@@ -467,13 +468,7 @@ int main(int argc, char** argv) {
                    "Override the config's power bound: load_sensing, actuator_sum (the older "
                    "baseline) or none")
       ->check(CLI::IsMember({"load_sensing", "actuator_sum", "none"}));
-  replay
-      ->add_option("--resolution", args.resolution,
-                   "Override the config's redundancy resolution: energy-optimal (min-ls-power "
-                   "with a load-sensing pump, min-flow with a constant-pressure one), "
-                   "pinv-joint, pinv-actuator, min-flow or min-ls-power")
-      ->check(CLI::IsMember(
-          {"energy-optimal", "pinv-joint", "pinv-actuator", "min-flow", "min-ls-power"}));
+  cli::add_resolution_option(*replay, args.resolution, "for the run");
   replay->add_flag("--realtime", args.realtime,
                    "Pace the loop at real time (default: as fast as possible)");
   replay->add_option("--settle", args.settle_s, "Seconds to keep running after the last replay row")

@@ -21,6 +21,7 @@
 #include "craneassist/input/replay_source.hpp"
 #include "craneassist/input/sdl_source.hpp"
 #include "exit_codes.hpp"
+#include "resolution_option.hpp"
 
 namespace craneassist::cli {
 namespace {
@@ -156,6 +157,7 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
   sim->add_option("--initial", args.initial,
                   "Start pose of the simulated crane, e.g. \"lift=0 deg, tilt=-125 deg, "
                   "extension=0.2 m\" (joints left out keep the config's simulation.initial)");
+  add_resolution_option(*sim, args.resolution, "for the run");
   add_backend_options(*sim, args.machine);
   add_telemetry_options(*sim, args.telemetry, true);
   return sim;
@@ -190,6 +192,14 @@ int run_sim_command(const SimArgs& args) {
     cfg = args.config_file.empty() ? config::default_crane_config()
                                    : config::load_crane_config(args.config_file);
     if (args.payload_kg) config::set_payload_mass(cfg.model, *args.payload_kg);
+    if (!args.resolution.empty()) {
+      try {
+        config::set_resolution(cfg, args.resolution);
+      } catch (const std::invalid_argument& e) {
+        spdlog::error("--resolution: {}", e.what());
+        return kExitUsage;
+      }
+    }
     if (!args.initial.empty()) {
       if (uses_can_backend(args.machine, cfg)) {
         spdlog::error("--initial: the can backend starts where the machine is (use --backend sim)");
@@ -288,8 +298,9 @@ int run_sim_command(const SimArgs& args) {
             static_cast<std::size_t>(options.duration_s * cfg.control.rate_hz) + 16;
       }
     }
-    spdlog::info("sim: {} input ({}) on {} with the {} backend{}", source->name(), jcfg.source_name,
-                 cfg.model.name, machine.name(),
+    spdlog::info("sim: {} input ({}) on {} with the {} backend, resolution {}{}", source->name(),
+                 jcfg.source_name, cfg.model.name, machine.name(),
+                 config::resolution_description(cfg),
                  options.realtime ? ", real time" : ", as fast as possible");
     if (keyboard != nullptr) print_keys();
 

@@ -24,8 +24,9 @@ struct SimArgs {
   std::string record_file;         // empty: no recording
   bool no_realtime = false;        // --input replay only: as fast as possible
   std::optional<double> payload_kg;
-  std::string initial;  // start pose "NAME=VALUE UNIT, ..." (sim backend); empty: the config's
-  BackendArgs machine;  // empty values: the config's backend: and can:
+  std::string resolution;  // empty: the config's
+  std::string initial;     // start pose "NAME=VALUE UNIT, ..." (sim backend); empty: the config's
+  BackendArgs machine;     // empty values: the config's backend: and can:
   TelemetryArgs telemetry;
 };
 

@@ -10,6 +10,7 @@
 #include "craneassist/app/scenario_suite.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "exit_codes.hpp"
+#include "resolution_option.hpp"
 
 namespace craneassist::cli {
 namespace {
@@ -66,12 +67,8 @@ CLI::App* add_suite_command(CLI::App& cli, SuiteArgs& args) {
       ->add_option("--config", args.config_file,
                    "Crane config YAML (default: the embedded K70M reference crane)")
       ->check(CLI::ExistingFile);
-  suite
-      ->add_option("--resolution", args.resolution,
-                   "energy-optimal, pinv-joint, pinv-actuator, min-flow, min-ls-power, or all "
-                   "(each in turn, with the pump energy over the suite); default: the config's")
-      ->check(CLI::IsMember(
-          {"all", "energy-optimal", "pinv-joint", "pinv-actuator", "min-flow", "min-ls-power"}));
+  add_resolution_option(*suite, args.resolution, "for every run (all: the pump energy of each)",
+                        true);
   suite->add_option("--log-dir", args.log_dir, "Write each run's per-cycle log into this folder");
   suite->add_option("--only", args.only, "Run only the runs whose name contains this text");
   return suite;
