@@ -217,14 +217,17 @@ TEST(TipMotion, NoSlowDownForAJointEndWhileTheOthersCarryOn) {
   for (const char* r : kResolutions) {
     TipMotion m(with_resolution(r));
     const Eigen::Vector3d v(0.6, 0.0, 0.0);
-    bool reached = false, slowed = false;
+    bool reached = false, slowed = false, rested = false;
     int stalls = 0;
-    double max_speed = 0.0;
+    double max_speed = 0.0, after_rest = 0.0;
     for (int k = 0; k < 1300; ++k) {
       m.step(v);
       const double along = m.out.velocity.dot(v.normalized());
       max_speed = std::max(max_speed, along);
       if (along > 0.59) reached = true;
+      // Come (nearly) to rest at the end of the workspace, it stays there: no stop-and-go.
+      if (reached && along < 0.01) rested = true;
+      if (rested) after_rest = std::max(after_rest, along);
       if (reached && along < 0.3) slowed = true;
       if (slowed && along > 0.42) {
         ++stalls;
@@ -234,6 +237,7 @@ TEST(TipMotion, NoSlowDownForAJointEndWhileTheOthersCarryOn) {
     }
     EXPECT_TRUE(reached) << r;
     EXPECT_EQ(stalls, 0) << r;
+    EXPECT_LT(after_rest, 0.02) << r << ": restarted after coming to rest at the end";
     // It went out to (near) full reach, and is at rest there.
     EXPECT_GT(m.tip().x(), 8.8) << r;
     EXPECT_EQ(m.out.sdot, 0.0) << r;

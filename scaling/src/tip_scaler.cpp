@@ -24,6 +24,7 @@ constexpr double kRestartShare = 0.3;
 constexpr double kRestartSpeed = 0.05;  // m/s
 constexpr double kCommandChange = 0.02;
 constexpr double kMinRestTime = 0.4;  // s: valve delay and lag with margin
+constexpr double kRestartRoom = 4.0;
 
 }  // namespace
 
@@ -128,7 +129,19 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
     const double restart = std::max(kRestartShare * request, kRestartSpeed);
     const bool moved = (in.command - end_brake_command_).norm() > kCommandChange * request;
     const bool settled = speed > 0.0 || rest_time_s_ >= kMinRestTime;
-    if ((in.sdot_joint_limit >= restart && settled) || moved || request == 0.0) end_brake_ = false;
+    // Nearly at rest, only where a restart can go somewhere: a stop from the restart speed fits
+    // kRestartRoom times into what is left to the end. At the workspace's end the null space
+    // moves the joints' ends about and the end damping's cap rises and falls; without this the
+    // reference braked, restarted at a few cm/s and braked again, twice within a second. Still
+    // moving at the restart speed, the end damping's cap takes over as soon as it allows that
+    // speed (a hand-over moving the end away).
+    const bool room =
+        speed >= restart || kRestartRoom * braking_distance(restart, 0.0, in.stop_deceleration_m_s2,
+                                                            in.stop_jerk_m_s3) <
+                                in.end_distance_m;
+    if ((in.sdot_joint_limit >= restart && room && settled) || moved || request == 0.0) {
+      end_brake_ = false;
+    }
   }
   const bool end_brake = end_brake_;
   if (end_brake) target = 0.0;
