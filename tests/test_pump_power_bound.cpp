@@ -70,7 +70,7 @@ TEST(PumpPowerBound, ConstantPressureKeepsTheLoadPressureBelowTheSetpointMinusTh
   // 10 MPa + 3.5 MPa per unit sddot reaches 17 MPa at sddot = 2 (the cylinder's own 0.4 m/s^2
   // would allow 4).
   EXPECT_NEAR(cp.sddot_max, 2.0, 1e-9);
-  EXPECT_EQ(cp.limit_max, scaling::ActiveLimit::kPower);
+  EXPECT_EQ(cp.limit_max, scaling::ActiveLimit::kPressure);  // the supply pressure, not power
   // Unlike the LS bound the CP one does not tighten with speed (p_s Q has no sddot term).
   EXPECT_NEAR(f.bounds(kCp, 5.0).sddot_max, 2.0, 1e-9);
   EXPECT_LT(f.bounds(kLs, 5.0).sddot_max, f.bounds(kLs, 1.0).sddot_max);

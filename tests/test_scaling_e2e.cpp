@@ -298,7 +298,9 @@ TEST(ScalingEndToEnd, HeavyLoadStopsWhenTheStickIsReleasedAndNeverComesBack) {
         const double t = log["t"][k];
         if (t <= 3.5) release_speed = log["sdot"][k];
         if (t > 3.5 && rest_at < 0.0 && log["sdot"][k] == 0.0) rest_at = t;
-        if (rest_at >= 0.0) EXPECT_EQ(log["sdot"][k], 0.0) << r << " at " << t << " s";
+        if (rest_at >= 0.0) {
+          EXPECT_EQ(log["sdot"][k], 0.0) << r << " at " << t << " s";
+        }
         const Eigen::Vector3d ref(log["ref_vx"][k], log["ref_vy"][k], log["ref_vz"][k]);
         backwards = std::max(backwards, -ref.dot(line));
       }

@@ -46,6 +46,7 @@ std::string time_shares(const scaling::TimeOptimalResult& r,
     const auto& seg = r.segments[k];
     const char* limit = seg.limit == scaling::ActiveLimit::kCylinderAcceleration ? "cylinder"
                         : seg.limit == scaling::ActiveLimit::kPower              ? "power"
+                        : seg.limit == scaling::ActiveLimit::kPressure           ? "relief pressure"
                                                                                  : "path bound";
     std::string name;
     switch (seg.phase) {

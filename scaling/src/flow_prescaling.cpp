@@ -26,6 +26,8 @@ const char* to_string(ActiveLimit limit) {
       return "stale_input";
     case ActiveLimit::kSingularity:
       return "singularity";
+    case ActiveLimit::kPressure:
+      return "pressure";
   }
   return "?";
 }

@@ -39,15 +39,16 @@ void apply_upper(double k, double c, double limit, ActiveLimit kind, Acceleratio
   }
 }
 
-// A pump-power (or supply-pressure) constraint k x + c <= limit: it only ever caps the
+// A pump-power (or supply-pressure) constraint k x + c <= limit (kind: kPower or kPressure,
+// whichever sets the limit): it only ever caps the
 // acceleration. Where slowing down would raise a load pressure past what the pump gives (k < 0:
 // decelerating an over-running or heavy load), the constraint is left out: a pump short of
 // power slows the motion, it never forces it to go faster, and a stop must always be possible.
 // At sddot = 0 over the limit with no acceleration to help (k = 0), it asks for the strongest
 // deceleration, as apply_upper does.
-void apply_power(double k, double c, double limit, AccelerationBounds& b) {
+void apply_power(double k, double c, double limit, ActiveLimit kind, AccelerationBounds& b) {
   if (k < -kTinyRate) return;
-  apply_upper(k, c, limit, ActiveLimit::kPower, b);
+  apply_upper(k, c, limit, kind, b);
 }
 
 // The pump-power bound for a constant-pressure pump: P = p_s Q(sdot) does not depend on the
@@ -66,11 +67,13 @@ void constant_pressure_bounds(const dynamics::CraneModel& model, const PathGeome
     const double area = dynamics::flow_area_m2(model.cylinders[static_cast<std::size_t>(i)],
                                                path.dc_dq[i] * path.f1[i]);
     const double scale = sign / (path.dc_dq[i] * area);
-    apply_power(scale * terms.m[i], scale * terms.b[i], b.pressure_limit_pa, b);
+    apply_power(scale * terms.m[i], scale * terms.b[i], b.pressure_limit_pa, ActiveLimit::kPressure,
+                b);
   }
   if (flow_per_speed > 0.0 && p_supply > 0.0) {
-    b.sdot_power =
-        max_static_pressure > b.pressure_limit_pa ? 0.0 : p_max_w / (p_supply * flow_per_speed);
+    const bool starved = max_static_pressure > b.pressure_limit_pa;
+    b.sdot_power = starved ? 0.0 : p_max_w / (p_supply * flow_per_speed);
+    b.sdot_power_kind = starved ? ActiveLimit::kPressure : ActiveLimit::kPower;
   }
 }
 
@@ -118,6 +121,7 @@ void path_acceleration_bounds(const dynamics::CraneModel& model, const PathGeome
   b.limit_min = ActiveLimit::kNone;
   b.limit_max = ActiveLimit::kNone;
   b.sdot_power = kInf;
+  b.sdot_power_kind = ActiveLimit::kPower;
   b.sdot_acceleration = kInf;
   b.pressure_limit_pa = kInf;
   const double speed = std::max(sdot, 0.0);
@@ -157,26 +161,29 @@ void path_acceleration_bounds(const dynamics::CraneModel& model, const PathGeome
     const double p_power = flow > 0.0 ? p_max_w / flow - pump.ls_margin_pa : kInf;
     const double p_relief = pump.max_pressure_pa - pump.ls_margin_pa;
     b.pressure_limit_pa = std::min(p_power, p_relief);
+    // Which of the two sets the limit: the prime mover's power, or the relief valve.
+    const ActiveLimit kind = p_power < p_relief ? ActiveLimit::kPower : ActiveLimit::kPressure;
     for (int i = 0; i < n; ++i) {
       const double sign = motion_sign(path, i);
       if (sign == 0.0) continue;
       const double area = dynamics::flow_area_m2(model.cylinders[static_cast<std::size_t>(i)],
                                                  path.dc_dq[i] * path.f1[i]);
       const double scale = sign / (path.dc_dq[i] * area);
-      apply_power(scale * terms.m[i], scale * terms.b[i], b.pressure_limit_pa, b);
+      apply_power(scale * terms.m[i], scale * terms.b[i], b.pressure_limit_pa, kind, b);
     }
     // Quasi-static limit: the speed at which the current loads take exactly P_max at sddot = 0.
     if (flow_per_speed > 0.0) {
       const double p_supply = std::max(max_static_pressure, 0.0) + pump.ls_margin_pa;
-      b.sdot_power =
-          p_supply > p_relief + pump.ls_margin_pa ? 0.0 : p_max_w / (p_supply * flow_per_speed);
+      const bool beyond_relief = p_supply > p_relief + pump.ls_margin_pa;
+      b.sdot_power = beyond_relief ? 0.0 : p_max_w / (p_supply * flow_per_speed);
+      b.sdot_power_kind = beyond_relief ? ActiveLimit::kPressure : ActiveLimit::kPower;
     }
   } else if (limits.power_bound == PowerBound::kActuatorPowerSum) {
     // |sdot f1 . (m sddot + b)| <= P_max
     const double k = speed * path.f1.dot(terms.m);
     const double c = speed * path.f1.dot(terms.b);
-    apply_power(k, c, p_max_w, b);
-    apply_power(-k, -c, p_max_w, b);
+    apply_power(k, c, p_max_w, ActiveLimit::kPower, b);
+    apply_power(-k, -c, p_max_w, ActiveLimit::kPower, b);
     const double static_power_per_speed = std::abs(path.f1.dot(terms.b));
     if (static_power_per_speed > 0.0) {
       b.sdot_power = p_max_w / static_power_per_speed;

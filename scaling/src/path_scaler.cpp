@@ -27,7 +27,7 @@ SpeedCap lowest_speed_cap(double sdot_request, double tracking_factor, double sd
       {speed.sdot_flow, ActiveLimit::kFlow},
       {speed.sdot_cylinder, cylinder_speed},
       {sdot_joint_limit, ActiveLimit::kJointLimit},
-      {bounds.sdot_power, ActiveLimit::kPower},
+      {bounds.sdot_power, bounds.sdot_power_kind},
       {bounds.sdot_acceleration, cylinder_acceleration},
   };
   SpeedCap lowest = candidates[0];
@@ -79,9 +79,10 @@ void PathScaler::update(const JointVector& q, const PathGeometry& geometry,
   if (in.stale_input) {
     out.limit = ActiveLimit::kStaleInput;
   } else if (out.filter_status == ScalingFilterStatus::kAccelerationLimited &&
-             out.bounds.limit_max == ActiveLimit::kPower &&
+             (out.bounds.limit_max == ActiveLimit::kPower ||
+              out.bounds.limit_max == ActiveLimit::kPressure) &&
              out.state.sddot >= out.bounds.sddot_max - 1e-9) {
-    out.limit = ActiveLimit::kPower;
+    out.limit = out.bounds.limit_max;
   } else if (lowest.kind != ActiveLimit::kNone && lowest.value < in.sdot_request) {
     out.limit = lowest.kind;
   }

@@ -253,9 +253,10 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
   if (in.stale_input) {
     out.limit = ActiveLimit::kStaleInput;
   } else if (status == ScalingFilterStatus::kAccelerationLimited &&
-             out.bounds.limit_max == ActiveLimit::kPower &&
+             (out.bounds.limit_max == ActiveLimit::kPower ||
+              out.bounds.limit_max == ActiveLimit::kPressure) &&
              a_new.dot(u) >= out.bounds.sddot_max - 1e-9) {
-    out.limit = ActiveLimit::kPower;
+    out.limit = out.bounds.limit_max;
   } else if (end_brake) {
     out.limit = ActiveLimit::kJointLimit;
   } else if (cap.kind != ActiveLimit::kNone && cap.value < request) {

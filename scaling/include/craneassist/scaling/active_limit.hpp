@@ -14,8 +14,9 @@ enum class ActiveLimit {
   kStaleInput,            // no valid operator input
   kCylinderAcceleration,  // a cylinder's maximum acceleration (path curvature at speed)
   kSingularity,           // a near-singular pose: the direction needs very fast joints
+  kPressure,              // a load pressure at the pump's ceiling (relief; p_s with a CP pump)
 };
-inline constexpr int kActiveLimitCount = 9;
+inline constexpr int kActiveLimitCount = 10;
 
 const char* to_string(ActiveLimit limit);
 

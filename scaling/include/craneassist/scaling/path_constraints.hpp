@@ -54,7 +54,9 @@ void path_speed_limits(const dynamics::CraneModel& model, const PathGeometry& pa
 struct AccelerationBounds {
   double sddot_min = 0.0;
   double sddot_max = 0.0;
-  // What sets each side: kCylinderAcceleration, kPower, or kNone for the path's own bound.
+  // What sets each side: kCylinderAcceleration, kPower (the prime mover's power), kPressure (a
+  // load pressure at relief, or at p_s - dp_c with a constant-pressure pump), or kNone for the
+  // path's own bound.
   ActiveLimit limit_min = ActiveLimit::kNone;
   ActiveLimit limit_max = ActiveLimit::kNone;
   // min(P_max / Q - dp_LS, p_relief - dp_LS) (LS bound); p_s - dp_c (constant pressure).
@@ -62,6 +64,7 @@ struct AccelerationBounds {
   // Highest path speed at which the power bound still admits sddot = 0 (quasi-static power
   // limit), evaluated with the loads of this cycle; +inf when power does not limit.
   double sdot_power = 0.0;
+  ActiveLimit sdot_power_kind = ActiveLimit::kPower;  // kPressure: 0 for a load beyond relief
   // Highest path speed at which the curvature term of each cylinder's acceleration,
   // (r'_i f'_i^2 + r_i f''_i) sdot^2, stays within its limit with sddot = 0: where f' vanishes
   // (a turning point of the path) the acceleration bound becomes this speed bound.
