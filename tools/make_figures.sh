@@ -14,9 +14,20 @@ $bin replay examples/replays/combined_move.csv "${small[@]}" --scaling flow --lo
 tools/plot_direction.py "$out/cm_none.csv" "$out/cm_flow.csv" docs/img/combined_move.png \
   --labels "no scaling" "flow prescaling" --flow-limit 100
 
-# docs/scaling.md: the heavy lift, flow prescaling only against full scaling.
-$bin replay examples/replays/heavy_lift.csv --payload 650 --settle 1.5 --scaling flow --log "$out/hl_flow.csv" >/dev/null
-$bin replay examples/replays/heavy_lift.csv --payload 650 --settle 1.5 --scaling full --log "$out/hl_full.csv" >/dev/null
+# docs/scaling.md: what the operator feels, before (archived logs of commit 9969e41,
+# docs/data/feel-before/) and now.
+$bin replay examples/replays/suite/push_x_plus.csv --log "$out/push.csv" >/dev/null
+$bin replay examples/replays/suite/reversal_slow.csv --log "$out/reversal.csv" >/dev/null
+tools/plot_feel.py docs/img/operator_feel.png \
+  --run "push straight out" docs/data/feel-before/push_x_plus.csv "$out/push.csv" \
+  --run "slow reversal" docs/data/feel-before/reversal_slow.csv "$out/reversal.csv"
+
+# docs/scaling.md: the heavy lift, flow prescaling only against full scaling. The joint-space
+# pseudo-inverse, with which this lift is power-bound (the energy-optimal default needs less
+# power for it and is bound by the cylinders' speeds first).
+hl=(examples/replays/heavy_lift.csv --payload 650 --settle 1.5 --resolution pinv-joint)
+$bin replay "${hl[@]}" --scaling flow --log "$out/hl_flow.csv" >/dev/null
+$bin replay "${hl[@]}" --scaling full --log "$out/hl_full.csv" >/dev/null
 tools/plot_direction.py "$out/hl_flow.csv" "$out/hl_full.csv" docs/img/heavy_lift.png \
   --labels "flow prescaling only" "full scaling (LS power bound)" --power-limit 35
 

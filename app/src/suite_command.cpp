@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -31,8 +32,10 @@ int run_one_resolution(const app::Suite& suite, const config::CraneConfig& cfg,
   config::CraneConfig shown = cfg;
   if (!resolution.empty()) config::set_resolution(shown, resolution);
   std::printf("  resolution %s\n", config::resolution_description(shown).c_str());
-  std::printf("    %-36s %6s %10s %10s %9s %9s  %s\n", "run", "stalls", "lateral", "peak power",
-              "dir. err", "energy", "result");
+  int width = 3;  // the run names' column, as wide as the longest
+  for (const auto& run : suite.runs) width = std::max(width, static_cast<int>(run.name().size()));
+  std::printf("    %-*s %6s %10s %10s %9s %9s  %s\n", width, "run", "stalls", "lateral",
+              "peak power", "dir. err", "energy", "result");
   int missed = 0;
   for (const auto& run : suite.runs) {
     if (!args.only.empty() && run.name().find(args.only) == std::string::npos) continue;
@@ -44,7 +47,7 @@ int run_one_resolution(const app::Suite& suite, const config::CraneConfig& cfg,
     char lateral[32] = "-";
     if (s.feel.one_line)
       std::snprintf(lateral, sizeof lateral, "%.3f m/s", s.feel.lateral_peak_m_s);
-    std::printf("    %-36s %6d %10s %6.2f Pmax %5.2f deg %6.1f kJ  %s\n", run.name().c_str(),
+    std::printf("    %-*s %6d %10s %6.2f Pmax %5.2f deg %6.1f kJ  %s\n", width, run.name().c_str(),
                 s.feel.stall_events, lateral, s.peak_power_w / out.p_max_w,
                 s.max_direction_error_deg, s.energy_j / 1e3, out.ok() ? "ok" : "MISSED");
     for (const auto& m : out.missed) std::printf("      missed: %s\n", m.c_str());
