@@ -19,12 +19,14 @@ constexpr double kIntendedShare = 1.25;
 // speed) is a reversal.
 constexpr double kReversalShare = 0.05;
 // After braking at a joint end: restart once the end damping allows this share of the request
+// (as far as the hydraulics give it)
 // (at least kRestartSpeed), or when the command changes by more than kCommandChange of itself.
 constexpr double kRestartShare = 0.3;
 constexpr double kRestartSpeed = 0.05;  // m/s
 constexpr double kCommandChange = 0.02;
 constexpr double kMinRestTime = 0.4;  // s: valve delay and lag with margin
 constexpr double kRestartRoom = 4.0;
+constexpr double kMinRestartRoom = 0.1;  // m: a restart from rest goes at least this far
 
 }  // namespace
 
@@ -126,19 +128,24 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
     // after the stop, with the machine still moving, would swing spools across their dead
     // zones).
     rest_time_s_ = speed == 0.0 ? rest_time_s_ + period : 0.0;
-    const double restart = std::max(kRestartShare * request, kRestartSpeed);
+    // A share of what the stick asks for as far as the hydraulics give it (a stick pushed
+    // beyond what the crane can do does not raise the bar).
+    const double reachable =
+        std::min(request, lowest_speed_cap(request, 1.0, kInf, out.speed, out.bounds, false).value);
+    const double restart = std::max(kRestartShare * reachable, kRestartSpeed);
     const bool moved = (in.command - end_brake_command_).norm() > kCommandChange * request;
     const bool settled = speed > 0.0 || rest_time_s_ >= kMinRestTime;
     // Nearly at rest, only where a restart can go somewhere: a stop from the restart speed fits
-    // kRestartRoom times into what is left to the end. At the workspace's end the null space
-    // moves the joints' ends about and the end damping's cap rises and falls; without this the
-    // reference braked, restarted at a few cm/s and braked again, twice within a second. Still
-    // moving at the restart speed, the end damping's cap takes over as soon as it allows that
-    // speed (a hand-over moving the end away).
+    // kRestartRoom times into what is left to the end, and that is at least kMinRestartRoom. At the
+    // workspace's end the null space moves the joints' ends about and the end damping's cap rises
+    // and falls; without this the reference braked, restarted at a few cm/s and braked again, twice
+    // within a second. Still moving at the restart speed, the end damping's cap takes over as soon
+    // as it allows that speed (a hand-over moving the end away).
     const bool room =
-        speed >= restart || kRestartRoom * braking_distance(restart, 0.0, in.stop_deceleration_m_s2,
-                                                            in.stop_jerk_m_s3) <
-                                in.end_distance_m;
+        speed >= restart ||
+        std::max(kRestartRoom *
+                     braking_distance(restart, 0.0, in.stop_deceleration_m_s2, in.stop_jerk_m_s3),
+                 kMinRestartRoom) < in.end_distance_m;
     if ((in.sdot_joint_limit >= restart && room && settled) || moved || request == 0.0) {
       end_brake_ = false;
     }

@@ -11,7 +11,7 @@
 // faster than its cylinder can decelerate): the velocity bounds shaped from the position limits
 // of Flacco et al., per unit path speed. The resolution keeps every joint inside them through the
 // null space while the other joints can do the task, and an end-avoidance term that grows inside
-// the end zone (docs/config.md, redundancy.end_zone) hands the motion over to the other joints
+// the end zone (the last 10 % of its range) hands the motion over to the other joints
 // before the bound is reached. So the tip does not slow down for a joint end as long as the other
 // joints can carry on. When they cannot (the edge of the workspace along u), the end damping
 // below caps the path speed at the speed from which a stop within the joint's deceleration and
