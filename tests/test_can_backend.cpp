@@ -159,6 +159,16 @@ TEST(CanBackend, SendsAtTheMappingCycleNotEveryWrite) {
   EXPECT_FALSE(backend.faulted());
 }
 
+// The valves see a command every 20 ms: the backend says so, and the controller's valve
+// follower leaves out its one-cycle dead-zone lead (tests/test_valve_command_period.cpp).
+TEST(CanBackend, ReportsItsValveCommandPeriod) {
+  Rig r;
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  EXPECT_DOUBLE_EQ(backend.command_period_s(), 0.02);
+  const valves::MachineInterface& machine = backend;
+  EXPECT_DOUBLE_EQ(machine.command_period_s(), 0.02);
+}
+
 TEST(CanBackend, LostFeedbackLatchesBlockUntilEnable) {
   Rig r;
   CanBackend backend(r.map, r.cfg.model, r.backend_end);

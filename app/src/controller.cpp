@@ -45,6 +45,7 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
       // planned trajectories (trajectory_runner.hpp), whose at-rest cylinders the planner counts
       // as closed.
       follower_(config.model, config.control.position_gain_1_s, period_s_) {
+  follower_.set_command_period(options.valve_command_period_s);
   const int n = model_.dof();
   q_ref_ = config.simulation.q_initial;
   dc_dq_.setZero(n);

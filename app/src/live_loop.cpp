@@ -11,7 +11,9 @@ namespace craneassist::app {
 
 LiveSummary run_live(const config::CraneConfig& config, input::CommandSource& source,
                      valves::MachineInterface& machine, const LiveOptions& options, CsvLog* log) {
-  Controller controller(config, options.controller);
+  ControllerOptions controller_options = options.controller;
+  controller_options.valve_command_period_s = machine.command_period_s();
+  Controller controller(config, controller_options);
   input::InputMonitor monitor(options.monitor);
   const double period = controller.period_s();
   const long max_cycles = options.duration_s > 0.0

@@ -17,7 +17,9 @@ double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 RunSummary run_replay(const config::CraneConfig& config, const input::Replay& replay,
                       valves::MachineInterface& machine, const RunOptions& options, CsvLog* log) {
   const auto& model = config.model;
-  Controller controller(config, options.controller);
+  ControllerOptions controller_options = options.controller;
+  controller_options.valve_command_period_s = machine.command_period_s();
+  Controller controller(config, controller_options);
   const double period = controller.period_s();
   const int cycles =
       static_cast<int>(std::ceil((replay.end_time_s() + options.settle_s) / period - 1e-9)) + 1;

@@ -29,6 +29,7 @@ TrajectoryRunSummary run_trajectory(const config::CraneConfig& config,
   valves::ReferenceFollower follower(model, config.control.position_gain_1_s, period,
                                      config.control.activation_speed_m_s,
                                      config.control.activation_error_m);
+  follower.set_command_period(machine.command_period_s());
   valves::MachineState state;
   valves::ValveCommand command;
   dynamics::KinematicsData kin;

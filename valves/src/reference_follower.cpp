@@ -12,6 +12,7 @@ ReferenceFollower::ReferenceFollower(const dynamics::CraneModel& model, double p
                                      double activation_error_m)
     : model_(model),
       valves_(model, position_gain_1_s, activation_speed_m_s, activation_error_m),
+      period_s_(period_s),
       lag_alpha_(model.valves.time_constant_s > 0.0
                      ? 1.0 - std::exp(-period_s / model.valves.time_constant_s)
                      : 1.0) {
@@ -31,6 +32,10 @@ void ReferenceFollower::reset(const JointVector& q) {
   for (auto& h : q_ref_history_) h = q;
   head_ = 0;
   spool_estimate_.setZero();
+}
+
+void ReferenceFollower::set_command_period(double command_period_s) {
+  lead_ = !(command_period_s > period_s_ * (1.0 + 1e-6));
 }
 
 void ReferenceFollower::neutral(ValveCommand& out) {
@@ -55,7 +60,8 @@ void ReferenceFollower::update(const JointVector& q_ref, const JointVector& qdot
   valves_.update(in_, out);
   // Deadbeat compensation of the spool lag while a spool still has to cross the dead zone to the
   // side it is wanted on (no flow passes there, so a fast crossing costs nothing); outside it
-  // the wanted position goes through unchanged, so feedback corrections are not amplified.
+  // the wanted position goes through unchanged, so feedback corrections are not amplified. Only
+  // when every command reaches the valves: held for two cycles, the lead would overshoot.
   for (int i = 0; i < n; ++i) {
     const double wanted = out.spool[i];
     const double estimate = spool_estimate_[i];
@@ -63,8 +69,9 @@ void ReferenceFollower::update(const JointVector& q_ref, const JointVector& qdot
     const double edge = wanted != 0.0 ? valves_.dead_band_edge(i, wanted) : 0.0;
     const bool crossing =
         wanted != 0.0 && (estimate * wanted <= 0.0 || std::abs(estimate) < std::abs(edge));
-    const double command =
-        crossing ? std::clamp(estimate + (wanted - estimate) / lag_alpha_, -1.0, 1.0) : wanted;
+    const double command = crossing && lead_
+                               ? std::clamp(estimate + (wanted - estimate) / lag_alpha_, -1.0, 1.0)
+                               : wanted;
     spool_estimate_[i] += lag_alpha_ * (command - spool_estimate_[i]);
     out.spool[i] = command;
   }

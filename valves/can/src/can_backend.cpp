@@ -427,6 +427,12 @@ void CanBackend::read_pump(valves::PumpMeasurement& pump, std::int64_t now_rt_us
   pump.energy_j = m.pump_energy_j;
 }
 
+double CanBackend::command_period_s() const {
+  std::int64_t longest_us = 0;
+  for (const auto& j : impl_->joints) longest_us = std::max(longest_us, j.cycle_us);
+  return static_cast<double>(longest_us) * 1e-6;
+}
+
 valves::BackendStatus CanBackend::write(const valves::ValveCommand& command) {
   Impl& m = *impl_;
   const std::int64_t now = mono_us();

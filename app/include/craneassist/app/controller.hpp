@@ -43,6 +43,8 @@ const char* to_string(ScalingMode mode);
 
 struct ControllerOptions {
   ScalingMode mode = ScalingMode::kFull;
+  // How often a command reaches the valves (MachineInterface::command_period_s; 0: every cycle).
+  double valve_command_period_s = 0.0;
 };
 
 struct ControllerOutput {

@@ -50,6 +50,10 @@ class MachineInterface {
   // loop's clock paces it).
   virtual void advance(double dt_s) = 0;
   virtual const char* name() const = 0;
+  // How often a written command reaches the valves, s: 0 when every write does (the simulator);
+  // a bus backend sends at its own cycle and the valves hold the latest command in between. The
+  // valve control must not rely on a single cycle's command then (ReferenceFollower).
+  virtual double command_period_s() const { return 0.0; }
 };
 
 }  // namespace craneassist::valves

@@ -27,6 +27,12 @@ class ReferenceFollower {
   // Fills the history with q (the machine at rest at q).
   void reset(const JointVector& q);
 
+  // How often a command reaches the valves (MachineInterface::command_period_s; 0: every
+  // update). The spool lag is compensated through the dead zone by a one-cycle lead only when
+  // every command reaches the valves: a lead held for longer (a bus that sends every 20 ms)
+  // overshoots the dead zone into flow.
+  void set_command_period(double command_period_s);
+
   // q_ref, qdot_ref: this cycle's joint reference; q_meas: the measurement, or nullptr when
   // there is none (feed-forward only).
   void update(const JointVector& q_ref, const JointVector& qdot_ref, const JointVector* q_meas,
@@ -44,6 +50,8 @@ class ReferenceFollower {
   ProportionalValvesInput in_;
   JointVector dc_dq_, c_ref_, c_meas_;
   JointVector spool_estimate_;
+  double period_s_;
+  bool lead_ = true;  // every command reaches the valves: the dead-zone lead is safe
   double lag_alpha_;  // share of the remaining spool travel the lag covers in one period
   std::vector<JointVector> q_ref_history_;
   std::size_t head_ = 0;

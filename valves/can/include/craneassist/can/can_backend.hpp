@@ -85,6 +85,8 @@ class CanBackend final : public valves::MachineInterface {
   valves::BackendStatus write(const valves::ValveCommand& command) override;
   void advance(double) override {}
   const char* name() const override { return "can"; }
+  // The slowest valve command cycle of the mapping (ISO 11783-7 AVC, or the current signal's).
+  double command_period_s() const override;
 
   // Start-up (may block): reads until every joint's position has arrived, or the timeout.
   bool wait_for_feedback(double timeout_s, valves::MachineState& state);
