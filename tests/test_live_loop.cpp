@@ -61,7 +61,8 @@ class Probe : public app::CycleObserver {
     rows.reserve(n);
     allocations.reserve(n);
   }
-  void on_cycle(const app::LogRow& row) noexcept override {
+  void on_cycle(const app::CycleRecord& cycle) noexcept override {
+    const app::LogRow& row = cycle.row;
     if (rows.size() < rows.capacity()) {
       rows.push_back(row);
       allocations.push_back(craneassist::test::heap_allocations());

@@ -6,6 +6,7 @@
 #include <ostream>
 #include <stdexcept>
 
+#include "craneassist/app/control_loop.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/valve_table.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
@@ -29,6 +30,83 @@ double mid_stroke_q(const dynamics::CraneModel& model, int i) {
   }
   return 0.5 * (a + b);
 }
+
+// The calibration's cycle task: one section's spool held at a level, every other valve neutral.
+class HoldValves final : public CycleTask {
+ public:
+  HoldValves(int dof, int section, double level) : section_(section), level_(level) {
+    spool_.setZero(dof);
+    spool_[section] = level;
+  }
+  void start(const valves::MachineState&, double) override {}
+  CycleStatus step(const CycleTime& time, const valves::MachineState& state, const char*,
+                   valves::ValveCommand& command, LogRow& row) noexcept override {
+    command.spool = spool_;
+    row.t = time.t_s;
+    if (state.valid) row.q[static_cast<std::size_t>(section_)] = state.q[section_];
+    row.spool[static_cast<std::size_t>(section_)] = level_;
+    row.set_pump(state.pump);
+    return CycleStatus::kRunning;
+  }
+
+ private:
+  int section_;
+  double level_;
+  dynamics::JointVector spool_;
+};
+
+// Measures the steady cylinder velocity of one level: the mean over the window after the settle
+// time, invalid when the two halves of the window differ or the stroke comes near an end stop.
+class LevelProbe final : public CycleObserver {
+ public:
+  LevelProbe(const dynamics::Cylinder& cyl, int section, double command, int settle_cycles,
+             int measure_cycles, double period_s, double c_lo, double c_hi, double tolerance,
+             std::vector<SweepLogRow>* log)
+      : cyl_(cyl),
+        section_(section),
+        settle_(settle_cycles),
+        measure_(measure_cycles),
+        half_(settle_cycles + measure_cycles / 2),
+        period_s_(period_s),
+        c_lo_(c_lo),
+        c_hi_(c_hi),
+        tolerance_(tolerance),
+        log_(log),
+        point_{command, 0.0, true} {
+    if (log_ != nullptr) log_->reserve(log_->size() + static_cast<std::size_t>(settle_ + measure_ + 1));
+  }
+
+  void on_cycle(const CycleRecord& c) noexcept override {
+    const long k = c.time.k;
+    const double q = c.state.q[section_];
+    const double length = dynamics::cylinder_length(cyl_, q);
+    const bool measuring = k >= settle_;
+    if (k == settle_) c_start_ = length;
+    if (k == half_) c_half_ = length;
+    if (measuring && (length < c_lo_ || length > c_hi_)) point_.valid = false;
+    if (k == settle_ + measure_) {
+      point_.velocity_m_s = (length - c_start_) / (measure_ * period_s_);
+      const double v1 = (c_half_ - c_start_) / ((half_ - settle_) * period_s_);
+      const double v2 = (length - c_half_) / ((settle_ + measure_ - half_) * period_s_);
+      const double scale = std::max(std::abs(point_.velocity_m_s), 1e-3 * cyl_.v_max_m_s);
+      if (std::abs(v2 - v1) > tolerance_ * scale) point_.valid = false;
+    }
+    if (log_ != nullptr) {
+      log_->push_back({section_, point_.command, static_cast<double>(k) * period_s_, length,
+                       dynamics::cylinder_arm(cyl_, q) * c.state.qdot[section_], measuring});
+    }
+  }
+  const SweepPoint& point() const { return point_; }
+
+ private:
+  const dynamics::Cylinder& cyl_;
+  int section_;
+  int settle_, measure_, half_;
+  double period_s_, c_lo_, c_hi_, tolerance_;
+  std::vector<SweepLogRow>* log_;
+  SweepPoint point_;
+  double c_start_ = 0.0, c_half_ = 0.0;
+};
 
 std::string format_list(const std::vector<double>& values) {
   std::string out;
@@ -68,35 +146,15 @@ SectionCalibration calibrate_section(const config::CraneConfig& config, int sect
   for (double level : options.levels) {
     for (double sign : {-1.0, 1.0}) {
       sim_backend::SimBackend machine(model, settings);
-      valves::ValveCommand command;
-      command.spool.setZero(model.dof());
-      command.spool[section] = sign * level;
-      valves::MachineState state;
-      SweepPoint point{sign * level, 0.0, true};
-      double c_start = 0.0, c_half = 0.0;
-      const int half = settle_cycles + measure_cycles / 2;
-      for (int k = 0; k <= settle_cycles + measure_cycles; ++k) {
-        machine.read(state);
-        const double c = dynamics::cylinder_length(cyl, state.q[section]);
-        const bool measuring = k >= settle_cycles;
-        if (k == settle_cycles) c_start = c;
-        if (k == half) c_half = c;
-        if (measuring && (c < c_lo || c > c_hi)) point.valid = false;
-        if (k == settle_cycles + measure_cycles) {
-          point.velocity_m_s = (c - c_start) / (measure_cycles * period);
-          const double v1 = (c_half - c_start) / ((half - settle_cycles) * period);
-          const double v2 = (c - c_half) / ((settle_cycles + measure_cycles - half) * period);
-          const double scale = std::max(std::abs(point.velocity_m_s), 1e-3 * cyl.v_max_m_s);
-          if (std::abs(v2 - v1) > options.settled_tolerance * scale) point.valid = false;
-        }
-        if (log != nullptr) {
-          log->push_back({section, point.command, k * period, c,
-                          dynamics::cylinder_arm(cyl, state.q[section]) * state.qdot[section],
-                          measuring});
-        }
-        machine.write(command);
-        machine.advance(period);
-      }
+      HoldValves task(model.dof(), section, sign * level);
+      LevelProbe probe(cyl, section, sign * level, settle_cycles, measure_cycles, period, c_lo,
+                       c_hi, options.settled_tolerance, log);
+      LoopOptions loop;
+      loop.period_s = period;
+      loop.max_cycles = settle_cycles + measure_cycles + 1;
+      loop.observers = {&probe};
+      run_control_loop(task, machine, loop);
+      const SweepPoint point = probe.point();
       result.points.push_back(point);
     }
   }

@@ -75,6 +75,11 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
 
 Controller::~Controller() = default;
 
+void Controller::set_valve_command_period(double period_s) {
+  options_.valve_command_period_s = period_s;
+  follower_.set_command_period(period_s);
+}
+
 void Controller::reset(const valves::MachineState& state) {
   q_ref_ = state.q;
   follower_.reset(q_ref_);

@@ -6,18 +6,6 @@
 
 namespace craneassist::app {
 
-const char* status_word(ControllerStatus status) {
-  switch (status) {
-    case ControllerStatus::kRunning:
-      return "running";
-    case ControllerStatus::kStopping:
-      return "stopping";
-    case ControllerStatus::kStopped:
-      return "stopped";
-  }
-  return "unknown";
-}
-
 LogRowBuilder::LogRowBuilder(const dynamics::CraneModel& model)
     : model_(model), cyl_pos_(model.dof()), cyl_arm_(model.dof()) {
   // Size the working data once (forward kinematics at the zero configuration).

@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "craneassist/app/controller.hpp"
-#include "craneassist/app/cycle_observer.hpp"
+#include "craneassist/app/control_loop.hpp"
 #include "craneassist/app/replay_runner.hpp"
 #include "craneassist/app/sim_setup.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
@@ -289,7 +289,8 @@ namespace {
 // fine here).
 class ReferenceRecorder : public CycleObserver {
  public:
-  void on_cycle(const LogRow& row) noexcept override {
+  void on_cycle(const CycleRecord& cycle) noexcept override {
+    const LogRow& row = cycle.row;
     Row r;
     r.t = row.t;
     r.s = row.s;

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "craneassist/app/control_loop.hpp"
+#include "craneassist/app/run_statistics.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
 #include "craneassist/dynamics/rigid_body_terms.hpp"
@@ -28,63 +30,56 @@ dynamics::CraneModel machine_model(const config::CraneConfig& config,
   return model;
 }
 
-SinePathSummary run_sine_path(const config::CraneConfig& config, const SinePathOptions& options,
-                              valves::MachineInterface& machine, CsvLog* log) {
-  const auto& model = config.model;
-  if (model.dof() != 2) throw std::invalid_argument("the sine path needs a two-joint model");
-  const double period = 1.0 / config.control.rate_hz;
-  dynamics::RigidBodyTerms terms(model);
-  scaling::PathScaler scaler(
-      model,
-      {period, options.jerk_max, options.acceleration_max, config.control.flow_reserve,
-       options.power_bound, config.scaling.power_reserve},
-      terms);
-  valves::ReferenceFollower follower(model, config.control.position_gain_1_s, period);
+namespace {
 
-  scaling::PathGeometry geometry;
-  dynamics::JointVector q_ref, qdot_ref;
-  sine_path(0.0, q_ref, geometry.f1, geometry.f2);
-  follower.reset(q_ref);
-  dynamics::KinematicsData kin;
-  dynamics::TaskJacobian jac;
-  valves::MachineState state;
-  valves::ValveCommand command;
-  scaling::PathScalerOutput out;
-  LogRow row;
-  SinePathSummary summary;
-  const int cycles = static_cast<int>(std::lround(options.duration_s / period));
-  for (int k = 0; k < cycles; ++k) {
-    machine.read(state);
-    const double s = scaler.state().s;
-    sine_path(s, q_ref, geometry.f1, geometry.f2);
-    dynamics::cylinder_arms(model, q_ref, geometry.dc_dq);
-    geometry.d2c_dq2.resize(2);
+// The 2R arm on the sine path: the path scaler sets the path speed, the reference follower the
+// valves; the log row holds the tip the path commands, the reference and the planned LS power.
+class SinePathTask final : public CycleTask {
+ public:
+  SinePathTask(const config::CraneConfig& config, const SinePathOptions& options)
+      : model_(config.model),
+        options_(options),
+        terms_(model_),
+        scaler_(model_,
+                {1.0 / config.control.rate_hz, options.jerk_max, options.acceleration_max,
+                 config.control.flow_reserve, options.power_bound, config.scaling.power_reserve},
+                terms_),
+        follower_(model_, config.control.position_gain_1_s, 1.0 / config.control.rate_hz) {
+    geometry_.d2c_dq2.resize(2);
+  }
+
+  void start(const valves::MachineState&, double) override {
+    sine_path(0.0, q_ref_, geometry_.f1, geometry_.f2);
+    follower_.reset(q_ref_);
+  }
+
+  CycleStatus step(const CycleTime& time, const valves::MachineState& state, const char*,
+                   valves::ValveCommand& command, LogRow& row) noexcept override {
+    const double s = scaler_.state().s;
+    sine_path(s, q_ref_, geometry_.f1, geometry_.f2);
+    dynamics::cylinder_arms(model_, q_ref_, geometry_.dc_dq);
     for (int i = 0; i < 2; ++i) {
-      geometry.d2c_dq2[i] =
-          dynamics::cylinder_arm_slope(model.cylinders[static_cast<std::size_t>(i)], q_ref[i]);
+      geometry_.d2c_dq2[i] =
+          dynamics::cylinder_arm_slope(model_.cylinders[static_cast<std::size_t>(i)], q_ref_[i]);
     }
     scaling::PathScalerInput in;
-    in.sdot_request = options.sdot_request;
-    scaler.update(q_ref, geometry, in, out);
+    in.sdot_request = options_.sdot_request;
+    scaler_.update(q_ref_, geometry_, in, out_);
     const double planned =
-        scaling::load_sensing_power(model, geometry, out.terms, out.state.sdot, out.state.sddot);
-    sine_path(out.state.s, q_ref, geometry.f1, geometry.f2);
-    qdot_ref = geometry.f1 * out.state.sdot;
-    follower.update(q_ref, qdot_ref, state.valid ? &state.q : nullptr, command);
-    machine.write(command);
+        scaling::load_sensing_power(model_, geometry_, out_.terms, out_.state.sdot, out_.state.sddot);
+    sine_path(out_.state.s, q_ref_, geometry_.f1, geometry_.f2);
+    qdot_ref_ = geometry_.f1 * out_.state.sdot;
+    follower_.update(q_ref_, qdot_ref_, state.valid ? &state.q : nullptr, command);
 
-    summary.peak_pump_power_w = std::max(summary.peak_pump_power_w, state.pump.power_w);
-    summary.peak_planned_ls_power_w = std::max(summary.peak_planned_ls_power_w, planned);
-    summary.cycles_power_limited += state.pump.limit == valves::PumpLimit::kPower;
-    summary.peak_path_jerk = std::max(summary.peak_path_jerk, std::abs(out.state.sdddot));
-    if (log != nullptr && state.valid) {
-      dynamics::tip_jacobian(model, kin, state.q, jac);
-      const Eigen::Vector3d tip = model.task_from_base * kin.frames[2].translation();
-      const Eigen::Vector3d tip_v = jac * state.qdot;
-      dynamics::tip_jacobian(model, kin, q_ref, jac);
-      const Eigen::Vector3d ref_v = jac * qdot_ref;
-      const Eigen::Vector3d cmd_v = jac * geometry.f1 * options.sdot_request;
-      row.t = k * period;
+    peak_planned_ls_power_w_ = std::max(peak_planned_ls_power_w_, planned);
+    peak_path_jerk_ = std::max(peak_path_jerk_, std::abs(out_.state.sdddot));
+    if (state.valid) {
+      dynamics::tip_jacobian(model_, kin_, state.q, jac_);
+      const Eigen::Vector3d tip = model_.task_from_base * kin_.frames[2].translation();
+      const Eigen::Vector3d tip_v = jac_ * state.qdot;
+      dynamics::tip_jacobian(model_, kin_, q_ref_, jac_);
+      const Eigen::Vector3d ref_v = jac_ * qdot_ref_;
+      const Eigen::Vector3d cmd_v = jac_ * geometry_.f1 * options_.sdot_request;
       for (std::size_t a = 0; a < 3; ++a) {
         const auto e = static_cast<Eigen::Index>(a);
         row.cmd[a] = cmd_v[e];
@@ -95,30 +90,78 @@ SinePathSummary run_sine_path(const config::CraneConfig& config, const SinePathO
       for (std::size_t i = 0; i < 2; ++i) {
         const auto e = static_cast<Eigen::Index>(i);
         row.q[i] = state.q[e];
-        row.q_ref[i] = q_ref[e];
+        row.q_ref[i] = q_ref_[e];
         row.spool[i] = command.spool[e];
         row.load_pressure[i] = state.load_pressure_pa[e];
       }
-      row.set_pump(state.pump);
-      row.active_limit = scaling::to_string(out.limit);
-      row.scale = out.state.sdot / options.sdot_request;
-      row.flow_demand_m3s = out.speed.flow_per_speed_m3 * options.sdot_request;
-      row.s = out.state.s;
-      row.sdot = out.state.sdot;
-      row.sddot = out.state.sddot;
-      row.sdddot = out.state.sdddot;
-      row.sddot_min = out.bounds.sddot_min;
-      row.sddot_max = out.bounds.sddot_max;
-      row.tip_error_m = 0.0;
-      row.ref_power_w = planned;
-      log->push(row);
     }
-    machine.advance(period);
+    row.t = time.t_s;
+    row.set_pump(state.pump);
+    row.active_limit = scaling::to_string(out_.limit);
+    row.scale = out_.state.sdot / options_.sdot_request;
+    row.flow_demand_m3s = out_.speed.flow_per_speed_m3 * options_.sdot_request;
+    row.s = out_.state.s;
+    row.sdot = out_.state.sdot;
+    row.sddot = out_.state.sddot;
+    row.sdddot = out_.state.sdddot;
+    row.sddot_min = out_.bounds.sddot_min;
+    row.sddot_max = out_.bounds.sddot_max;
+    row.tip_error_m = 0.0;
+    row.ref_power_w = planned;
+    return CycleStatus::kRunning;
   }
-  machine.read(state);
-  summary.cycles = cycles;
-  summary.s_final = scaler.state().s;
-  summary.energy_j = state.pump.energy_j;
+
+  void fill(SinePathSummary& s) const {
+    s.s_final = scaler_.state().s;
+    s.peak_planned_ls_power_w = peak_planned_ls_power_w_;
+    s.peak_path_jerk = peak_path_jerk_;
+  }
+
+ private:
+  const dynamics::CraneModel& model_;
+  SinePathOptions options_;
+  dynamics::RigidBodyTerms terms_;
+  scaling::PathScaler scaler_;
+  valves::ReferenceFollower follower_;
+  scaling::PathGeometry geometry_;
+  scaling::PathScalerOutput out_;
+  dynamics::JointVector q_ref_, qdot_ref_;
+  dynamics::KinematicsData kin_;
+  dynamics::TaskJacobian jac_;
+  double peak_planned_ls_power_w_ = 0.0, peak_path_jerk_ = 0.0;
+};
+
+// Counts the cycles the simulated pump's power limiter held the flow back.
+class PowerLimitedCycles final : public CycleObserver {
+ public:
+  void on_cycle(const CycleRecord& c) noexcept override {
+    cycles += c.state.pump.limit == valves::PumpLimit::kPower;
+  }
+  int cycles = 0;
+};
+
+}  // namespace
+
+SinePathSummary run_sine_path(const config::CraneConfig& config, const SinePathOptions& options,
+                              valves::MachineInterface& machine, CsvLog* log) {
+  if (config.model.dof() != 2) throw std::invalid_argument("the sine path needs a two-joint model");
+  const double period = 1.0 / config.control.rate_hz;
+  SinePathTask task(config, options);
+  RunStatistics statistics(period);
+  PowerLimitedCycles power_limited;
+  LoopOptions loop;
+  loop.period_s = period;
+  loop.max_cycles = std::lround(options.duration_s / period);
+  loop.log = log;
+  loop.observers = {&statistics, &power_limited};
+  const RunSummary s = statistics.summary(run_control_loop(task, machine, loop));
+
+  SinePathSummary summary;
+  summary.cycles = s.cycles;
+  summary.energy_j = s.energy_j;
+  summary.peak_pump_power_w = s.peak_power_w;
+  summary.cycles_power_limited = power_limited.cycles;
+  task.fill(summary);
   return summary;
 }
 

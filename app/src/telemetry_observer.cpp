@@ -44,8 +44,8 @@ void to_frame(const LogRow& row, int dof, dds::TelemetryFrame& f) noexcept {
   f.deadman = row.deadman;
 }
 
-void TelemetryObserver::on_cycle(const LogRow& row) noexcept {
-  to_frame(row, dof_, frame_);
+void TelemetryObserver::on_cycle(const CycleRecord& cycle) noexcept {
+  to_frame(cycle.row, dof_, frame_);
   frame_.cycle = cycle_++;
   publisher_.push(frame_);
 }

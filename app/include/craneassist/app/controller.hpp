@@ -19,6 +19,7 @@
 #include <memory>
 #include <vector>
 
+#include "craneassist/app/control_loop.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
 #include "craneassist/dynamics/redundancy.hpp"
@@ -61,7 +62,8 @@ struct ControllerOutput {
   double ref_power_w = 0.0;  // pump power (LS, or p_s Q) the model predicts for the reference
 };
 
-enum class ControllerStatus { kRunning, kStopping, kStopped };
+// The controller's status is the cycle status of the loop (control_loop.hpp).
+using ControllerStatus = CycleStatus;
 
 class Controller {
  public:
@@ -79,6 +81,8 @@ class Controller {
                           ControllerOutput& out);
 
   double period_s() const { return period_s_; }
+  // How often a command reaches the valves (ControllerOptions::valve_command_period_s).
+  void set_valve_command_period(double period_s);
 
  private:
   void update_full(const valves::MachineState& state, const Eigen::Vector3d& v_cmd, bool stale,

@@ -1,8 +1,7 @@
-// The live control loop: a fixed-rate loop paced at real time that reads an operator's
-// CommandSource each cycle, checks it with the input monitor, runs the controller on the
-// machine, fills the log row (the same row the replay loop writes) and hands it to the CSV log
-// and to the cycle observers (telemetry). Optionally it records the command the controller got,
-// in the replay format, so `craneassist replay` reproduces the session.
+// A live run (`craneassist sim`): an operator's CommandSource behind the input monitor as the
+// command of the tip controller, through the one control loop (control_loop.hpp) paced at real
+// time, with the CSV log and the cycle observers (telemetry). Optionally it records the command
+// the controller got, in the replay format, so `craneassist replay` reproduces the session.
 //
 // The loop thread allocates nothing per cycle, never blocks on another thread (the status board
 // is published with try_lock) and throws nothing once running.
@@ -14,7 +13,7 @@
 
 #include "craneassist/app/controller.hpp"
 #include "craneassist/app/csv_log.hpp"
-#include "craneassist/app/cycle_observer.hpp"
+#include "craneassist/app/control_loop.hpp"
 #include "craneassist/input/command_source.hpp"
 #include "craneassist/input/input_monitor.hpp"
 #include "craneassist/input/replay.hpp"

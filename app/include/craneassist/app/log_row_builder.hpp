@@ -10,9 +10,6 @@
 
 namespace craneassist::app {
 
-// The loop status words of LogRow::status.
-const char* status_word(ControllerStatus status);
-
 class LogRowBuilder {
  public:
   explicit LogRowBuilder(const dynamics::CraneModel& model);

@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-#include "craneassist/app/cycle_observer.hpp"
+#include "craneassist/app/control_loop.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/dds/telemetry_frame.hpp"
 #include "craneassist/dds/telemetry_publisher.hpp"
@@ -16,7 +16,7 @@ class TelemetryObserver final : public CycleObserver {
  public:
   TelemetryObserver(dds::TelemetryPublisher& publisher, int dof)
       : publisher_(publisher), dof_(dof) {}
-  void on_cycle(const LogRow& row) noexcept override;
+  void on_cycle(const CycleRecord& cycle) noexcept override;
 
  private:
   dds::TelemetryPublisher& publisher_;
