@@ -73,7 +73,8 @@ class LevelProbe final : public CycleObserver {
         tolerance_(tolerance),
         log_(log),
         point_{command, 0.0, true} {
-    if (log_ != nullptr) log_->reserve(log_->size() + static_cast<std::size_t>(settle_ + measure_ + 1));
+    if (log_ != nullptr)
+      log_->reserve(log_->size() + static_cast<std::size_t>(settle_ + measure_ + 1));
   }
 
   void on_cycle(const CycleRecord& c) noexcept override {

@@ -25,8 +25,8 @@ LoopSummary run_control_loop(CycleTask& task, valves::MachineInterface& machine,
                              const LoopOptions& options) {
   using Clock = std::chrono::steady_clock;
   const double period = options.period_s;
-  const auto tick = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(period));
+  const auto tick =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period));
   const long settle_cycles = static_cast<long>(std::ceil(options.stop_settle_max_s / period));
 
   valves::MachineState state;

@@ -6,8 +6,8 @@
 #include <limits>
 #include <stdexcept>
 
-#include "craneassist/app/controller.hpp"
 #include "craneassist/app/control_loop.hpp"
+#include "craneassist/app/controller.hpp"
 #include "craneassist/app/replay_runner.hpp"
 #include "craneassist/app/sim_setup.hpp"
 #include "craneassist/dynamics/cylinders.hpp"

@@ -53,8 +53,7 @@ void RunStatistics::on_cycle(const CycleRecord& c) noexcept {
   if (!(moving_cmd && angle_deg(cmd, out->ref_tip_velocity_m_s) < 0.5)) {
     cmd_since_s_ = t + period_s_;  // not on the command yet: the window starts later
   }
-  if (moving_cmd && speed > options_.min_speed_m_s &&
-      t - cmd_since_s_ >= options_.steady_after_s) {
+  if (moving_cmd && speed > options_.min_speed_m_s && t - cmd_since_s_ >= options_.steady_after_s) {
     const double err = angle_deg(cmd, tip_v);
     s_.max_direction_error_deg = std::max(s_.max_direction_error_deg, err);
     sum_sq_direction_ += err * err;

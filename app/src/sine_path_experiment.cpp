@@ -65,8 +65,8 @@ class SinePathTask final : public CycleTask {
     scaling::PathScalerInput in;
     in.sdot_request = options_.sdot_request;
     scaler_.update(q_ref_, geometry_, in, out_);
-    const double planned =
-        scaling::load_sensing_power(model_, geometry_, out_.terms, out_.state.sdot, out_.state.sddot);
+    const double planned = scaling::load_sensing_power(model_, geometry_, out_.terms,
+                                                       out_.state.sdot, out_.state.sddot);
     sine_path(out_.state.s, q_ref_, geometry_.f1, geometry_.f2);
     qdot_ref_ = geometry_.f1 * out_.state.sdot;
     follower_.update(q_ref_, qdot_ref_, state.valid ? &state.q : nullptr, command);

@@ -5,7 +5,8 @@
 namespace craneassist::app {
 namespace {
 
-const Eigen::Vector3d kNoValue = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+const Eigen::Vector3d kNoValue =
+    Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
 
 }  // namespace
 

@@ -11,9 +11,9 @@
 #include <mutex>
 #include <vector>
 
+#include "craneassist/app/control_loop.hpp"
 #include "craneassist/app/controller.hpp"
 #include "craneassist/app/csv_log.hpp"
-#include "craneassist/app/control_loop.hpp"
 #include "craneassist/input/command_source.hpp"
 #include "craneassist/input/input_monitor.hpp"
 #include "craneassist/input/replay.hpp"

@@ -42,7 +42,7 @@ struct RunSummary {
   int input_stop_cycles = 0;     // cycles without a command (a replay stop row, an input fault)
   int neutral_valve_cycles = 0;  // kStopped: at rest with every valve neutral
   std::array<int, scaling::kActiveLimitCount> limit_cycles{};  // indexed by scaling::ActiveLimit
-  bool machine_fault = false;                                   // the loop stopped for it
+  bool machine_fault = false;                                  // the loop stopped for it
   std::size_t log_rows_dropped = 0;
   MotionQualityResult feel;  // stall events and lateral speed (motion_quality.hpp)
 };

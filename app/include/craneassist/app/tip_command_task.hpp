@@ -73,9 +73,8 @@ class TipCommandTask final : public CycleTask {
                  TipCommandInput& input);
 
   void start(const valves::MachineState& state, double valve_command_period_s) override;
-  CycleStatus step(const CycleTime& time, const valves::MachineState& state,
-                   const char* stop_cause, valves::ValveCommand& command,
-                   LogRow& row) noexcept override;
+  CycleStatus step(const CycleTime& time, const valves::MachineState& state, const char* stop_cause,
+                   valves::ValveCommand& command, LogRow& row) noexcept override;
   const ControllerOutput* controller_output() const noexcept override { return &out_; }
 
   double period_s() const noexcept { return controller_.period_s(); }
