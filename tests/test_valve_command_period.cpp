@@ -32,6 +32,10 @@ class HeldCommandMachine final : public valves::MachineInterface {
   void advance(double dt_s) override { inner_.advance(dt_s); }
   const char* name() const override { return "held"; }
   double command_period_s() const override { return reported_; }
+  bool activate(double timeout_s, std::string* why) override {
+    return inner_.activate(timeout_s, why);
+  }
+  void safe_stop() noexcept override { inner_.safe_stop(); }
 
  private:
   valves::MachineInterface& inner_;

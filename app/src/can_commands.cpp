@@ -39,13 +39,6 @@ CanMachine::CanMachine(const dynamics::CraneModel& model, const std::string& ifa
   backend_ = std::make_unique<can::CanBackend>(mapping, model, *transport_, options);
 }
 
-bool CanMachine::start(double timeout_s) {
-  valves::MachineState state;
-  if (!backend_->wait_for_feedback(timeout_s, state)) return false;
-  backend_->enable();
-  return true;
-}
-
 void CanMachine::report() const {
   const auto c = backend_->counters();
   std::printf(

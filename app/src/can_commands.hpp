@@ -22,8 +22,6 @@ class CanMachine {
   CanMachine(const dynamics::CraneModel& model, const std::string& iface,
              const std::string& mapping_file, const std::string& candump_log,
              double feedback_timeout_s = 0.05);
-  // Waits for every joint's feedback, then enables the backend. False: no feedback in time.
-  bool start(double timeout_s);
   can::CanBackend& backend() { return *backend_; }
   // Prints the counters and, after a fault, its reason and how to recover.
   void report() const;

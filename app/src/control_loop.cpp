@@ -73,8 +73,13 @@ LoopSummary run_control_loop(CycleTask& task, valves::MachineInterface& machine,
     for (CycleObserver* o : options.observers) o->on_cycle(record);
 
     machine.advance(period);
-    if (stop_cause != nullptr &&
-        (status == CycleStatus::kStopped || k - stop_requested_at >= settle_cycles)) {
+    if (stop_cause != nullptr && status == CycleStatus::kStopped) {
+      ++k;
+      break;
+    }
+    if (stop_cause != nullptr && k - stop_requested_at >= settle_cycles) {
+      machine.safe_stop();  // not at rest in time: every valve to its safe state now
+      summary.safe_stopped = true;
       ++k;
       break;
     }

@@ -38,7 +38,7 @@ int Machine::open(const config::CraneConfig& cfg, const BackendArgs& args) {
   if (!uses_can_backend(args, cfg)) {
     sim_.emplace(cfg.model, app::sim_settings(cfg));
     machine_ = &*sim_;
-    return kExitOk;
+    return machine_->activate(0.0, nullptr) ? kExitOk : kExitRuntime;
   }
   const std::string iface = args.can_iface.empty() ? cfg.backend.can.interface : args.can_iface;
   if (iface.empty()) {
@@ -50,23 +50,20 @@ int Machine::open(const config::CraneConfig& cfg, const BackendArgs& args) {
       args.mapping_file.empty() ? cfg.backend.can.mapping : args.mapping_file;
   can_.emplace(cfg.model, iface, mapping, args.can_log,
                args.feedback_timeout_s.value_or(cfg.backend.can.feedback_timeout_s));
-  if (!can_->start(2.0)) {
-    spdlog::error(
-        "no position feedback of every joint on {} within 2 s (is the machine or "
-        "`craneassist emulate --can {}` running?)",
-        iface, iface);
+  machine_ = &can_->backend();
+  if (std::string why; !machine_->activate(2.0, &why)) {
+    spdlog::error("{} on {} (is the machine or `craneassist emulate --can {}` running?)", why,
+                  iface, iface);
     return kExitRuntime;
   }
-  machine_ = &can_->backend();
   return kExitOk;
 }
 
 int Machine::finish() {
-  if (!can_) return kExitOk;
-  can_->backend().disable();  // the normal end: every section to block
-  can_->backend().stop();
-  can_->report();
-  return can_->backend().faulted() ? kExitRuntime : kExitOk;
+  if (machine_ == nullptr) return kExitOk;
+  machine_->deactivate();
+  if (can_) can_->report();
+  return machine_->faulted() ? kExitRuntime : kExitOk;
 }
 
 }  // namespace craneassist::cli

@@ -29,17 +29,16 @@ void add_backend_options(CLI::App& command, BackendArgs& args);
 // The resolved choice: --backend, else the config's `backend:`.
 bool uses_can_backend(const BackendArgs& args, const config::CraneConfig& cfg);
 
-// Holds the machine of a run: the simulator or the CAN machine (transport and backend).
+// Holds the machine of a run: the simulator or the CAN machine (transport and backend). Callers
+// use the machine through its interface only.
 class Machine {
  public:
   valves::MachineInterface& get() { return *machine_; }
-  bool is_can() const { return can_.has_value(); }
-  can::CanBackend* can_backend() { return can_ ? &can_->backend() : nullptr; }
-  // Builds and starts the machine: the CAN backend waits up to 2 s for every joint's feedback
-  // and is enabled. Returns kExitOk, or logs why not and returns the exit code.
+  // Builds and activates the machine (a bus machine waits up to 2 s for every joint's
+  // feedback). Returns kExitOk, or logs why not and returns the exit code.
   int open(const config::CraneConfig& cfg, const BackendArgs& args);
-  // The normal end of a run on CAN: every section blocked (CanBackend::disable), the backend
-  // stopped and its report printed. Returns kExitRuntime after a CAN fault, else kExitOk.
+  // The normal end of a run: the machine deactivated (every valve to its safe state, its
+  // threads ended) and the bus report printed. Returns kExitRuntime after a latched fault.
   int finish();
 
  private:

@@ -323,7 +323,6 @@ int run_replay_command(const ReplayArgs& args) {
     cli::Machine machines;
     if (const int rc = machines.open(cfg, args.machine); rc != kExitOk) return rc;
     valves::MachineInterface& machine = machines.get();
-    const bool use_can = machines.is_can();
     cli::Telemetry telemetry;
     const bool telemetry_wanted = args.telemetry.on || !args.telemetry.config_file.empty();
     if (const int rc = telemetry.open(telemetry_settings, telemetry_wanted, cfg, machine.name());
@@ -338,7 +337,7 @@ int run_replay_command(const ReplayArgs& args) {
                               : args.scaling == "flow" ? app::ScalingMode::kFlowOnly
                               : args.scaling == "none" ? app::ScalingMode::kNone
                                                        : app::ScalingMode::kFull;
-    options.realtime = args.realtime || use_can;  // a real machine runs in real time
+    options.realtime = args.realtime || machine.real_time();
     options.settle_s = args.settle_s;
     options.freeze_at_s = args.freeze_at_s;
     options.freeze_for_s = args.freeze_for_s;
@@ -353,6 +352,7 @@ int run_replay_command(const ReplayArgs& args) {
     if (summary.log_rows_dropped > 0) {
       spdlog::warn("the log writer fell behind: {} rows dropped", summary.log_rows_dropped);
     }
+    if (summary.machine_fault) spdlog::error("the machine reported a fault: run stopped");
     if (const int rc = machines.finish(); rc != kExitOk) return rc;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());

@@ -315,8 +315,8 @@ int run_sim_command(const SimArgs& args) {
       ui.join();
       throw;
     }
-    // On CAN: every section to block at once (Machine::finish() below reports).
-    if (can::CanBackend* can = machines.can_backend()) can->disable();
+    // Every valve to its safe state at once (Machine::finish() below deactivates and reports).
+    machine.safe_stop();
     done.store(true);
     ui.join();
     std::optional<dds::CommandInputStats> remote_stats;

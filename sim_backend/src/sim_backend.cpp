@@ -173,6 +173,7 @@ struct SimBackend::Impl {
   std::vector<dJointFeedback> feedback;
   std::vector<ValveSection> sections;
   JointVector spool_command, requested_velocity, demand, load_pressure, force, q, qdot;
+  bool active = true;  // inactive: the spools are commanded neutral
   PumpResult pump_result;
   double load_alpha = 1.0;
   double supply_ceiling_pa = dynamics::supply_pressure_ceiling_pa(model.pump);
@@ -213,8 +214,19 @@ valves::BackendStatus SimBackend::read(valves::MachineState& state) {
 
 valves::BackendStatus SimBackend::write(const valves::ValveCommand& command) {
   if (command.spool.size() != impl_->model.dof()) return valves::BackendStatus::kFault;
+  if (!impl_->active) return valves::BackendStatus::kOk;  // held neutral until activate()
   impl_->spool_command = command.spool;
   return valves::BackendStatus::kOk;
+}
+
+bool SimBackend::activate(double, std::string*) {
+  impl_->active = true;
+  return true;
+}
+
+void SimBackend::safe_stop() noexcept {
+  impl_->active = false;
+  impl_->spool_command.setZero();
 }
 
 void SimBackend::advance(double dt_s) {

@@ -488,7 +488,17 @@ void CanBackend::send_heartbeat(std::int64_t now_us, std::int64_t now_rt_us) {
   ++hb.counter;  // the next one advances, whether or not this one went out
 }
 
-void CanBackend::disable() {
+bool CanBackend::activate(double timeout_s, std::string* why) {
+  valves::MachineState state;
+  if (!wait_for_feedback(timeout_s, state)) {
+    if (why != nullptr) *why = "no position feedback of every joint within the timeout";
+    return false;
+  }
+  enable();
+  return true;
+}
+
+void CanBackend::disable() noexcept {
   // The normal end of a run: every section to block now, and the heartbeat says disabled.
   enabled_.store(false, std::memory_order_release);
   Impl& m = *impl_;

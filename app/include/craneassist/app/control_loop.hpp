@@ -11,8 +11,8 @@
 // Stopping is uniform. A stop request (the caller's stop flag: a signal or the keyboard's q; or
 // a machine fault, BackendStatus::kFault) is handed to the task, which brings the machine to
 // rest (the controller's jerk-limited stop, then neutral valves); the loop keeps cycling until
-// the task reports kStopped, at most stop_settle_max_s, then ends. A run also ends after
-// max_cycles.
+// the task reports kStopped, at most stop_settle_max_s (then it calls the machine's safe_stop()),
+// and ends. A run also ends after max_cycles.
 //
 // The loop allocates nothing and throws nothing once running: the task's step() and the
 // observers' on_cycle() are noexcept and allocation-free (their contract), the log is a ring.
@@ -115,6 +115,9 @@ struct LoopSummary {
   // stopped as for a stop request (stop reason "machine fault").
   bool machine_fault = false;
   bool stop_requested = false;  // by the stop flag or a fault
+  // The task did not bring the machine to rest within stop_settle_max_s of the stop request:
+  // the loop called MachineInterface::safe_stop().
+  bool safe_stopped = false;
   std::size_t log_rows_dropped = 0;
 };
 

@@ -42,6 +42,9 @@ class SimBackend final : public valves::MachineInterface {
   valves::BackendStatus write(const valves::ValveCommand& command) override;
   void advance(double dt_s) override;
   const char* name() const override { return "sim"; }
+  // The simulator starts active. Inactive, its spools are commanded neutral whatever is written.
+  bool activate(double timeout_s, std::string* why) override;
+  void safe_stop() noexcept override;
 
   double time_s() const;
   // Cylinder forces of the last step (N, positive pushing the cylinder out).

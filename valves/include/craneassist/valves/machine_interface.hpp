@@ -1,7 +1,9 @@
 // The contract between the control loop and a machine, simulated or real (ros2_control's
-// hardware_interface is the model): read the measured state, write valve commands. The loop
-// never knows which backend it drives.
+// hardware_interface is the model): a lifecycle (activate, safe stop, deactivate), read the
+// measured state, write valve commands. No caller asks which backend it drives.
 #pragma once
+
+#include <string>
 
 #include "craneassist/dynamics/model.hpp"
 
@@ -54,6 +56,31 @@ class MachineInterface {
   // a bus backend sends at its own cycle and the valves hold the latest command in between. The
   // valve control must not rely on a single cycle's command then (ReferenceFollower).
   virtual double command_period_s() const { return 0.0; }
+  // True when the machine moves in real time whatever the loop does (a real machine): the loop
+  // must then be paced at its period. The simulator waits for advance().
+  virtual bool real_time() const { return false; }
+
+  // Lifecycle (ros2_control's activate/deactivate). While inactive every valve is held in its
+  // safe state (neutral, or blocked where the valve has that state) whatever is written. The
+  // simulator starts active; a bus machine starts inactive.
+  //
+  // Makes the machine ready to move: a bus machine waits up to timeout_s for every joint's
+  // feedback, then enables its valves (a deliberate enable also clears a latched fault). May
+  // block: call it before the loop. False, with the reason in *why, when it cannot.
+  virtual bool activate(double timeout_s, std::string* why) = 0;
+  // Every valve to its safe state now, and held there until activate(). For the control
+  // thread: non-blocking, allocation-free. The loop calls it when a stop cannot bring the crane
+  // to rest in time.
+  virtual void safe_stop() noexcept = 0;
+  // The normal end of a run, after the loop has brought the crane to rest: safe_stop(), then
+  // the backend's own threads end (a bus machine's watchdog, its traffic log). May block
+  // briefly.
+  virtual void deactivate() { safe_stop(); }
+  // Whether a fault has latched that only a deliberate activate() clears (a bus machine's lost
+  // feedback, bus-off), and its text for the operator ("" when none; not for the control
+  // thread).
+  virtual bool faulted() const { return false; }
+  virtual std::string fault_text() const { return {}; }
 };
 
 }  // namespace craneassist::valves

@@ -87,6 +87,15 @@ class CanBackend final : public valves::MachineInterface {
   const char* name() const override { return "can"; }
   // The slowest valve command cycle of the mapping (ISO 11783-7 AVC, or the current signal's).
   double command_period_s() const override;
+  bool real_time() const override { return true; }
+  // activate(): wait_for_feedback(), then enable(). safe_stop(): disable(). deactivate():
+  // disable(), then stop().
+  bool activate(double timeout_s, std::string* why) override;
+  void safe_stop() noexcept override { disable(); }
+  void deactivate() override {
+    disable();
+    stop();
+  }
 
   // Start-up (may block): reads until every joint's position has arrived, or the timeout.
   bool wait_for_feedback(double timeout_s, valves::MachineState& state);
@@ -94,12 +103,12 @@ class CanBackend final : public valves::MachineInterface {
   void enable();
   // The normal end of a run (control thread, non-blocking): sends block to every section at once
   // and a heartbeat in state disabled; further write()s send block until the next enable().
-  void disable();
+  void disable() noexcept;
   bool enabled() const { return enabled_.load(std::memory_order_acquire); }
-  bool faulted() const { return fault_.load(std::memory_order_acquire) == kLatched; }
+  bool faulted() const override { return fault_.load(std::memory_order_acquire) == kLatched; }
   FaultReason fault_reason() const { return reason_.load(std::memory_order_acquire); }
   // The reason text of the latched fault ("" when none); not for the control thread.
-  std::string fault_text() const;
+  std::string fault_text() const override;
   // Monotonic time (s since construction) when the fault latched, or NaN.
   double fault_time_s() const;
   CanBackendCounters counters() const;

@@ -1,0 +1,232 @@
+// The one control loop (app/control_loop.hpp) and the machine lifecycle: the loop runs its task
+// cycle by cycle on machine time, hands every cycle to the observers in order, ends a run on a
+// stop request only once the task reports the machine at rest, safe-stops the machine when that
+// takes too long, and treats a machine fault the same in a replay as in a live run.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "craneassist/app/control_loop.hpp"
+#include "craneassist/app/replay_runner.hpp"
+#include "craneassist/app/sim_setup.hpp"
+#include "craneassist/config/crane_config.hpp"
+#include "craneassist/input/replay.hpp"
+
+using namespace craneassist;
+
+namespace {
+
+// A machine that counts the calls of the loop; read() reports a fault from cycle fault_at on.
+class CountingMachine final : public valves::MachineInterface {
+ public:
+  explicit CountingMachine(long fault_at = -1) : fault_at_(fault_at) {}
+  valves::BackendStatus read(valves::MachineState& state) override {
+    ++reads;
+    state.valid = !(fault_at_ >= 0 && advances >= fault_at_);
+    return state.valid ? valves::BackendStatus::kOk : valves::BackendStatus::kFault;
+  }
+  valves::BackendStatus write(const valves::ValveCommand&) override {
+    ++writes;
+    return valves::BackendStatus::kOk;
+  }
+  void advance(double) override { ++advances; }
+  const char* name() const override { return "counting"; }
+  bool activate(double, std::string*) override { return true; }
+  void safe_stop() noexcept override { ++safe_stops; }
+  long reads = 0, writes = 0, advances = 0, safe_stops = 0;
+
+ private:
+  long fault_at_;
+};
+
+// The simulator whose measurement is lost for good (a latched fault) after `fault_at` cycles.
+class FaultingSim final : public valves::MachineInterface {
+ public:
+  FaultingSim(const config::CraneConfig& cfg, long fault_at)
+      : sim_(cfg.model, app::sim_settings(cfg)), fault_at_(fault_at) {}
+  valves::BackendStatus read(valves::MachineState& state) override {
+    sim_.read(state);
+    if (advances_ < fault_at_) return valves::BackendStatus::kOk;
+    state.valid = false;
+    return valves::BackendStatus::kFault;
+  }
+  valves::BackendStatus write(const valves::ValveCommand& c) override { return sim_.write(c); }
+  void advance(double dt_s) override {
+    ++advances_;
+    sim_.advance(dt_s);
+  }
+  const char* name() const override { return "faulting"; }
+  bool activate(double t, std::string* why) override { return sim_.activate(t, why); }
+  void safe_stop() noexcept override { sim_.safe_stop(); }
+
+ private:
+  sim_backend::SimBackend sim_;
+  long fault_at_;
+  long advances_ = 0;
+};
+
+// Reports kStopping for `stop_cycles` cycles after a stop request, then kStopped.
+class StoppingTask final : public app::CycleTask {
+ public:
+  explicit StoppingTask(long stop_cycles) : stop_cycles_(stop_cycles) {}
+  void start(const valves::MachineState&, double) override { ++starts; }
+  app::CycleStatus step(const app::CycleTime& time, const valves::MachineState&,
+                        const char* stop_cause, valves::ValveCommand&,
+                        app::LogRow& row) noexcept override {
+    row.t = time.t_s;
+    if (stop_cause == nullptr) return app::CycleStatus::kRunning;
+    cause = stop_cause;
+    if (stop_seen_at < 0) stop_seen_at = time.k;
+    return time.k - stop_seen_at >= stop_cycles_ ? app::CycleStatus::kStopped
+                                                 : app::CycleStatus::kStopping;
+  }
+  int starts = 0;
+  long stop_seen_at = -1;
+  std::string cause;
+
+ private:
+  long stop_cycles_;
+};
+
+class Recorder final : public app::CycleObserver {
+ public:
+  void on_cycle(const app::CycleRecord& c) noexcept override {
+    ks.push_back(c.time.k);
+    ts.push_back(c.row.t);
+  }
+  void on_finish(const app::CycleTime& last, const valves::MachineState&) override {
+    ++finishes;
+    last_k = last.k;
+  }
+  std::vector<long> ks;
+  std::vector<double> ts;
+  int finishes = 0;
+  long last_k = -1;
+};
+
+// Sets the stop flag at cycle `at`.
+class StopAt final : public app::CycleObserver {
+ public:
+  StopAt(std::atomic<bool>& flag, long at) : flag_(flag), at_(at) {}
+  void on_cycle(const app::CycleRecord& c) noexcept override {
+    if (c.time.k == at_) flag_.store(true);
+  }
+
+ private:
+  std::atomic<bool>& flag_;
+  long at_;
+};
+
+}  // namespace
+
+TEST(ControlLoop, RunsEveryCycleOnMachineTimeAndTellsEveryObserverInOrder) {
+  CountingMachine machine;
+  StoppingTask task(0);
+  Recorder recorder;
+  app::LoopOptions options;
+  options.period_s = 0.01;
+  options.t0_s = 2.0;
+  options.max_cycles = 50;
+  options.observers = {&recorder};
+  const auto s = app::run_control_loop(task, machine, options);
+  EXPECT_EQ(s.cycles, 50);
+  EXPECT_DOUBLE_EQ(s.duration_s, 0.5);
+  EXPECT_FALSE(s.stop_requested);
+  EXPECT_EQ(task.starts, 1);
+  EXPECT_EQ(machine.writes, 50);
+  EXPECT_EQ(machine.advances, 50);
+  EXPECT_EQ(machine.reads, 52) << "one before the start, one per cycle, one at the end";
+  ASSERT_EQ(recorder.ks.size(), 50u);
+  for (std::size_t k = 0; k < recorder.ks.size(); ++k) {
+    EXPECT_EQ(recorder.ks[k], static_cast<long>(k));
+    EXPECT_DOUBLE_EQ(recorder.ts[k], 2.0 + 0.01 * static_cast<double>(k));
+  }
+  EXPECT_EQ(recorder.finishes, 1);
+  EXPECT_EQ(recorder.last_k, 49);
+  EXPECT_EQ(machine.safe_stops, 0);
+}
+
+TEST(ControlLoop, AStopRequestEndsTheRunOnlyOnceTheTaskIsAtRest) {
+  CountingMachine machine;
+  StoppingTask task(30);  // 0.3 s to come to rest
+  std::atomic<bool> stop{false};
+  StopAt stopper(stop, 9);
+  app::LoopOptions options;
+  options.max_cycles = 1000;
+  options.stop = &stop;
+  options.stop_cause = "operator quit";
+  options.observers = {&stopper};
+  const auto s = app::run_control_loop(task, machine, options);
+  EXPECT_TRUE(s.stop_requested);
+  EXPECT_EQ(task.cause, "operator quit");
+  EXPECT_EQ(task.stop_seen_at, 10) << "the flag set in cycle 9 is read at the start of cycle 10";
+  EXPECT_EQ(s.cycles, 41) << "cycles 10..40 stopping, 40 reports kStopped";
+  EXPECT_FALSE(s.safe_stopped);
+  EXPECT_EQ(machine.safe_stops, 0);
+}
+
+TEST(ControlLoop, AStopThatTakesTooLongSafeStopsTheMachine) {
+  CountingMachine machine;
+  StoppingTask task(100000);  // never at rest
+  std::atomic<bool> stop{true};
+  app::LoopOptions options;
+  options.max_cycles = 100000;
+  options.stop = &stop;
+  options.stop_settle_max_s = 0.5;
+  const auto s = app::run_control_loop(task, machine, options);
+  EXPECT_TRUE(s.safe_stopped);
+  EXPECT_EQ(machine.safe_stops, 1);
+  EXPECT_EQ(s.cycles, 51);
+}
+
+TEST(ControlLoop, AMachineFaultIsAStopRequestWithItsReason) {
+  CountingMachine machine(20);
+  StoppingTask task(5);
+  app::LoopOptions options;
+  options.max_cycles = 1000;
+  const auto s = app::run_control_loop(task, machine, options);
+  EXPECT_TRUE(s.machine_fault);
+  EXPECT_TRUE(s.stop_requested);
+  EXPECT_EQ(task.cause, "machine fault");
+  EXPECT_EQ(s.cycles, 26);
+}
+
+// A replay on a machine that faults stops as a live run does: the controller's stop, then the
+// end of the run (the replay used to run on to its end, ignoring the fault).
+TEST(ControlLoop, AReplayStopsOnAMachineFaultAsALiveRunDoes) {
+  const auto cfg = config::default_crane_config();
+  const auto replay = input::Replay::parse("t,v_x,v_y,v_z\n0,0.4,0,0\n10,0.4,0,0\n", "fault.csv");
+  FaultingSim machine(cfg, 150);
+  app::RunOptions options;
+  const auto s = app::run_replay(cfg, replay, machine, options, nullptr);
+  EXPECT_TRUE(s.machine_fault);
+  EXPECT_GT(s.cycles, 150);
+  EXPECT_LT(s.cycles, 400) << "the 11 s replay ended soon after the fault";
+  EXPECT_GT(s.neutral_valve_cycles, 0);
+}
+
+TEST(MachineLifecycle, ASafeStoppedSimulatorHoldsItsValvesNeutralUntilActivated) {
+  const auto cfg = config::default_crane_config();
+  sim_backend::SimBackend sim(cfg.model, app::sim_settings(cfg));
+  valves::ValveCommand open;
+  open.spool = dynamics::JointVector::Constant(cfg.model.dof(), 0.0);
+  open.spool[0] = 0.8;  // slew
+  valves::MachineState state;
+  const auto run = [&](int cycles) {
+    for (int k = 0; k < cycles; ++k) {
+      sim.write(open);
+      sim.advance(0.01);
+    }
+    sim.read(state);
+    return std::abs(state.qdot[0]);
+  };
+  EXPECT_GT(run(100), 0.05) << "active from the start: the slew moves";
+  sim.safe_stop();
+  EXPECT_LT(run(150), 1e-3) << "safe-stopped: written commands are ignored";
+  std::string why;
+  ASSERT_TRUE(sim.activate(0.0, &why));
+  EXPECT_GT(run(100), 0.05) << "activated again";
+}
