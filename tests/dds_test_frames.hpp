@@ -60,6 +60,9 @@ inline dds::TelemetryFrame test_frame(std::uint64_t cycle) {
   f.pump_limit = "none";
   f.input_source = "replay";
   f.deadman = true;
+  f.loop_latency_max_s = 120e-6;
+  f.loop_compute_s = 40e-6;
+  f.loop_overruns = 2;
   return f;
 }
 

@@ -3,6 +3,8 @@
 // stop request only once the task reports the machine at rest, safe-stops the machine when that
 // takes too long, and treats a machine fault the same in a replay as in a live run.
 #include <gtest/gtest.h>
+#include <pthread.h>
+#include <sched.h>
 
 #include <atomic>
 #include <cmath>
@@ -229,4 +231,64 @@ TEST(MachineLifecycle, ASafeStoppedSimulatorHoldsItsValvesNeutralUntilActivated)
   std::string why;
   ASSERT_TRUE(sim.activate(0.0, &why));
   EXPECT_GT(run(100), 0.05) << "activated again";
+}
+
+TEST(CycleTiming, HistogramQuantilesAndExtremes) {
+  app::DurationHistogram h;
+  for (int i = 1; i <= 100; ++i) h.add(i * 1e-6 * 10.0);  // 10 us .. 1 ms
+  h.add(0.5);                                             // beyond the last bin
+  EXPECT_EQ(h.count(), 101);
+  EXPECT_DOUBLE_EQ(h.min_s(), 10e-6);
+  EXPECT_DOUBLE_EQ(h.max_s(), 0.5);
+  // The upper edge of the 10 us bin that holds the quantile.
+  EXPECT_NEAR(h.quantile_s(0.5), 0.52e-3, 1e-9);
+  EXPECT_NEAR(h.quantile_s(0.99), 1.01e-3, 1e-9);
+  EXPECT_DOUBLE_EQ(h.quantile_s(1.0), 0.5);
+  h.add(std::nan(""));  // counted as 0, never a crash
+  EXPECT_DOUBLE_EQ(h.min_s(), 0.0);
+}
+
+TEST(CycleTiming, APacedLoopMeasuresItsStartLatencyAndComputeTime) {
+  CountingMachine machine;
+  StoppingTask task(0);
+  app::LoopOptions options;
+  options.period_s = 0.002;
+  options.max_cycles = 50;
+  options.realtime = true;
+  const auto s = app::run_control_loop(task, machine, options);
+  EXPECT_EQ(s.timing.start_latency.count(), 50);
+  EXPECT_EQ(s.timing.compute.count(), 50);
+  EXPECT_GE(s.timing.start_latency.min_s(), 0.0);
+  EXPECT_DOUBLE_EQ(s.max_late_s, s.timing.start_latency.max_s());
+  EXPECT_GE(s.wall_time_s, 49 * 0.002) << "paced: 50 cycles take at least 49 periods";
+  EXPECT_NE(app::describe(s.timing).find("overruns in 50 cycles"), std::string::npos);
+}
+
+// The system may refuse SCHED_FIFO or the memory lock (a container, no CAP_SYS_NICE): the loop
+// runs anyway and says why; whatever was granted is undone at the end.
+TEST(CycleTiming, RealTimeSetUpIsGrantedOrRefusedWithAReason) {
+  CountingMachine machine;
+  StoppingTask task(0);
+  app::LoopOptions options;
+  options.max_cycles = 5;
+  options.realtime_setup.lock_memory = true;
+  options.realtime_setup.priority = 80;
+  options.realtime_setup.cpu = 0;
+  const auto s = app::run_control_loop(task, machine, options);
+  EXPECT_EQ(s.cycles, 5);
+  const auto& r = s.realtime_result;
+  if (!r.memory_locked) {
+    EXPECT_NE(r.refused.find("memory lock refused"), std::string::npos);
+  }
+  if (r.priority == 0) {
+    EXPECT_NE(r.refused.find("SCHED_FIFO priority 80 refused"), std::string::npos);
+  }
+  if (r.cpu < 0) {
+    EXPECT_NE(r.refused.find("core 0"), std::string::npos);
+  }
+  EXPECT_EQ(r.refused.empty(), r.memory_locked && r.priority == 80 && r.cpu == 0);
+  int policy = -1;
+  sched_param param{};
+  pthread_getschedparam(pthread_self(), &policy, &param);
+  EXPECT_EQ(policy, SCHED_OTHER) << "the priority is given back after the run";
 }

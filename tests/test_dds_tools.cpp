@@ -347,6 +347,8 @@ void expect_test_frame_snapshot(const std::string& out) {
         "limit     power",
         "pump limiter  none",
         "scale     0.80",
+        "loop      worst start 120 us",
+        "overruns      2",
         "power     [###########...................]   12.5 /   35.0 kW      36 %",
         "flow      [###############...............]   60.0 /  120.0 L/min   50 %",
         "pressure 12.5 MPa",

@@ -236,6 +236,9 @@ cdds::TelemetryFrame frame(std::uint64_t k) {
   f.pump_limit = "none";
   f.input_source = "keyboard";
   f.deadman = true;
+  f.loop_latency_max_s = 120e-6;
+  f.loop_compute_s = 40e-6;
+  f.loop_overruns = 2;
   return f;
 }
 
@@ -269,6 +272,9 @@ TEST(Telemetry, EveryTopicRoundTripsEveryField) {
   EXPECT_EQ(s.scale(), 0.5);
   EXPECT_DOUBLE_EQ(s.tip_speed_m_s(), 0.5);
   EXPECT_EQ(s.tip_error_m(), 0.004);
+  EXPECT_EQ(s.loop_latency_max_s(), 120e-6);
+  EXPECT_EQ(s.loop_compute_s(), 40e-6);
+  EXPECT_EQ(s.loop_overruns(), 2u);
 
   const auto j = sub.joints.samples().front();
   EXPECT_EQ(j.header().cycle(), 0u);

@@ -90,6 +90,7 @@ LiveSummary run_live(const config::CraneConfig& config, input::CommandSource& so
                         ? static_cast<long>(std::ceil(options.duration_s / period - 1e-9))
                         : std::numeric_limits<long>::max();
   loop.realtime = options.realtime;
+  loop.realtime_setup = options.realtime_setup;
   loop.stop = options.stop;
   loop.stop_settle_max_s = options.stop_settle_max_s;
   loop.log = log;
@@ -121,6 +122,8 @@ LiveSummary run_live(const config::CraneConfig& config, input::CommandSource& so
   summary.log_rows_dropped = ran.log_rows_dropped;
   summary.record_rows_dropped = recording ? recording->dropped() : 0;
   summary.machine_fault = ran.machine_fault;
+  summary.realtime_result = ran.realtime_result;
+  summary.timing = ran.timing;
   return summary;
 }
 

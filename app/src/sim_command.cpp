@@ -152,6 +152,14 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
                   "Record the command the controller got, in the replay format");
   sim->add_flag("--no-realtime", args.no_realtime,
                 "--input replay only: run as fast as possible on machine time");
+  sim->add_flag("--rt", args.rt,
+                "Real-time loop thread: lock memory and SCHED_FIFO priority 80 (docs/realtime.md)");
+  sim->add_flag("--lock-memory", args.lock_memory, "Lock the process's memory (mlockall)");
+  sim->add_option("--rt-priority", args.rt_priority,
+                  "SCHED_FIFO priority of the loop thread, 1..99 (0: the normal scheduler)")
+      ->check(CLI::Range(0, 99));
+  sim->add_option("--cpu", args.cpu, "Pin the loop thread to this core")
+      ->check(CLI::Range(0, 1023));
   sim->add_option("--payload", args.payload_kg, "Payload mass in the grapple, kg")
       ->check(CLI::Range(0.0, 100000.0));
   sim->add_option("--initial", args.initial,
@@ -290,6 +298,9 @@ int run_sim_command(const SimArgs& args) {
                                                : 0.0;
     options.stop = &g_stop;
     options.status_board = &board;
+    options.realtime_setup.lock_memory = args.rt || args.lock_memory;
+    options.realtime_setup.priority = args.rt_priority > 0 ? args.rt_priority : args.rt ? 80 : 0;
+    options.realtime_setup.cpu = args.cpu;
     if (app::CycleObserver* o = telemetry.observer()) options.observers.push_back(o);
     if (!args.record_file.empty()) {
       options.record = &record;
@@ -337,6 +348,16 @@ int run_sim_command(const SimArgs& args) {
                 s.duration_s, s.wall_time_s, s.cycles, s.max_late_s * 1e3);
     std::printf("  tip: path %.2f m, peak speed %.2f m/s; operator command passed in %d cycles\n",
                 s.tip_path_m, s.peak_tip_speed_m_s, s.enabled_cycles);
+    std::printf("  cycle timing: %s\n", app::describe(s.timing).c_str());
+    if (options.realtime_setup.lock_memory || options.realtime_setup.priority > 0 ||
+        options.realtime_setup.cpu >= 0) {
+      const app::RealtimeResult& r = s.realtime_result;
+      std::printf("  real time: memory %s, %s, %s\n", r.memory_locked ? "locked" : "not locked",
+                  r.priority > 0 ? ("SCHED_FIFO " + std::to_string(r.priority)).c_str()
+                                 : "normal scheduler",
+                  r.cpu >= 0 ? ("core " + std::to_string(r.cpu)).c_str() : "any core");
+      if (!r.refused.empty()) spdlog::warn("real time: {}", r.refused);
+    }
     std::printf("  input device: %d disconnects, %d re-attaches\n", s.disconnects, s.reconnects);
     if (remote_stats) {
       const dds::CommandInputStats& d = *remote_stats;

@@ -23,6 +23,10 @@ struct SimArgs {
   std::string log_file;            // empty: no log
   std::string record_file;         // empty: no recording
   bool no_realtime = false;        // --input replay only: as fast as possible
+  bool rt = false;                 // --rt: lock memory and SCHED_FIFO priority 80
+  bool lock_memory = false;        // --lock-memory
+  int rt_priority = 0;             // --rt-priority N (SCHED_FIFO); 0: none
+  int cpu = -1;                    // --cpu N: pin the loop thread; -1: none
   std::optional<double> payload_kg;
   std::string resolution;  // empty: the config's
   std::string initial;     // start pose "NAME=VALUE UNIT, ..." (sim backend); empty: the config's

@@ -42,6 +42,9 @@ void to_frame(const LogRow& row, int dof, dds::TelemetryFrame& f) noexcept {
   f.pump_limit = row.pump_limit;
   f.input_source = row.input_source;
   f.deadman = row.deadman;
+  f.loop_latency_max_s = row.loop_latency_max_s;
+  f.loop_compute_s = row.loop_compute_s;
+  f.loop_overruns = static_cast<std::uint64_t>(row.loop_overruns);
 }
 
 void TelemetryObserver::on_cycle(const CycleRecord& cycle) noexcept {

@@ -208,6 +208,10 @@ std::vector<std::string> render(const Snapshot& s, const DashboardOptions& o, st
                        : st ? fmt("%.2f", s.status.scale())
                             : "-",
                        "path speed", cp ? fmt("%.3f 1/s", s.command_path.sdot()) : "-"));
+  lines.push_back(
+      pair("loop", st ? fmt("worst start %.0f us", s.status.loop_latency_max_s() * 1e6) : "-",
+           "overruns",
+           st ? fmt("%llu", static_cast<unsigned long long>(s.status.loop_overruns())) : "-"));
   lines.push_back("");
 
   // The pump against its limits (hydraulics topic).

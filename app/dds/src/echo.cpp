@@ -63,6 +63,9 @@ void describe(const msg::Status& m, FieldVisitor& v) {
   v.number("scale", m.scale(), "");
   v.number("tip_speed_m_s", m.tip_speed_m_s(), "m/s");
   v.number("tip_error_m", m.tip_error_m(), "m");
+  v.number("loop_latency_max_s", m.loop_latency_max_s(), "s");
+  v.number("loop_compute_s", m.loop_compute_s(), "s");
+  v.number("loop_overruns", static_cast<double>(m.loop_overruns()), "");
 }
 
 void describe(const msg::JointState& m, FieldVisitor& v) {

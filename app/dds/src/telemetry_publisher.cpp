@@ -173,6 +173,9 @@ struct TelemetryPublisher::Impl {
                                    f.tip_v_m_s[1] * f.tip_v_m_s[1] +
                                    f.tip_v_m_s[2] * f.tip_v_m_s[2]));
     status.tip_error_m(f.tip_error_m);
+    status.loop_latency_max_s(f.loop_latency_max_s);
+    status.loop_compute_s(f.loop_compute_s);
+    status.loop_overruns(f.loop_overruns);
     return writers[0]->write(&status);
   }
 

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "craneassist/app/csv_log.hpp"
+#include "craneassist/app/cycle_timing.hpp"
 #include "craneassist/valves/machine_interface.hpp"
 
 namespace craneassist::app {
@@ -91,9 +92,12 @@ struct LoopOptions {
   double t0_s = 0.0;  // machine time of cycle 0
   // Cycles to run at most; a stop request may end the run earlier.
   long max_cycles = 0;
-  // true: paced at the period by steady_clock (CLOCK_MONOTONIC), the input clock is
-  // steady_clock; false: as fast as possible, the input clock is machine time.
+  // true: paced at the period on CLOCK_MONOTONIC (absolute clock_nanosleep, as cyclictest), the
+  // input clock is steady_clock; false: as fast as possible, the input clock is machine time.
   bool realtime = false;
+  // Memory lock, SCHED_FIFO priority and core of the loop thread for the run (cycle_timing.hpp);
+  // applied before the first cycle and undone after the last.
+  RealtimeSetup realtime_setup;
   const std::atomic<bool>* stop = nullptr;  // set by a signal handler or the keyboard's q
   const char* stop_cause = "operator quit";
   // After a stop request, run until the task reports kStopped, at most this long.
@@ -108,9 +112,11 @@ struct LoopOptions {
 
 struct LoopSummary {
   long cycles = 0;
-  double duration_s = 0.0;   // machine time
-  double wall_time_s = 0.0;  // computer time
-  double max_late_s = 0.0;   // realtime: the latest a cycle started after its tick
+  double duration_s = 0.0;         // machine time
+  double wall_time_s = 0.0;        // computer time
+  double max_late_s = 0.0;         // realtime: the latest a cycle started after its tick
+  RealtimeResult realtime_result;  // what the system granted of LoopOptions::realtime_setup
+  CycleTiming timing;              // start latency (paced runs), compute time, overruns
   // The machine reported a fault (BackendStatus::kFault, e.g. a latched CAN fault): the loop
   // stopped as for a stop request (stop reason "machine fault").
   bool machine_fault = false;

@@ -39,6 +39,10 @@ struct LogRow {
   const char* stop_reason = "";  // why the loop stops or holds ("" while running)
   const char* input_source = "";
   bool deadman = false;
+  // Cycle timing (the control loop fills them, cycle_timing.hpp): the worst start latency of the
+  // run so far (0 when not paced), the previous cycle's compute time, the overruns so far.
+  double loop_latency_max_s = 0.0, loop_compute_s = 0.0;
+  long loop_overruns = 0;
 
   // The pump columns from a measurement.
   void set_pump(const valves::PumpMeasurement& pump) {

@@ -60,6 +60,8 @@ struct LiveOptions {
   // true: paced at the control rate, the monitor's clock is steady_clock (device sources);
   // false: as fast as possible, the clock is machine time (scripted sources and tests only).
   bool realtime = true;
+  // Memory lock, SCHED_FIFO priority and core of the loop thread (realtime runs).
+  RealtimeSetup realtime_setup;
   double duration_s = 0.0;                  // machine time to run; 0: until *stop is set
   const std::atomic<bool>* stop = nullptr;  // set by a signal handler or the keyboard's q
   // After a stop request (or a machine fault), keep running with a non-finite command (the
@@ -88,6 +90,8 @@ struct LiveSummary {
   // The machine reported a fault (BackendStatus::kFault, e.g. a latched CAN fault): the loop
   // stopped as for a stop request (stop reason "machine fault").
   bool machine_fault = false;
+  RealtimeResult realtime_result;  // what the system granted of LiveOptions::realtime_setup
+  CycleTiming timing;              // start latency, compute time, overruns (cycle_timing.hpp)
 };
 
 // The clock of device sources' stamps (input/command_source.hpp).

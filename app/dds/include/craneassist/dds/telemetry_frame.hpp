@@ -32,6 +32,9 @@ struct TelemetryFrame {
   const char* pump_limit = "";
   const char* input_source = "";
   bool deadman = false;
+  // Cycle timing: the worst start latency so far, the last compute time, overruns so far.
+  double loop_latency_max_s = 0.0, loop_compute_s = 0.0;
+  std::uint64_t loop_overruns = 0;
 };
 static_assert(std::is_trivially_copyable_v<TelemetryFrame>);
 
