@@ -7,6 +7,7 @@ cd "$(dirname "$0")/.."
 tools/install-deps.sh
 tools/can-vm/prepare.sh  # Debian's stock kernel with CAN for the VM tests (cached in build/)
 jobs="$(nproc)"
+export CRANEASSIST_CAN_VM_REQUIRED=1  # here the VM tests must run, never be skipped
 
 echo "== formatting (clang-format)"
 find app bench config dynamics input scaling sim_backend tests valves \( -name '*.cpp' -o -name '*.hpp' \) \
