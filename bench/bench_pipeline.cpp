@@ -2,8 +2,8 @@
 //   build/bench/bench_pipeline --benchmark_repetitions=5 --benchmark_report_aggregates_only
 #include <benchmark/benchmark.h>
 
-#include "craneassist/app/controller.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/control/controller.hpp"
 #include "craneassist/dynamics/rigid_body_terms.hpp"
 #include "craneassist/scaling/tip_path.hpp"
 #include "craneassist/scaling/tip_scaler.hpp"
@@ -38,7 +38,7 @@ BENCHMARK(BM_SimulatorControlPeriod)->Unit(benchmark::kMicrosecond);
 // every 3 s of motion so that it measures motion, not a crane come to rest at a workspace end.
 void BM_ControllerUpdate(benchmark::State& state) {
   const auto cfg = config::default_crane_config();
-  app::Controller controller(cfg, {});
+  control::Controller controller(cfg, {});
   valves::MachineState start;
   start.q = cfg.simulation.q_initial;
   start.qdot = dynamics::JointVector::Zero(4);
@@ -46,7 +46,7 @@ void BM_ControllerUpdate(benchmark::State& state) {
   start.valid = true;
   valves::MachineState s = start;
   controller.reset(s);
-  app::ControllerOutput out;
+  control::ControllerOutput out;
   const Eigen::Vector3d v(0.3, 0.2, 0.4);
   int k = 0;
   for (auto _ : state) {
@@ -67,14 +67,14 @@ BENCHMARK(BM_ControllerUpdate)->Unit(benchmark::kMicrosecond);
 // damps the ends and holds the reference at rest): the busiest case of the end handling.
 void BM_ControllerUpdateAtWorkspaceEnd(benchmark::State& state) {
   const auto cfg = config::default_crane_config();
-  app::Controller controller(cfg, {});
+  control::Controller controller(cfg, {});
   valves::MachineState s;
   s.q = cfg.simulation.q_initial;
   s.qdot = dynamics::JointVector::Zero(4);
   s.load_pressure_pa = dynamics::JointVector::Zero(4);
   s.valid = true;
   controller.reset(s);
-  app::ControllerOutput out;
+  control::ControllerOutput out;
   const Eigen::Vector3d v(0.3, 0.2, 0.4);
   for (int k = 0; k < 3000; ++k) {  // 30 s: far enough to meet the end
     controller.update(s, v, out);

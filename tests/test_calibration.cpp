@@ -7,11 +7,11 @@
 #include <fstream>
 #include <string>
 
-#include "craneassist/app/calibration.hpp"
-#include "craneassist/app/replay_runner.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/control/replay_runner.hpp"
 #include "craneassist/dynamics/valve_table.hpp"
 #include "craneassist/input/replay.hpp"
+#include "craneassist/offline/calibration.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
 #include "craneassist/valves/proportional_valves.hpp"
 
@@ -27,12 +27,12 @@ std::string read_file(const std::string& path) {
 }
 
 // Calibrated once for the whole file (about a second of simulation).
-const std::vector<app::SectionCalibration>& k70m_calibration() {
-  static const std::vector<app::SectionCalibration> results = [] {
+const std::vector<offline::SectionCalibration>& k70m_calibration() {
+  static const std::vector<offline::SectionCalibration> results = [] {
     const auto cfg = config::default_crane_config();
-    std::vector<app::SectionCalibration> r;
+    std::vector<offline::SectionCalibration> r;
     for (int i = 0; i < cfg.model.dof(); ++i) {
-      r.push_back(app::calibrate_section(cfg, i, app::CalibrationOptions{}));
+      r.push_back(offline::calibrate_section(cfg, i, offline::CalibrationOptions{}));
     }
     return r;
   }();
@@ -70,7 +70,7 @@ TEST(Calibration, ReproducesTheSimulatedDeadZoneAndTopSpeeds) {
 
 TEST(Calibration, FitIsMonotoneAndFindsTheDeadBandEdge) {
   // A noisy sweep: the 0.9 level reads below 0.8 (a violation), the dead band ends at 0.52.
-  std::vector<app::SweepPoint> points;
+  std::vector<offline::SweepPoint> points;
   auto line = [](double u) { return std::copysign(std::max(std::abs(u) - 0.52, 0.0) * 0.5, u); };
   for (double u : {-1.0, -0.8, -0.7, -0.6, -0.5, -0.3, 0.0, 0.3, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0}) {
     points.push_back({u, line(u), true});
@@ -78,7 +78,7 @@ TEST(Calibration, FitIsMonotoneAndFindsTheDeadBandEdge) {
   points[12].velocity_m_s = 0.13;  // 0.9: true 0.19, reads below 0.8's 0.14
   points[4].velocity_m_s = 1e-6;   // drift in the dead band
   points[13].valid = false;        // 1.0 hit the end stop: not used
-  const auto t = app::fit_valve_table(points, 1e-4);
+  const auto t = offline::fit_valve_table(points, 1e-4);
   ASSERT_EQ(dynamics::check_valve_table(t), "") << t.command.size();
   EXPECT_NEAR(dynamics::valve_table_dead_band_edge(t, 1.0), 0.52, 1e-12);
   EXPECT_NEAR(dynamics::valve_table_dead_band_edge(t, -1.0), -0.52, 1e-12);
@@ -92,7 +92,7 @@ TEST(Calibration, FitIsMonotoneAndFindsTheDeadBandEdge) {
 TEST(Calibration, YamlBlockLoadsIntoTheConfig) {
   const auto cfg = config::default_crane_config();
   const std::string block =
-      app::valve_tables_yaml(cfg.model, k70m_calibration(), "craneassist calibrate: test");
+      offline::valve_tables_yaml(cfg.model, k70m_calibration(), "craneassist calibrate: test");
   std::string text = read_file(kSource + "/config/cranes/k70m.yaml");
   const std::string anchor = "    delay: 0.15 s, paper";
   const auto eol = text.find('\n', text.find(anchor));
@@ -115,7 +115,7 @@ TEST(Calibration, CalibratedTablesTrackLikeTheStraightLine) {
   const auto replay = input::Replay::load_file(kSource + "/examples/replays/demo.csv");
   auto run = [&](const config::CraneConfig& cfg) {
     sim_backend::SimBackend machine(cfg.model, {cfg.simulation.step_s, cfg.simulation.q_initial});
-    return app::run_replay(cfg, replay, machine, app::RunOptions{}, nullptr);
+    return control::run_replay(cfg, replay, machine, control::RunOptions{}, nullptr);
   };
   const auto plain_cfg = config::default_crane_config();
   auto table_cfg = plain_cfg;

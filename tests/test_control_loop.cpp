@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "craneassist/app/control_loop.hpp"
-#include "craneassist/app/replay_runner.hpp"
-#include "craneassist/app/sim_setup.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/control/control_loop.hpp"
+#include "craneassist/control/replay_runner.hpp"
 #include "craneassist/input/replay.hpp"
+#include "craneassist/offline/sim_setup.hpp"
 
 using namespace craneassist;
 
@@ -48,7 +48,7 @@ class CountingMachine final : public valves::MachineInterface {
 class FaultingSim final : public valves::MachineInterface {
  public:
   FaultingSim(const config::CraneConfig& cfg, long fault_at)
-      : sim_(cfg.model, app::sim_settings(cfg)), fault_at_(fault_at) {}
+      : sim_(cfg.model, offline::sim_settings(cfg)), fault_at_(fault_at) {}
   valves::BackendStatus read(valves::MachineState& state) override {
     sim_.read(state);
     if (advances_ < fault_at_) return valves::BackendStatus::kOk;
@@ -71,19 +71,19 @@ class FaultingSim final : public valves::MachineInterface {
 };
 
 // Reports kStopping for `stop_cycles` cycles after a stop request, then kStopped.
-class StoppingTask final : public app::CycleTask {
+class StoppingTask final : public control::CycleTask {
  public:
   explicit StoppingTask(long stop_cycles) : stop_cycles_(stop_cycles) {}
   void start(const valves::MachineState&, double) override { ++starts; }
-  app::CycleStatus step(const app::CycleTime& time, const valves::MachineState&,
-                        const char* stop_cause, valves::ValveCommand&,
-                        app::LogRow& row) noexcept override {
+  control::CycleStatus step(const control::CycleTime& time, const valves::MachineState&,
+                            const char* stop_cause, valves::ValveCommand&,
+                            control::LogRow& row) noexcept override {
     row.t = time.t_s;
-    if (stop_cause == nullptr) return app::CycleStatus::kRunning;
+    if (stop_cause == nullptr) return control::CycleStatus::kRunning;
     cause = stop_cause;
     if (stop_seen_at < 0) stop_seen_at = time.k;
-    return time.k - stop_seen_at >= stop_cycles_ ? app::CycleStatus::kStopped
-                                                 : app::CycleStatus::kStopping;
+    return time.k - stop_seen_at >= stop_cycles_ ? control::CycleStatus::kStopped
+                                                 : control::CycleStatus::kStopping;
   }
   int starts = 0;
   long stop_seen_at = -1;
@@ -93,13 +93,13 @@ class StoppingTask final : public app::CycleTask {
   long stop_cycles_;
 };
 
-class Recorder final : public app::CycleObserver {
+class Recorder final : public control::CycleObserver {
  public:
-  void on_cycle(const app::CycleRecord& c) noexcept override {
+  void on_cycle(const control::CycleRecord& c) noexcept override {
     ks.push_back(c.time.k);
     ts.push_back(c.row.t);
   }
-  void on_finish(const app::CycleTime& last, const valves::MachineState&) override {
+  void on_finish(const control::CycleTime& last, const valves::MachineState&) override {
     ++finishes;
     last_k = last.k;
   }
@@ -110,10 +110,10 @@ class Recorder final : public app::CycleObserver {
 };
 
 // Sets the stop flag at cycle `at`.
-class StopAt final : public app::CycleObserver {
+class StopAt final : public control::CycleObserver {
  public:
   StopAt(std::atomic<bool>& flag, long at) : flag_(flag), at_(at) {}
-  void on_cycle(const app::CycleRecord& c) noexcept override {
+  void on_cycle(const control::CycleRecord& c) noexcept override {
     if (c.time.k == at_) flag_.store(true);
   }
 
@@ -128,12 +128,12 @@ TEST(ControlLoop, RunsEveryCycleOnMachineTimeAndTellsEveryObserverInOrder) {
   CountingMachine machine;
   StoppingTask task(0);
   Recorder recorder;
-  app::LoopOptions options;
+  control::LoopOptions options;
   options.period_s = 0.01;
   options.t0_s = 2.0;
   options.max_cycles = 50;
   options.observers = {&recorder};
-  const auto s = app::run_control_loop(task, machine, options);
+  const auto s = control::run_control_loop(task, machine, options);
   EXPECT_EQ(s.cycles, 50);
   EXPECT_DOUBLE_EQ(s.duration_s, 0.5);
   EXPECT_FALSE(s.stop_requested);
@@ -156,12 +156,12 @@ TEST(ControlLoop, AStopRequestEndsTheRunOnlyOnceTheTaskIsAtRest) {
   StoppingTask task(30);  // 0.3 s to come to rest
   std::atomic<bool> stop{false};
   StopAt stopper(stop, 9);
-  app::LoopOptions options;
+  control::LoopOptions options;
   options.max_cycles = 1000;
   options.stop = &stop;
   options.stop_cause = "operator quit";
   options.observers = {&stopper};
-  const auto s = app::run_control_loop(task, machine, options);
+  const auto s = control::run_control_loop(task, machine, options);
   EXPECT_TRUE(s.stop_requested);
   EXPECT_EQ(task.cause, "operator quit");
   EXPECT_EQ(task.stop_seen_at, 10) << "the flag set in cycle 9 is read at the start of cycle 10";
@@ -174,11 +174,11 @@ TEST(ControlLoop, AStopThatTakesTooLongSafeStopsTheMachine) {
   CountingMachine machine;
   StoppingTask task(100000);  // never at rest
   std::atomic<bool> stop{true};
-  app::LoopOptions options;
+  control::LoopOptions options;
   options.max_cycles = 100000;
   options.stop = &stop;
   options.stop_settle_max_s = 0.5;
-  const auto s = app::run_control_loop(task, machine, options);
+  const auto s = control::run_control_loop(task, machine, options);
   EXPECT_TRUE(s.safe_stopped);
   EXPECT_EQ(machine.safe_stops, 1);
   EXPECT_EQ(s.cycles, 51);
@@ -187,9 +187,9 @@ TEST(ControlLoop, AStopThatTakesTooLongSafeStopsTheMachine) {
 TEST(ControlLoop, AMachineFaultIsAStopRequestWithItsReason) {
   CountingMachine machine(20);
   StoppingTask task(5);
-  app::LoopOptions options;
+  control::LoopOptions options;
   options.max_cycles = 1000;
-  const auto s = app::run_control_loop(task, machine, options);
+  const auto s = control::run_control_loop(task, machine, options);
   EXPECT_TRUE(s.machine_fault);
   EXPECT_TRUE(s.stop_requested);
   EXPECT_EQ(task.cause, "machine fault");
@@ -202,8 +202,8 @@ TEST(ControlLoop, AReplayStopsOnAMachineFaultAsALiveRunDoes) {
   const auto cfg = config::default_crane_config();
   const auto replay = input::Replay::parse("t,v_x,v_y,v_z\n0,0.4,0,0\n10,0.4,0,0\n", "fault.csv");
   FaultingSim machine(cfg, 150);
-  app::RunOptions options;
-  const auto s = app::run_replay(cfg, replay, machine, options, nullptr);
+  control::RunOptions options;
+  const auto s = control::run_replay(cfg, replay, machine, options, nullptr);
   EXPECT_TRUE(s.machine_fault);
   EXPECT_GT(s.cycles, 150);
   EXPECT_LT(s.cycles, 400) << "the 11 s replay ended soon after the fault";
@@ -212,7 +212,7 @@ TEST(ControlLoop, AReplayStopsOnAMachineFaultAsALiveRunDoes) {
 
 TEST(MachineLifecycle, ASafeStoppedSimulatorHoldsItsValvesNeutralUntilActivated) {
   const auto cfg = config::default_crane_config();
-  sim_backend::SimBackend sim(cfg.model, app::sim_settings(cfg));
+  sim_backend::SimBackend sim(cfg.model, offline::sim_settings(cfg));
   valves::ValveCommand open;
   open.spool = dynamics::JointVector::Constant(cfg.model.dof(), 0.0);
   open.spool[0] = 0.8;  // slew
@@ -234,7 +234,7 @@ TEST(MachineLifecycle, ASafeStoppedSimulatorHoldsItsValvesNeutralUntilActivated)
 }
 
 TEST(CycleTiming, HistogramQuantilesAndExtremes) {
-  app::DurationHistogram h;
+  control::DurationHistogram h;
   for (int i = 1; i <= 100; ++i) h.add(i * 1e-6 * 10.0);  // 10 us .. 1 ms
   h.add(0.5);                                             // beyond the last bin
   EXPECT_EQ(h.count(), 101);
@@ -251,17 +251,17 @@ TEST(CycleTiming, HistogramQuantilesAndExtremes) {
 TEST(CycleTiming, APacedLoopMeasuresItsStartLatencyAndComputeTime) {
   CountingMachine machine;
   StoppingTask task(0);
-  app::LoopOptions options;
+  control::LoopOptions options;
   options.period_s = 0.002;
   options.max_cycles = 50;
   options.realtime = true;
-  const auto s = app::run_control_loop(task, machine, options);
+  const auto s = control::run_control_loop(task, machine, options);
   EXPECT_EQ(s.timing.start_latency.count(), 50);
   EXPECT_EQ(s.timing.compute.count(), 50);
   EXPECT_GE(s.timing.start_latency.min_s(), 0.0);
   EXPECT_DOUBLE_EQ(s.max_late_s, s.timing.start_latency.max_s());
   EXPECT_GE(s.wall_time_s, 49 * 0.002) << "paced: 50 cycles take at least 49 periods";
-  EXPECT_NE(app::describe(s.timing).find("overruns in 50 cycles"), std::string::npos);
+  EXPECT_NE(control::describe(s.timing).find("overruns in 50 cycles"), std::string::npos);
 }
 
 // The system may refuse SCHED_FIFO or the memory lock (a container, no CAP_SYS_NICE): the loop
@@ -269,12 +269,12 @@ TEST(CycleTiming, APacedLoopMeasuresItsStartLatencyAndComputeTime) {
 TEST(CycleTiming, RealTimeSetUpIsGrantedOrRefusedWithAReason) {
   CountingMachine machine;
   StoppingTask task(0);
-  app::LoopOptions options;
+  control::LoopOptions options;
   options.max_cycles = 5;
   options.realtime_setup.lock_memory = true;
   options.realtime_setup.priority = 80;
   options.realtime_setup.cpu = 0;
-  const auto s = app::run_control_loop(task, machine, options);
+  const auto s = control::run_control_loop(task, machine, options);
   EXPECT_EQ(s.cycles, 5);
   const auto& r = s.realtime_result;
   if (!r.memory_locked) {

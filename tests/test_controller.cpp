@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "allocation_counter.hpp"
-#include "craneassist/app/controller.hpp"
-#include "craneassist/app/csv_log.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/control/controller.hpp"
+#include "craneassist/control/csv_log.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
 
@@ -38,14 +38,14 @@ double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 TEST(Controller, ReferenceKeepsTheCommandedDirection) {
   auto cfg = config::default_crane_config();
   cfg.model.pump.max_flow_m3_s = 50e-3 / 60.0;  // make the flow limit bind
-  app::Controller controller(cfg, {app::ScalingMode::kFlowOnly});
+  control::Controller controller(cfg, {control::ScalingMode::kFlowOnly});
   auto state = still_state(cfg);
   controller.reset(state);
-  app::ControllerOutput out;
+  control::ControllerOutput out;
   const Eigen::Vector3d v(0.6, 0.8, 1.2);
   int flow_limited = 0;
   for (int k = 0; k < 100; ++k) {
-    ASSERT_EQ(controller.update(state, v, out), app::ControllerStatus::kRunning);
+    ASSERT_EQ(controller.update(state, v, out), control::ControllerStatus::kRunning);
     EXPECT_LT(angle_deg(out.ref_tip_velocity_m_s, v), 1e-6);
     EXPECT_LE(out.scale, 1.0);
     flow_limited += out.limit == scaling::ActiveLimit::kFlow;
@@ -60,32 +60,32 @@ TEST(Controller, ReferenceKeepsTheCommandedDirection) {
 
 TEST(Controller, InvalidInputStopsWithNeutralValves) {
   const auto cfg = config::default_crane_config();
-  app::Controller controller(cfg, {app::ScalingMode::kFlowOnly});
+  control::Controller controller(cfg, {control::ScalingMode::kFlowOnly});
   auto state = still_state(cfg);
   controller.reset(state);
-  app::ControllerOutput out;
+  control::ControllerOutput out;
   controller.update(state, Eigen::Vector3d(0.3, 0, 0), out);
   ASSERT_GT(out.valves.spool.cwiseAbs().maxCoeff(), 0.0);
   EXPECT_NE(controller.update(state, Eigen::Vector3d(NAN, 0, 0), out),
-            app::ControllerStatus::kRunning);
+            control::ControllerStatus::kRunning);
   EXPECT_EQ(out.limit, scaling::ActiveLimit::kStaleInput);
   EXPECT_EQ(out.valves.spool.cwiseAbs().maxCoeff(), 0.0);
   state.valid = false;
   EXPECT_EQ(controller.update(state, Eigen::Vector3d(0.3, 0, 0), out),
-            app::ControllerStatus::kStopped);
+            control::ControllerStatus::kStopped);
   EXPECT_EQ(out.valves.spool.cwiseAbs().maxCoeff(), 0.0);
   state.valid = true;
   state.q[2] = INFINITY;
   EXPECT_EQ(controller.update(state, Eigen::Vector3d(0.3, 0, 0), out),
-            app::ControllerStatus::kStopped);
+            control::ControllerStatus::kStopped);
 }
 
 TEST(Controller, CycleDoesNotAllocate) {
   const auto cfg = config::default_crane_config();
-  app::Controller controller(cfg, {app::ScalingMode::kFull});
+  control::Controller controller(cfg, {control::ScalingMode::kFull});
   auto state = still_state(cfg);
   controller.reset(state);
-  app::ControllerOutput out;
+  control::ControllerOutput out;
   controller.update(state, Eigen::Vector3d(0.1, 0.1, 0.1), out);  // first call sizes the output
   const long before = craneassist::test::heap_allocations();
   for (int k = 0; k < 200; ++k) {
@@ -104,10 +104,10 @@ TEST(Controller, CycleWithAConstantPressurePumpDoesNotAllocate) {
   auto cfg = config::default_crane_config();
   cfg.model.pump.mode = dynamics::PumpMode::kConstantPressure;
   cfg.model.pump.prime_mover_power_w = 10e3;  // make the p_s Q bound bind
-  app::Controller controller(cfg, {app::ScalingMode::kFull});
+  control::Controller controller(cfg, {control::ScalingMode::kFull});
   auto state = still_state(cfg);
   controller.reset(state);
-  app::ControllerOutput out;
+  control::ControllerOutput out;
   controller.update(state, Eigen::Vector3d(0.1, 0.1, 0.1), out);  // first call sizes the output
   int power_limited = 0;
   const long before = craneassist::test::heap_allocations();
@@ -123,14 +123,14 @@ TEST(Controller, CycleWithAConstantPressurePumpDoesNotAllocate) {
 TEST(Controller, FullScalingKeepsDirectionAndJerkBound) {
   auto cfg = config::default_crane_config();
   config::set_payload_mass(cfg.model, 650.0);
-  app::Controller controller(cfg, {app::ScalingMode::kFull});
+  control::Controller controller(cfg, {control::ScalingMode::kFull});
   auto state = still_state(cfg);
   controller.reset(state);
-  app::ControllerOutput out;
+  control::ControllerOutput out;
   const Eigen::Vector3d v(0.2, 0.6, 0.5);
   double prev_sddot = 0.0;
   for (int k = 0; k < 300; ++k) {
-    ASSERT_EQ(controller.update(state, v, out), app::ControllerStatus::kRunning);
+    ASSERT_EQ(controller.update(state, v, out), control::ControllerStatus::kRunning);
     if (out.sdot > 0.0) {
       EXPECT_LT(angle_deg(out.ref_tip_velocity_m_s, v), 1e-9);
     }
@@ -146,10 +146,10 @@ TEST(Controller, FullScalingKeepsDirectionAndJerkBound) {
 
 TEST(Controller, FullScalingStaleInputIsAJerkLimitedStop) {
   const auto cfg = config::default_crane_config();
-  app::Controller controller(cfg, {app::ScalingMode::kFull});
+  control::Controller controller(cfg, {control::ScalingMode::kFull});
   auto state = still_state(cfg);
   controller.reset(state);
-  app::ControllerOutput out;
+  control::ControllerOutput out;
   // A machine that follows the reference one valve delay (transport delay plus lag) late, as
   // the real one does; the tracking-error slow-down measures against that delayed reference.
   const auto lag = static_cast<std::size_t>(std::lround(
@@ -163,17 +163,17 @@ TEST(Controller, FullScalingStaleInputIsAJerkLimitedStop) {
   ASSERT_GT(out.sdot, 0.45);
   double prev_sddot = out.sddot;
   int stopping = 0;
-  app::ControllerStatus status = app::ControllerStatus::kRunning;
-  for (int k = 0; k < 500 && status != app::ControllerStatus::kStopped; ++k) {
+  control::ControllerStatus status = control::ControllerStatus::kRunning;
+  for (int k = 0; k < 500 && status != control::ControllerStatus::kStopped; ++k) {
     status = controller.update(state, Eigen::Vector3d(NAN, 0.0, 0.0), out);
     EXPECT_EQ(out.limit, scaling::ActiveLimit::kStaleInput);
     EXPECT_LE(std::abs(out.sddot - prev_sddot),
               cfg.scaling.jerk_max_m_s3 * controller.period_s() * (1 + 1e-9));
     prev_sddot = out.sddot;
-    stopping += status == app::ControllerStatus::kStopping;
+    stopping += status == control::ControllerStatus::kStopping;
     state.q = out.q_ref;
   }
-  EXPECT_EQ(status, app::ControllerStatus::kStopped);
+  EXPECT_EQ(status, control::ControllerStatus::kStopped);
   EXPECT_GT(stopping, 10) << "a stop from speed takes time, not one cycle";
   EXPECT_EQ(out.sdot, 0.0);
   EXPECT_EQ(out.valves.spool.cwiseAbs().maxCoeff(), 0.0);
@@ -181,12 +181,13 @@ TEST(Controller, FullScalingStaleInputIsAJerkLimitedStop) {
 
 // Largest joint acceleration of the reference while the operator swings the stick from one
 // direction to a nearly opposite one, for a machine that follows the reference.
-double peak_joint_acceleration_when_swinging(app::ScalingMode mode, int* turn_cycles = nullptr) {
+double peak_joint_acceleration_when_swinging(control::ScalingMode mode,
+                                             int* turn_cycles = nullptr) {
   const auto cfg = config::default_crane_config();
-  app::Controller controller(cfg, {mode});
+  control::Controller controller(cfg, {mode});
   auto state = still_state(cfg);
   controller.reset(state);
-  app::ControllerOutput out;
+  control::ControllerOutput out;
   dynamics::JointVector previous = dynamics::JointVector::Zero(4);
   double peak = 0.0;
   for (int k = 0; k < 400; ++k) {
@@ -209,8 +210,8 @@ double peak_joint_acceleration_when_swinging(app::ScalingMode mode, int* turn_cy
 TEST(Controller, SwingingTheStickKeepsJointAccelerationsBounded) {
   int turn_cycles = 0;
   const double blended =
-      peak_joint_acceleration_when_swinging(app::ScalingMode::kFull, &turn_cycles);
-  const double stepped = peak_joint_acceleration_when_swinging(app::ScalingMode::kFlowOnly);
+      peak_joint_acceleration_when_swinging(control::ScalingMode::kFull, &turn_cycles);
+  const double stepped = peak_joint_acceleration_when_swinging(control::ScalingMode::kFlowOnly);
   std::printf(
       "[ figures  ] stick reversal: peak joint acceleration %.3f (blended) vs %.3f "
       "(velocity steps), direction turned over %d cycles\n",
@@ -225,14 +226,14 @@ TEST(Controller, EveryResolutionDrivesTheReferenceAlongTheCommand) {
                  dynamics::Resolution::kMinFlow, dynamics::Resolution::kMinLsPower}) {
     auto cfg = config::default_crane_config();
     cfg.redundancy.resolution = r;
-    app::Controller controller(cfg, {app::ScalingMode::kFull});
+    control::Controller controller(cfg, {control::ScalingMode::kFull});
     auto state = still_state(cfg);
     controller.reset(state);
-    app::ControllerOutput out;
+    control::ControllerOutput out;
     const Eigen::Vector3d v(0.3, 0.3, 0.4);
     const long before = craneassist::test::heap_allocations();
     for (int k = 0; k < 200; ++k) {
-      ASSERT_EQ(controller.update(state, v, out), app::ControllerStatus::kRunning);
+      ASSERT_EQ(controller.update(state, v, out), control::ControllerStatus::kRunning);
       if (out.sdot > 0.0) {
         // The reference tip velocity is J(q_ref) f' sdot: check it against the Jacobian.
         dynamics::KinematicsData kin;
@@ -257,10 +258,10 @@ TEST(Controller, EveryResolutionRespectsCylinderAccelerationLimits) {
                  dynamics::Resolution::kMinFlow, dynamics::Resolution::kMinLsPower}) {
     auto cfg = config::default_crane_config();
     cfg.redundancy.resolution = r;
-    app::Controller controller(cfg, {app::ScalingMode::kFull});
+    control::Controller controller(cfg, {control::ScalingMode::kFull});
     auto state = still_state(cfg);
     controller.reset(state);
-    app::ControllerOutput out;
+    control::ControllerOutput out;
     const std::array<Eigen::Vector3d, 4> moves = {
         Eigen::Vector3d(0.6, 0.0, 0.0), Eigen::Vector3d(0.0, 0.5, 0.3),
         Eigen::Vector3d(-0.5, -0.2, 0.2), Eigen::Vector3d(0.2, -0.4, -0.4)};
@@ -295,8 +296,8 @@ TEST(Controller, EveryResolutionRespectsCylinderAccelerationLimits) {
 
 TEST(CsvLog, PushDoesNotAllocateAndEveryRowArrives) {
   const auto path = std::filesystem::temp_directory_path() / "craneassist_test_log.csv";
-  app::CsvLog log(path, 4, 64);
-  app::LogRow row;
+  control::CsvLog log(path, 4, 64);
+  control::LogRow row;
   row.active_limit = "none";
   row.pump_limit = "none";
   const long before = craneassist::test::heap_allocations();
@@ -315,7 +316,7 @@ TEST(CsvLog, PushDoesNotAllocateAndEveryRowArrives) {
   std::ifstream in(path);
   std::string line;
   std::getline(in, line);
-  EXPECT_EQ(line, app::CsvLog::header(4));
+  EXPECT_EQ(line, control::CsvLog::header(4));
   int rows = 0;
   while (std::getline(in, line)) ++rows;
   EXPECT_EQ(rows, 1000);
@@ -323,7 +324,7 @@ TEST(CsvLog, PushDoesNotAllocateAndEveryRowArrives) {
 
 TEST(CsvLog, UnwritablePathIsReported) {
   try {
-    app::CsvLog log("/nonexistent-dir/log.csv", 4);
+    control::CsvLog log("/nonexistent-dir/log.csv", 4);
     FAIL();
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent-dir/log.csv"), std::string::npos);

@@ -4,11 +4,11 @@
 #include <cstdio>
 #include <sstream>
 
-#include "craneassist/app/planning.hpp"
-#include "craneassist/app/trajectory_runner.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/control/trajectory_runner.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
 #include "craneassist/input/joint_trajectory.hpp"
+#include "craneassist/offline/planning.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
 #include "craneassist/valves/proportional_valves.hpp"
 
@@ -118,12 +118,12 @@ TEST(TrajectoryRunner, SimulatedCraneFollowsAPlan) {
   options.refinement.passes = 1;
   const auto plan = planner::plan_dp(stages, 0.3, options);
   ASSERT_TRUE(plan.ok);
-  const auto traj = app::to_joint_trajectory(plan, "test");
+  const auto traj = offline::to_joint_trajectory(plan, "test");
   ASSERT_EQ(traj.size(), 81u);
   EXPECT_EQ(traj.comments.size(), 3u);
 
   sim_backend::SimBackend machine(m, {cfg.simulation.step_s, dynamics::JointVector(traj.q(0))});
-  const auto summary = app::run_trajectory(cfg, traj, machine, {}, nullptr);
+  const auto summary = control::run_trajectory(cfg, traj, machine, {}, nullptr);
   EXPECT_LT(summary.start_error_m, 1e-6);
   EXPECT_LT(summary.max_tip_error_m, 0.02);
   EXPECT_LT(summary.rms_tip_error_m, 0.01);
@@ -135,9 +135,9 @@ TEST(TrajectoryRunner, SimulatedCraneFollowsAPlan) {
 
   // Without the preview the machine lags the plan by its valve delay: a larger error.
   sim_backend::SimBackend lagging(m, {cfg.simulation.step_s, dynamics::JointVector(traj.q(0))});
-  app::TrajectoryRunOptions no_preview;
+  control::TrajectoryRunOptions no_preview;
   no_preview.preview = false;
-  const auto late = app::run_trajectory(cfg, traj, lagging, no_preview, nullptr);
+  const auto late = control::run_trajectory(cfg, traj, lagging, no_preview, nullptr);
   EXPECT_GT(late.rms_tip_error_m, summary.rms_tip_error_m);
 }
 

@@ -15,11 +15,11 @@
 #include <vector>
 
 #include "allocation_counter.hpp"
-#include "craneassist/app/live_loop.hpp"
-#include "craneassist/app/replay_runner.hpp"
-#include "craneassist/app/sim_setup.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/control/live_loop.hpp"
+#include "craneassist/control/replay_runner.hpp"
 #include "craneassist/input/replay.hpp"
+#include "craneassist/offline/sim_setup.hpp"
 
 using namespace craneassist;
 
@@ -55,20 +55,20 @@ class ScriptedSource : public input::CommandSource {
 };
 
 // Keeps every row (preallocated) and the heap allocations seen at each cycle.
-class Probe : public app::CycleObserver {
+class Probe : public control::CycleObserver {
  public:
   explicit Probe(std::size_t n) {
     rows.reserve(n);
     allocations.reserve(n);
   }
-  void on_cycle(const app::CycleRecord& cycle) noexcept override {
-    const app::LogRow& row = cycle.row;
+  void on_cycle(const control::CycleRecord& cycle) noexcept override {
+    const control::LogRow& row = cycle.row;
     if (rows.size() < rows.capacity()) {
       rows.push_back(row);
       allocations.push_back(craneassist::test::heap_allocations());
     }
   }
-  std::vector<app::LogRow> rows;
+  std::vector<control::LogRow> rows;
   std::vector<long> allocations;
 };
 
@@ -79,7 +79,7 @@ std::string read_file(const std::filesystem::path& p) {
   return s.str();
 }
 
-double speed(const app::LogRow& r) {
+double speed(const control::LogRow& r) {
   return std::sqrt(r.tip_v[0] * r.tip_v[0] + r.tip_v[1] * r.tip_v[1] + r.tip_v[2] * r.tip_v[2]);
 }
 
@@ -93,8 +93,8 @@ Script moving(double t) {
   return s;
 }
 
-app::LiveOptions scripted_options(double duration_s, Probe* probe) {
-  app::LiveOptions o;
+control::LiveOptions scripted_options(double duration_s, Probe* probe) {
+  control::LiveOptions o;
   o.realtime = false;
   o.duration_s = duration_s;
   if (probe != nullptr) o.observers.push_back(probe);
@@ -124,13 +124,13 @@ TEST(LiveLoop, RecordedSessionReplaysToTheSameLog) {
   const auto live_log = dir / "craneassist_live_session.csv";
   const auto replay_log = dir / "craneassist_live_replayed.csv";
   std::vector<input::ReplayRow> record;
-  app::LiveSummary live;
+  control::LiveSummary live;
   {
-    sim_backend::SimBackend machine(cfg.model, app::sim_settings(cfg));
-    app::CsvLog log(live_log, cfg.model.dof());
+    sim_backend::SimBackend machine(cfg.model, offline::sim_settings(cfg));
+    control::CsvLog log(live_log, cfg.model.dof());
     auto options = scripted_options(4.5, nullptr);
     options.record = &record;
-    live = app::run_live(cfg, source, machine, options, &log);
+    live = control::run_live(cfg, source, machine, options, &log);
   }
   EXPECT_EQ(live.cycles, 450);
   EXPECT_EQ(live.disconnects, 1);
@@ -158,11 +158,11 @@ TEST(LiveLoop, RecordedSessionReplaysToTheSameLog) {
   EXPECT_TRUE(text.str().starts_with("t,v_x,v_y,v_z,stop\n"));
   const auto replay = input::Replay::parse(text.str(), "recording");
   {
-    sim_backend::SimBackend machine(cfg.model, app::sim_settings(cfg));
-    app::CsvLog log(replay_log, cfg.model.dof());
-    app::RunOptions options;
+    sim_backend::SimBackend machine(cfg.model, offline::sim_settings(cfg));
+    control::CsvLog log(replay_log, cfg.model.dof());
+    control::RunOptions options;
     options.settle_s = 0.0;
-    const auto summary = app::run_replay(cfg, replay, machine, options, &log);
+    const auto summary = control::run_replay(cfg, replay, machine, options, &log);
     EXPECT_EQ(summary.cycles, 450);
   }
   const std::string a = read_file(live_log), b = read_file(replay_log);
@@ -211,9 +211,9 @@ TEST(LiveLoop, StaleInputStopsJerkLimitedAndMotionResumesOnlyAfterReArm) {
     if (t >= 5.0 && t < 5.2) s.deadman = false;    // the operator re-arms
     return s;
   });
-  sim_backend::SimBackend machine(cfg.model, app::sim_settings(cfg));
+  sim_backend::SimBackend machine(cfg.model, offline::sim_settings(cfg));
   Probe probe(800);
-  app::run_live(cfg, source, machine, scripted_options(7.0, &probe), nullptr);
+  control::run_live(cfg, source, machine, scripted_options(7.0, &probe), nullptr);
   ASSERT_EQ(probe.rows.size(), 700u);
 
   // Moving before the freeze.
@@ -306,9 +306,9 @@ TEST(LiveLoop, EveryFaultStopsWithItsReason) {
       if (t >= 1.5) c.fault(s);
       return s;
     });
-    sim_backend::SimBackend machine(cfg.model, app::sim_settings(cfg));
+    sim_backend::SimBackend machine(cfg.model, offline::sim_settings(cfg));
     Probe probe(400);
-    app::run_live(cfg, source, machine, scripted_options(3.5, &probe), nullptr);
+    control::run_live(cfg, source, machine, scripted_options(3.5, &probe), nullptr);
     ASSERT_EQ(probe.rows.size(), 350u) << c.reason;
     EXPECT_GT(speed(probe.rows[149]), 0.3) << c.reason;
     EXPECT_STREQ(probe.rows[150].stop_reason, c.reason);
@@ -334,11 +334,11 @@ TEST(LiveLoop, StopRequestBringsTheCraneToRestBeforeReturning) {
     if (t >= 1.0) stop.store(true);
     return moving(t);
   });
-  sim_backend::SimBackend machine(cfg.model, app::sim_settings(cfg));
+  sim_backend::SimBackend machine(cfg.model, offline::sim_settings(cfg));
   Probe probe(1000);
   auto options = scripted_options(0.0, &probe);
   options.stop = &stop;
-  const auto s = app::run_live(cfg, source, machine, options, nullptr);
+  const auto s = control::run_live(cfg, source, machine, options, nullptr);
   EXPECT_GT(s.cycles, 101);
   EXPECT_LT(s.cycles, 400);
   EXPECT_STREQ(probe.rows.back().stop_reason, "operator quit");
@@ -354,13 +354,13 @@ TEST(LiveLoop, CyclesAllocateNothing) {
     if (t > 1.5 && t < 1.6) s.deadman = false;
     return s;
   });
-  sim_backend::SimBackend machine(cfg.model, app::sim_settings(cfg));
+  sim_backend::SimBackend machine(cfg.model, offline::sim_settings(cfg));
   Probe probe(300);
   std::vector<input::ReplayRow> record;
   auto options = scripted_options(3.0, &probe);
   options.record = &record;
   options.record_capacity = 400;
-  app::run_live(cfg, source, machine, options, nullptr);
+  control::run_live(cfg, source, machine, options, nullptr);
   ASSERT_EQ(probe.allocations.size(), 300u);
   // std::function calls in the scripted source allocate nothing either (captureless lambda).
   EXPECT_EQ(probe.allocations.back() - probe.allocations[1], 0);

@@ -1,13 +1,13 @@
-// app::MotionQuality on synthetic runs: what counts as a stall, what as lateral speed.
+// control::MotionQuality on synthetic runs: what counts as a stall, what as lateral speed.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <functional>
 
-#include "craneassist/app/motion_quality.hpp"
+#include "craneassist/control/motion_quality.hpp"
 
-using craneassist::app::MotionQuality;
-using craneassist::app::MotionQualityResult;
+using craneassist::control::MotionQuality;
+using craneassist::control::MotionQualityResult;
 
 namespace {
 

@@ -8,8 +8,8 @@
 
 #include <cstdio>
 
-#include "craneassist/app/scenario_suite.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/offline/scenario_suite.hpp"
 
 using namespace craneassist;
 
@@ -24,12 +24,12 @@ struct Totals {
 };
 
 Totals run_suite(const std::string& resolution, bool expect_every_target) {
-  const auto suite = app::load_suite(kSource + "/examples/replays/suite.yaml");
+  const auto suite = offline::load_suite(kSource + "/examples/replays/suite.yaml");
   const auto cfg = config::default_crane_config();
-  app::check_suite(suite, cfg);
+  offline::check_suite(suite, cfg);
   Totals t;
   for (const auto& run : suite.runs) {
-    const auto out = app::run_suite_run(cfg, run, resolution, {});
+    const auto out = offline::run_suite_run(cfg, run, resolution, {});
     const auto& s = out.summary;
     t.energy_j += s.energy_j;
     ++t.runs;

@@ -9,9 +9,9 @@
 #include <sstream>
 #include <vector>
 
-#include "craneassist/app/csv_log.hpp"
-#include "craneassist/app/replay_runner.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/control/csv_log.hpp"
+#include "craneassist/control/replay_runner.hpp"
 #include "craneassist/input/replay.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
 
@@ -31,19 +31,19 @@ config::CraneConfig flow_limited_crane() {
 }
 
 struct ReplayRun {
-  app::RunSummary summary;
+  control::RunSummary summary;
   double min_elevation_deg = 90.0;  // of the measured tip velocity while moving fast
 };
 
-ReplayRun run(const config::CraneConfig& cfg, const std::string& replay_file, app::ScalingMode mode,
-              const std::filesystem::path& log_path) {
+ReplayRun run(const config::CraneConfig& cfg, const std::string& replay_file,
+              control::ScalingMode mode, const std::filesystem::path& log_path) {
   const auto replay = input::Replay::load_file(kSource + "/examples/replays/" + replay_file);
   sim_backend::SimBackend machine(cfg.model, {cfg.simulation.step_s, cfg.simulation.q_initial});
-  app::CsvLog log(log_path, cfg.model.dof());
-  app::RunOptions options;
+  control::CsvLog log(log_path, cfg.model.dof());
+  control::RunOptions options;
   options.controller.mode = mode;
   ReplayRun r;
-  r.summary = app::run_replay(cfg, replay, machine, options, &log);
+  r.summary = control::run_replay(cfg, replay, machine, options, &log);
   // The elevation of the measured tip velocity, from the log (independent of the summary).
   std::ifstream in(log_path);
   std::string line;
@@ -67,9 +67,9 @@ ReplayRun run(const config::CraneConfig& cfg, const std::string& replay_file, ap
 TEST(ReplayEndToEnd, FlowPrescalingKeepsTheTipDirectionWhenThePumpSaturates) {
   const auto cfg = flow_limited_crane();
   const auto dir = std::filesystem::temp_directory_path();
-  const ReplayRun unscaled =
-      run(cfg, "combined_move.csv", app::ScalingMode::kNone, dir / "craneassist_e2e_unscaled.csv");
-  const ReplayRun scaled = run(cfg, "combined_move.csv", app::ScalingMode::kFlowOnly,
+  const ReplayRun unscaled = run(cfg, "combined_move.csv", control::ScalingMode::kNone,
+                                 dir / "craneassist_e2e_unscaled.csv");
+  const ReplayRun scaled = run(cfg, "combined_move.csv", control::ScalingMode::kFlowOnly,
                                dir / "craneassist_e2e_scaled.csv");
   const double commanded_elevation = std::asin(0.8 / std::sqrt(0.36 + 0.64 + 1.44)) * 180 / M_PI;
 
@@ -102,7 +102,7 @@ TEST(ReplayEndToEnd, FlowPrescalingKeepsTheTipDirectionWhenThePumpSaturates) {
 TEST(ReplayEndToEnd, DemoRunsAndLogsEveryDocumentedColumn) {
   const auto cfg = config::default_crane_config();
   const auto log_path = std::filesystem::temp_directory_path() / "craneassist_e2e_demo.csv";
-  const ReplayRun r = run(cfg, "demo.csv", app::ScalingMode::kFull, log_path);
+  const ReplayRun r = run(cfg, "demo.csv", control::ScalingMode::kFull, log_path);
   const auto replay = input::Replay::load_file(kSource + "/examples/replays/demo.csv");
   EXPECT_EQ(r.summary.cycles, static_cast<int>(std::round((replay.end_time_s() + 1.0) * 100)) + 1);
   EXPECT_EQ(r.summary.log_rows_dropped, 0u);
@@ -161,8 +161,8 @@ TEST(ReplayEndToEnd, ReachingTheJointRangeEndStopsWithoutHittingIt) {
   auto cfg = config::default_crane_config();
   const auto replay = input::Replay::parse("t,v_x,v_y,v_z\n0,0.5,0,0\n12,0,0,0\n", "out.csv");
   sim_backend::SimBackend machine(cfg.model, {cfg.simulation.step_s, cfg.simulation.q_initial});
-  app::RunOptions options;
-  const auto s = app::run_replay(cfg, replay, machine, options, nullptr);
+  control::RunOptions options;
+  const auto s = control::run_replay(cfg, replay, machine, options, nullptr);
   EXPECT_GT(s.limit_cycles[static_cast<std::size_t>(scaling::ActiveLimit::kJointLimit)], 0);
   valves::MachineState state;
   machine.read(state);

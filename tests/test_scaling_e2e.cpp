@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "craneassist/app/csv_log.hpp"
-#include "craneassist/app/replay_runner.hpp"
-#include "craneassist/app/sine_path_experiment.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/control/csv_log.hpp"
+#include "craneassist/control/replay_runner.hpp"
 #include "craneassist/input/replay.hpp"
+#include "craneassist/offline/sine_path_experiment.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
 
 using namespace craneassist;
@@ -95,16 +95,16 @@ double max_abs(const std::vector<double>& v) {
 }
 
 Log run_replay_logged(const config::CraneConfig& cfg, const input::Replay& replay,
-                      app::ScalingMode mode, const std::string& name,
+                      control::ScalingMode mode, const std::string& name,
                       const dynamics::CraneModel* machine_model = nullptr) {
   const auto path = std::filesystem::temp_directory_path() / ("craneassist_" + name + ".csv");
   sim_backend::SimBackend machine(machine_model ? *machine_model : cfg.model,
                                   {cfg.simulation.step_s, cfg.simulation.q_initial});
-  app::CsvLog log(path, cfg.model.dof());
-  app::RunOptions options;
+  control::CsvLog log(path, cfg.model.dof());
+  control::RunOptions options;
   options.controller.mode = mode;
   options.settle_s = 1.5;
-  app::run_replay(cfg, replay, machine, options, &log);
+  control::run_replay(cfg, replay, machine, options, &log);
   return read_log(path);
 }
 
@@ -118,8 +118,8 @@ TEST(ScalingEndToEnd, HeavyLiftStaysWithinPowerAndKeepsDirection) {
   config::set_payload_mass(cfg.model, 650.0);
   config::set_resolution(cfg, "pinv-joint");
   const auto replay = input::Replay::load_file(kSource + "/examples/replays/heavy_lift.csv");
-  const Log full = run_replay_logged(cfg, replay, app::ScalingMode::kFull, "heavy_full");
-  const Log flow = run_replay_logged(cfg, replay, app::ScalingMode::kFlowOnly, "heavy_flow");
+  const Log full = run_replay_logged(cfg, replay, control::ScalingMode::kFull, "heavy_full");
+  const Log flow = run_replay_logged(cfg, replay, control::ScalingMode::kFlowOnly, "heavy_flow");
   const double p_max = cfg.model.pump.prime_mover_power_w;
   const DirectionStats d_full = direction_stats(full);
   const DirectionStats d_flow = direction_stats(flow);
@@ -153,7 +153,7 @@ TEST(ScalingEndToEnd, HeavyLiftStaysWithinPowerAndKeepsDirection) {
   for (const char* r : {"energy-optimal", "pinv-actuator", "min-flow"}) {
     auto other = cfg;
     config::set_resolution(other, r);
-    const Log log = run_replay_logged(other, replay, app::ScalingMode::kFull, "heavy_other");
+    const Log log = run_replay_logged(other, replay, control::ScalingMode::kFull, "heavy_other");
     const DirectionStats d = direction_stats(log);
     std::printf(
         "[ figures  ] heavy lift, %s: peak %.2f kW (%.1f %% of P_max), max direction "
@@ -170,16 +170,17 @@ TEST(ScalingEndToEnd, PaperTwoLinkExperimentOldBoundExceedsPowerLsBoundDoesNot) 
   const auto cfg = config::planar_2r_config();
   const double p_max = cfg.model.pump.prime_mover_power_w;
   struct Result {
-    app::SinePathSummary summary;
+    offline::SinePathSummary summary;
   };
   auto run = [&](scaling::PowerBound bound, bool limiter) {
-    app::SinePathOptions options;
+    offline::SinePathOptions options;
     options.power_bound = bound;
     options.pump_power_limiter = limiter;
     dynamics::JointVector q0, f1, f2;
-    app::sine_path(0.0, q0, f1, f2);
-    sim_backend::SimBackend machine(app::machine_model(cfg, options), {cfg.simulation.step_s, q0});
-    return app::run_sine_path(cfg, options, machine, nullptr);
+    offline::sine_path(0.0, q0, f1, f2);
+    sim_backend::SimBackend machine(offline::machine_model(cfg, options),
+                                    {cfg.simulation.step_s, q0});
+    return offline::run_sine_path(cfg, options, machine, nullptr);
   };
   const auto old_bound = run(scaling::PowerBound::kActuatorPowerSum, false);
   const auto ls_bound = run(scaling::PowerBound::kLoadSensing, false);
@@ -215,9 +216,9 @@ TEST(ScalingEndToEnd, TrackingErrorSlowsTheReferenceForALaggingMachine) {
   // Up at 1.2 m/s for 2.5 s: more than the crippled lift section can deliver.
   const auto replay = input::Replay::parse("t,v_x,v_y,v_z\n0,0,1.2,0\n2.5,0,0,0\n", "up.csv");
   const Log full =
-      run_replay_logged(cfg, replay, app::ScalingMode::kFull, "lagging_full", &slow_machine);
-  const Log flow =
-      run_replay_logged(cfg, replay, app::ScalingMode::kFlowOnly, "lagging_flow", &slow_machine);
+      run_replay_logged(cfg, replay, control::ScalingMode::kFull, "lagging_full", &slow_machine);
+  const Log flow = run_replay_logged(cfg, replay, control::ScalingMode::kFlowOnly, "lagging_flow",
+                                     &slow_machine);
   // Joint-space lag of the lift against its reference, halfway through and at the end of the
   // command, and how far the tip still travels after the stick is released (plus the valve
   // delay): the overrun an operator sees when the reference has run ahead of the machine.
@@ -255,7 +256,7 @@ TEST(ScalingEndToEnd, EndDampingStopsBeforeTheEndAndLetsTheOperatorBackOff) {
   const auto cfg = config::default_crane_config();
   const auto replay =
       input::Replay::parse("t,v_x,v_y,v_z\n0,0.6,0,0\n9,-0.4,0,0\n12,0,0,0\n", "out_and_back.csv");
-  const Log log = run_replay_logged(cfg, replay, app::ScalingMode::kFull, "end_damping");
+  const Log log = run_replay_logged(cfg, replay, control::ScalingMode::kFull, "end_damping");
   const double q4_max = cfg.model.joints[3].q_max;
   double q4_peak = 0.0;
   double q4_at_reverse = 0.0;
@@ -292,7 +293,7 @@ TEST(ScalingEndToEnd, HeavyLoadStopsWhenTheStickIsReleasedAndNeverComesBack) {
       config::set_resolution(cfg, r);
       const auto replay = input::Replay::parse(text, "heavy_release.csv");
       const Eigen::Vector3d line = replay.rows()[1].v_m_s.normalized();
-      const Log log = run_replay_logged(cfg, replay, app::ScalingMode::kFull, "heavy_release");
+      const Log log = run_replay_logged(cfg, replay, control::ScalingMode::kFull, "heavy_release");
       double release_speed = 0.0, rest_at = -1.0, backwards = 0.0;
       for (std::size_t k = 0; k < log.rows(); ++k) {
         const double t = log["t"][k];
@@ -336,9 +337,9 @@ TEST(ScalingEndToEnd, ConstantPressurePumpNeedsItsOwnPowerBound) {
   cp_cfg.model.pump.prime_mover_power_w = ls_cfg.model.pump.prime_mover_power_w = 20e3;
   const auto replay =
       input::Replay::parse("t,v_x,v_y,v_z\n0,1.0,1.0,0.6\n3,0,0,0\n", "up_and_out.csv");
-  const Log own = run_replay_logged(cp_cfg, replay, app::ScalingMode::kFull, "cp_own");
+  const Log own = run_replay_logged(cp_cfg, replay, control::ScalingMode::kFull, "cp_own");
   const Log ls_belief =
-      run_replay_logged(ls_cfg, replay, app::ScalingMode::kFull, "cp_ls_belief", &cp_cfg.model);
+      run_replay_logged(ls_cfg, replay, control::ScalingMode::kFull, "cp_ls_belief", &cp_cfg.model);
   const double p_bound = 20e3 * (1.0 - cp_cfg.scaling.power_reserve);
   const DirectionStats d_own = direction_stats(own);
   const DirectionStats d_ls = direction_stats(ls_belief);

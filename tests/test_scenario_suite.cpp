@@ -4,8 +4,8 @@
 
 #include <filesystem>
 
-#include "craneassist/app/scenario_suite.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/offline/scenario_suite.hpp"
 
 using namespace craneassist;
 
@@ -16,8 +16,8 @@ const std::filesystem::path kReplays =
 
 config::ConfigError error_of(const std::string& yaml) {
   try {
-    const auto suite = app::parse_suite(yaml, "test.yaml", kReplays);
-    app::check_suite(suite, config::default_crane_config());
+    const auto suite = offline::parse_suite(yaml, "test.yaml", kReplays);
+    offline::check_suite(suite, config::default_crane_config());
   } catch (const config::ConfigError& e) {
     return e;
   }
@@ -28,8 +28,8 @@ config::ConfigError error_of(const std::string& yaml) {
 }  // namespace
 
 TEST(ScenarioSuite, TheShippedSuiteExpandsEveryPose) {
-  const auto suite = app::load_suite(kReplays / "suite.yaml");
-  app::check_suite(suite, config::default_crane_config());
+  const auto suite = offline::load_suite(kReplays / "suite.yaml");
+  offline::check_suite(suite, config::default_crane_config());
   ASSERT_EQ(suite.runs.size(), 25u);
   EXPECT_EQ(suite.runs[0].name(), "suite/push_x_plus.csv @default");
   EXPECT_EQ(suite.runs[1].name(), "suite/push_x_plus.csv @folded");
@@ -78,11 +78,11 @@ TEST(ScenarioSuite, MistakesNameFileLineAndField) {
 }
 
 TEST(ScenarioSuite, ARunMissingATargetSaysWhichAndByHowMuch) {
-  auto suite = app::parse_suite(
+  auto suite = offline::parse_suite(
       "format: craneassist-suite/1\nruns:\n  - replay: heavy_lift.csv\n    payload: 650 kg\n"
       "    targets: {peak_power: 0.1, direction_error: 0.001 deg}\n",
       "tight.yaml", kReplays);
-  const auto out = app::run_suite_run(config::default_crane_config(), suite.runs[0], "", {});
+  const auto out = offline::run_suite_run(config::default_crane_config(), suite.runs[0], "", {});
   ASSERT_EQ(out.missed.size(), 2u);
   EXPECT_NE(out.missed[0].find("peak power"), std::string::npos) << out.missed[0];
   EXPECT_NE(out.missed[0].find("> 0.100"), std::string::npos) << out.missed[0];

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "craneassist/app/path_bound.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
+#include "craneassist/offline/path_bound.hpp"
 #include "craneassist/scaling/time_optimal.hpp"
 
 using namespace craneassist;
@@ -160,18 +160,18 @@ TEST(TimeOptimal, APathThatCannotBeTraversedNamesWhere) {
 TEST(PathBound, HorizontalPathDrivenByTheControllerNearTheBound) {
   const auto cfg = config::default_crane_config();
   const auto path = input::PrescribedPath::load_file(kSource + "/examples/paths/horizontal.csv");
-  app::JointPathOptions options;
-  const auto jp = app::joint_path_for(cfg, path, options);
+  offline::JointPathOptions options;
+  const auto jp = offline::joint_path_for(cfg, path, options);
   EXPECT_TRUE(jp.online_arrived);
   EXPECT_LT(jp.online_deviation_m, 0.01);
   EXPECT_NEAR(jp.samples.back().s, path.length_m(), 0.015);
-  const auto figures = app::bound_figures(cfg, jp);
+  const auto figures = offline::bound_figures(cfg, jp);
   ASSERT_TRUE(figures.bound.ok);
   const double ratio = jp.online_time_s / figures.bound.time_s;
   auto lifted = cfg;
   lifted.scaling.jerk_max_m_s3 *= 100.0;
-  const auto jp_lifted = app::joint_path_for(lifted, path, options);
-  const auto lifted_figures = app::bound_figures(lifted, jp_lifted);
+  const auto jp_lifted = offline::joint_path_for(lifted, path, options);
+  const auto lifted_figures = offline::bound_figures(lifted, jp_lifted);
   ASSERT_TRUE(lifted_figures.bound.ok);
   const double lifted_ratio = jp_lifted.online_time_s / lifted_figures.bound.time_s;
   std::printf(
@@ -189,5 +189,5 @@ TEST(PathBound, HorizontalPathDrivenByTheControllerNearTheBound) {
 TEST(PathBound, StartOutOfReachIsAnError) {
   const auto cfg = config::default_crane_config();
   const auto path = input::PrescribedPath::parse("t,x,y,z\n0,30,0,0\n5,31,0,0\n", "far.csv");
-  EXPECT_THROW(app::joint_path_for(cfg, path, {}), std::runtime_error);
+  EXPECT_THROW(offline::joint_path_for(cfg, path, {}), std::runtime_error);
 }

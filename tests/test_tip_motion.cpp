@@ -23,7 +23,7 @@ using dynamics::JointVector;
 
 namespace {
 
-// The scaling part of app::Controller::update_full, on a machine at the reference.
+// The scaling part of control::Controller::update_full, on a machine at the reference.
 class TipMotion {
  public:
   explicit TipMotion(const config::CraneConfig& cfg)

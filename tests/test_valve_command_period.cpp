@@ -7,10 +7,10 @@
 
 #include <string>
 
-#include "craneassist/app/replay_runner.hpp"
-#include "craneassist/app/sim_setup.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/control/replay_runner.hpp"
 #include "craneassist/input/replay.hpp"
+#include "craneassist/offline/sim_setup.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
 
 using namespace craneassist;
@@ -44,13 +44,13 @@ class HeldCommandMachine final : public valves::MachineInterface {
   long writes_ = 0;
 };
 
-app::RunSummary run(const config::CraneConfig& cfg, const input::Replay& replay, int hold,
-                    bool report) {
-  sim_backend::SimBackend sim(cfg.model, app::sim_settings(cfg));
+control::RunSummary run(const config::CraneConfig& cfg, const input::Replay& replay, int hold,
+                        bool report) {
+  sim_backend::SimBackend sim(cfg.model, offline::sim_settings(cfg));
   HeldCommandMachine machine(sim, hold, 1.0 / cfg.control.rate_hz, report);
-  app::RunOptions options;
+  control::RunOptions options;
   options.settle_s = 0.5;
-  return app::run_replay(cfg, replay, machine, options, nullptr);
+  return control::run_replay(cfg, replay, machine, options, nullptr);
 }
 
 }  // namespace

@@ -12,7 +12,7 @@
 
 namespace craneassist::dds {
 
-// Exit codes, the same as the command line's (app/src/exit_codes.hpp).
+// Exit codes, the same as the command line's (app/cli/exit_codes.hpp).
 inline constexpr int kToolOk = 0;
 inline constexpr int kToolUsage = 2;    // unknown topic, bad option
 inline constexpr int kToolRuntime = 3;  // DDS could not be set up, or no data in time

@@ -1,0 +1,69 @@
+#include "machine_setup.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include "craneassist/offline/sim_setup.hpp"
+#include "exit_codes.hpp"
+
+namespace craneassist::cli {
+
+void add_backend_options(CLI::App& command, BackendArgs& args) {
+  command
+      .add_option("--backend", args.backend,
+                  "Machine backend: sim (the simulated crane) or can (a machine on a CAN bus, "
+                  "docs/can.md; implies real-time pacing). Default: the config's `backend:` (sim)")
+      ->check(CLI::IsMember({"sim", "can"}));
+  command.add_option("--can", args.can_iface,
+                     "--backend can: the CAN interface (can0, vcan0; default: can.interface)");
+  command
+      .add_option("--mapping", args.mapping_file,
+                  "--backend can: CAN mapping YAML (default: can.mapping, else the embedded "
+                  "config/can/k70m_can.yaml)")
+      ->check(CLI::ExistingFile);
+  command.add_option("--can-log", args.can_log,
+                     "--backend can: write all CAN traffic as a candump -L log");
+  command
+      .add_option("--can-feedback-timeout", args.feedback_timeout_s,
+                  "--backend can: fault when a joint's position is older than this, s "
+                  "(default: can.feedback_timeout, 0.05)")
+      ->check(CLI::Range(0.005, 1.0));
+}
+
+bool uses_can_backend(const BackendArgs& args, const config::CraneConfig& cfg) {
+  return args.backend.empty() ? cfg.backend.kind == config::BackendKind::kCan
+                              : args.backend == "can";
+}
+
+int Machine::open(const config::CraneConfig& cfg, const BackendArgs& args) {
+  if (!uses_can_backend(args, cfg)) {
+    sim_.emplace(cfg.model, offline::sim_settings(cfg));
+    machine_ = &*sim_;
+    return machine_->activate(0.0, nullptr) ? kExitOk : kExitRuntime;
+  }
+  const std::string iface = args.can_iface.empty() ? cfg.backend.can.interface : args.can_iface;
+  if (iface.empty()) {
+    spdlog::error("the can backend needs an interface: --can IFACE or can.interface in {}",
+                  cfg.source_name);
+    return kExitUsage;
+  }
+  const std::string mapping =
+      args.mapping_file.empty() ? cfg.backend.can.mapping : args.mapping_file;
+  can_.emplace(cfg.model, iface, mapping, args.can_log,
+               args.feedback_timeout_s.value_or(cfg.backend.can.feedback_timeout_s));
+  machine_ = &can_->backend();
+  if (std::string why; !machine_->activate(2.0, &why)) {
+    spdlog::error("{} on {} (is the machine or `craneassist emulate --can {}` running?)", why,
+                  iface, iface);
+    return kExitRuntime;
+  }
+  return kExitOk;
+}
+
+int Machine::finish() {
+  if (machine_ == nullptr) return kExitOk;
+  machine_->deactivate();
+  if (can_) can_->report();
+  return machine_->faulted() ? kExitRuntime : kExitOk;
+}
+
+}  // namespace craneassist::cli

@@ -1,0 +1,395 @@
+#include "sim_command.hpp"
+
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <exception>
+#include <fstream>
+#include <memory>
+#include <thread>
+
+#include "craneassist/config/crane_config.hpp"
+#include "craneassist/config/joystick_config.hpp"
+#include "craneassist/control/live_loop.hpp"
+#include "craneassist/dds/command_source.hpp"
+#include "craneassist/input/evdev_source.hpp"
+#include "craneassist/input/keyboard_source.hpp"
+#include "craneassist/input/replay_source.hpp"
+#include "craneassist/input/sdl_source.hpp"
+#include "craneassist/offline/sim_setup.hpp"
+#include "exit_codes.hpp"
+#include "resolution_option.hpp"
+
+namespace craneassist::cli {
+namespace {
+
+std::atomic<bool> g_stop{false};
+
+extern "C" void on_stop_signal(int) {
+  g_stop.store(true);
+  input::KeyboardSource::restore_terminal();  // at once, in case the loop takes a while to stop
+}
+
+// The status line and the device event messages, from the loop's status board (UI thread).
+class StatusReporter {
+ public:
+  StatusReporter(const control::LiveStatusBoard& board, const input::KeyboardSource* keyboard,
+                 const dds::DdsCommandSource* remote = nullptr)
+      : board_(board), keyboard_(keyboard), remote_(remote), draw_(isatty(1) != 0) {}
+
+  void run(const std::atomic<bool>& done) {
+    while (!done.load()) {
+      report(board_.read());
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    report(board_.read());
+    if (draw_) std::printf("\n");
+    std::fflush(stdout);
+  }
+
+ private:
+  void clear_line() {
+    if (draw_) std::printf("\r\033[K");
+  }
+
+  void report(const control::LiveStatus& s) {
+    if (s.disconnects > disconnects_) {
+      clear_line();
+      spdlog::warn("t {:.2f} s: input device disconnected: stopping", s.t);
+    }
+    if (s.reconnects > reconnects_) {
+      clear_line();
+      spdlog::info("t {:.2f} s: input device attached again (release and press the deadman)", s.t);
+    }
+    disconnects_ = s.disconnects;
+    reconnects_ = s.reconnects;
+    if (s.fault != fault_) {
+      if (s.fault == input::InputFault::kDisconnected && s.disconnects == 0) {
+        clear_line();
+        spdlog::info("waiting for the input device (plug it in; then press the deadman)");
+      } else if (s.fault == input::InputFault::kStale) {
+        clear_line();
+        spdlog::warn("t {:.2f} s: input stale {:.0f} ms: stopping", s.t, s.input_age_s * 1e3);
+      } else if (s.fault == input::InputFault::kNotFinite ||
+                 s.fault == input::InputFault::kOutOfRange) {
+        clear_line();
+        spdlog::warn("t {:.2f} s: {}: stopping", s.t, input::to_string(s.fault));
+      }
+      fault_ = s.fault;
+    }
+    char sender[64] = "";
+    if (remote_ != nullptr) {  // the remote operator (OperatorCommand.sender)
+      const std::string now_sender = remote_->stats().sender;
+      if (now_sender != sender_) {
+        clear_line();
+        spdlog::info("remote operator: '{}' (DDS)", now_sender);
+        sender_ = now_sender;
+      }
+      std::snprintf(sender, sizeof sender, " | from %.40s", sender_.c_str());
+    }
+    if (!draw_) return;
+    char speed_step[32] = "";
+    if (keyboard_ != nullptr) {
+      std::snprintf(speed_step, sizeof speed_step, " | speed %d/%d%s", keyboard_->speed_step(),
+                    input::KeyboardState::kSteps, keyboard_->latched() ? " latched" : "");
+    }
+    char age[32] = "";
+    if (s.fault == input::InputFault::kStale) {
+      std::snprintf(age, sizeof age, " %.0f ms", s.input_age_s * 1e3);
+    }
+    std::printf(
+        "\r\033[Kt %6.1f s | %-8s | deadman %s%s%s | tip x %5.2f y %5.2f z %5.2f m | %.2f m/s | "
+        "%s%s",
+        s.t, s.status, s.deadman ? "ON " : "off", speed_step, sender, s.tip.x(), s.tip.y(),
+        s.tip.z(), s.tip_v.norm(), s.stop_reason, age);
+    std::fflush(stdout);
+  }
+
+  const control::LiveStatusBoard& board_;
+  const input::KeyboardSource* keyboard_;
+  const dds::DdsCommandSource* remote_;
+  std::string sender_;
+  bool draw_;
+  int disconnects_ = 0, reconnects_ = 0;
+  input::InputFault fault_ = input::InputFault::kNone;
+};
+
+void print_keys() {
+  std::printf(
+      "keys: space deadman on/off | w/s or up/down reach | a/d or left/right slew | r/f or "
+      "PgUp/PgDn height | +/- speed | l latch | x stop axes | q quit\n");
+}
+
+}  // namespace
+
+CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
+  auto* sim = cli.add_subcommand(
+      "sim",
+      "Drive the crane live: keyboard, joystick (evdev, SDL), a remote operator over DDS "
+      "Security or a replay file; the simulated crane, or with --backend can the machine on the "
+      "CAN bus");
+  sim->add_option("--config", args.config_file,
+                  "Crane config YAML (default: the embedded K70M reference crane)")
+      ->check(CLI::ExistingFile);
+  sim->add_option("--input", args.input,
+                  "keyboard (default on a terminal), evdev, sdl, dds (a remote operator, "
+                  "docs/remote-commands.md), or replay FILE")
+      ->expected(1, 2);
+  sim->add_option("--joystick", args.joystick_file,
+                  "Joystick mapping YAML (docs/joystick.md; default: the embedded "
+                  "config/joysticks/gamepad.yaml)")
+      ->check(CLI::ExistingFile);
+  sim->add_option("--device", args.device, "evdev: the device, e.g. /dev/input/event5");
+  sim->add_option(
+         "--duration", args.duration_s,
+         "Seconds to run (default: until q, Ctrl-C or SIGTERM; a replay: its length + 1 s)")
+      ->check(CLI::Range(0.01, 1e6));
+  sim->add_option("--log", args.log_file, "Per-cycle CSV log (docs/log-format.md)");
+  sim->add_option("--record", args.record_file,
+                  "Record the command the controller got, in the replay format");
+  sim->add_flag("--no-realtime", args.no_realtime,
+                "--input replay only: run as fast as possible on machine time");
+  sim->add_flag("--rt", args.rt,
+                "Real-time loop thread: lock memory and SCHED_FIFO priority 80 (docs/realtime.md)");
+  sim->add_flag("--lock-memory", args.lock_memory, "Lock the process's memory (mlockall)");
+  sim->add_option("--rt-priority", args.rt_priority,
+                  "SCHED_FIFO priority of the loop thread, 1..99 (0: the normal scheduler)")
+      ->check(CLI::Range(0, 99));
+  sim->add_option("--cpu", args.cpu, "Pin the loop thread to this core")
+      ->check(CLI::Range(0, 1023));
+  sim->add_option("--payload", args.payload_kg, "Payload mass in the grapple, kg")
+      ->check(CLI::Range(0.0, 100000.0));
+  sim->add_option("--initial", args.initial,
+                  "Start pose of the simulated crane, e.g. \"lift=0 deg, tilt=-125 deg, "
+                  "extension=0.2 m\" (joints left out keep the config's simulation.initial)");
+  add_resolution_option(*sim, args.resolution, "for the run");
+  add_backend_options(*sim, args.machine);
+  add_telemetry_options(*sim, args.telemetry, true);
+  return sim;
+}
+
+int run_sim_command(const SimArgs& args) {
+  std::string kind = args.input.empty() ? "keyboard" : args.input[0];
+  if (kind != "keyboard" && kind != "evdev" && kind != "sdl" && kind != "dds" && kind != "replay") {
+    spdlog::error("--input: unknown input '{}' (expected keyboard, evdev, sdl, dds or replay FILE)",
+                  kind);
+    return kExitUsage;
+  }
+  if ((kind == "replay") != (args.input.size() == 2)) {
+    spdlog::error(kind == "replay" ? "--input replay needs a FILE"
+                                   : "--input: only replay takes a FILE");
+    return kExitUsage;
+  }
+  if (args.no_realtime && kind != "replay") {
+    spdlog::error("--no-realtime works with --input replay only (devices run in real time)");
+    return kExitUsage;
+  }
+  if (kind == "keyboard" && !isatty(0)) {
+    spdlog::error(
+        "--input keyboard needs a terminal on stdin (give --input evdev, sdl or replay FILE)");
+    return kExitUsage;
+  }
+  config::CraneConfig cfg;
+  config::JoystickConfig jcfg;
+  config::TelemetryConfig tcfg;
+  std::optional<input::Replay> replay;
+  try {
+    cfg = args.config_file.empty() ? config::default_crane_config()
+                                   : config::load_crane_config(args.config_file);
+    if (args.payload_kg) config::set_payload_mass(cfg.model, *args.payload_kg);
+    if (!args.resolution.empty()) {
+      try {
+        config::set_resolution(cfg, args.resolution);
+      } catch (const std::invalid_argument& e) {
+        spdlog::error("--resolution: {}", e.what());
+        return kExitUsage;
+      }
+    }
+    if (!args.initial.empty()) {
+      if (uses_can_backend(args.machine, cfg)) {
+        spdlog::error("--initial: the can backend starts where the machine is (use --backend sim)");
+        return kExitUsage;
+      }
+      try {
+        cfg.simulation.q_initial =
+            config::parse_joint_pose(cfg.model, args.initial, cfg.simulation.q_initial);
+      } catch (const std::invalid_argument& e) {
+        spdlog::error("--initial: {}", e.what());
+        return kExitUsage;
+      }
+    }
+    jcfg = args.joystick_file.empty() ? config::default_joystick_config()
+                                      : config::load_joystick_config(args.joystick_file);
+    if (kind == "replay") replay = input::Replay::load_file(args.input[1]);
+    tcfg = load_telemetry_settings(args.telemetry);
+    if (kind == "dds") dds::check_command_input_settings(tcfg);
+  } catch (const config::ConfigError& e) {
+    spdlog::error("config: {}", e.what());
+    return kExitUsage;
+  } catch (const input::ReplayError& e) {
+    spdlog::error("replay: {}", e.what());
+    return kExitUsage;
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return kExitUsage;
+  }
+
+  if (args.no_realtime && uses_can_backend(args.machine, cfg)) {
+    spdlog::error("--no-realtime: the can backend always runs in real time");
+    return kExitUsage;
+  }
+
+  try {
+    Machine machines;
+    if (const int rc = machines.open(cfg, args.machine); rc != kExitOk) return rc;
+    valves::MachineInterface& machine = machines.get();
+    g_stop.store(false);
+    std::unique_ptr<input::CommandSource> source;
+    input::KeyboardSource* keyboard = nullptr;
+    dds::DdsCommandSource* remote = nullptr;
+    if (kind == "dds") {
+      auto d = std::make_unique<dds::DdsCommandSource>(tcfg);
+      remote = d.get();
+      source = std::move(d);
+      spdlog::info(
+          "dds input: craneassist/operator_command on DDS domain {} with DDS Security "
+          "({}); waiting for an operator (craneassist remote)",
+          tcfg.domain_id, tcfg.source_name);
+    } else if (kind == "keyboard") {
+      auto kb = std::make_unique<input::KeyboardSource>(0, jcfg.mapping, jcfg.keyboard, &g_stop);
+      keyboard = kb.get();
+      source = std::move(kb);
+    } else if (kind == "evdev") {
+      const std::string path = args.device.empty() ? jcfg.mapping.device_path : args.device;
+      source = std::make_unique<input::EvdevSource>(
+          jcfg.mapping, input::libevdev_opener(path, jcfg.mapping.device_name),
+          input::EvdevSource::Options{});
+    } else if (kind == "sdl") {
+      source = std::make_unique<input::SdlSource>(jcfg.mapping, input::SdlSource::Options{});
+    } else {
+      source = std::make_unique<input::ReplaySource>(*replay);
+    }
+    std::set_terminate([] {
+      input::KeyboardSource::restore_terminal();
+      std::abort();
+    });
+    struct sigaction sa = {};
+    sa.sa_handler = on_stop_signal;
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+
+    Telemetry telemetry;
+    if (const int rc = telemetry.open(tcfg, !args.telemetry.off, cfg, machine.name());
+        rc != kExitOk) {
+      return rc;
+    }
+    std::optional<control::CsvLog> log;
+    if (!args.log_file.empty()) log.emplace(args.log_file, cfg.model.dof());
+    std::vector<input::ReplayRow> record;
+    control::LiveStatusBoard board;
+    control::LiveOptions options;
+    options.monitor = jcfg.monitor;
+    options.realtime = !args.no_realtime;  // always on the can backend (checked above)
+    options.duration_s = args.duration_s > 0.0 ? args.duration_s
+                         : replay              ? replay->end_time_s() + 1.0
+                                               : 0.0;
+    options.stop = &g_stop;
+    options.status_board = &board;
+    options.realtime_setup.lock_memory = args.rt || args.lock_memory;
+    options.realtime_setup.priority = args.rt_priority > 0 ? args.rt_priority : args.rt ? 80 : 0;
+    options.realtime_setup.cpu = args.cpu;
+    if (control::CycleObserver* o = telemetry.observer()) options.observers.push_back(o);
+    if (!args.record_file.empty()) {
+      options.record = &record;
+      if (options.duration_s > 0.0) {
+        options.record_capacity =
+            static_cast<std::size_t>(options.duration_s * cfg.control.rate_hz) + 16;
+      }
+    }
+    spdlog::info("sim: {} input ({}) on {} with the {} backend, resolution {}{}", source->name(),
+                 jcfg.source_name, cfg.model.name, machine.name(),
+                 config::resolution_description(cfg),
+                 options.realtime ? ", real time" : ", as fast as possible");
+    if (keyboard != nullptr) print_keys();
+
+    std::atomic<bool> done{false};
+    StatusReporter reporter(board, keyboard, remote);
+    std::thread ui([&] { reporter.run(done); });
+    control::LiveSummary s;
+    try {
+      s = control::run_live(cfg, *source, machine, options, log ? &*log : nullptr);
+    } catch (...) {
+      done.store(true);
+      ui.join();
+      throw;
+    }
+    // Every valve to its safe state at once (Machine::finish() below deactivates and reports).
+    machine.safe_stop();
+    done.store(true);
+    ui.join();
+    std::optional<dds::CommandInputStats> remote_stats;
+    if (remote != nullptr) remote_stats = remote->stats();
+    source.reset();  // restores the terminal; ends the DDS input
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
+
+    if (!args.record_file.empty()) {
+      std::ofstream out(args.record_file, std::ios::binary);
+      if (!out) throw std::runtime_error(args.record_file + ": cannot open for writing");
+      input::write_replay(out, record);
+      if (!out) throw std::runtime_error(args.record_file + ": write failed");
+    }
+    std::printf("craneassist sim: %s input on %s, %s backend\n", kind.c_str(),
+                cfg.model.name.c_str(), machine.name());
+    std::printf("  ran %.2f s of machine time in %.2f s, %d cycles, latest cycle start %.1f ms\n",
+                s.duration_s, s.wall_time_s, s.cycles, s.max_late_s * 1e3);
+    std::printf("  tip: path %.2f m, peak speed %.2f m/s; operator command passed in %d cycles\n",
+                s.tip_path_m, s.peak_tip_speed_m_s, s.enabled_cycles);
+    std::printf("  cycle timing: %s\n", control::describe(s.timing).c_str());
+    if (options.realtime_setup.lock_memory || options.realtime_setup.priority > 0 ||
+        options.realtime_setup.cpu >= 0) {
+      const control::RealtimeResult& r = s.realtime_result;
+      std::printf("  real time: memory %s, %s, %s\n", r.memory_locked ? "locked" : "not locked",
+                  r.priority > 0 ? ("SCHED_FIFO " + std::to_string(r.priority)).c_str()
+                                 : "normal scheduler",
+                  r.cpu >= 0 ? ("core " + std::to_string(r.cpu)).c_str() : "any core");
+      if (!r.refused.empty()) spdlog::warn("real time: {}", r.refused);
+    }
+    std::printf("  input device: %d disconnects, %d re-attaches\n", s.disconnects, s.reconnects);
+    if (remote_stats) {
+      const dds::CommandInputStats& d = *remote_stats;
+      std::string from = " (no operator)";
+      if (d.first_sample_s >= 0.0) {
+        char first[32];
+        std::snprintf(first, sizeof first, "%.2f", d.first_sample_s);
+        from = " from '" + d.sender + "' (first " + first + " s after start)";
+      }
+      std::printf(
+          "  dds input: %llu samples%s, %llu lost, %llu non-finite, %llu from other senders; "
+          "writers matched %d (peak %d)\n",
+          static_cast<unsigned long long>(d.samples), from.c_str(),
+          static_cast<unsigned long long>(d.lost), static_cast<unsigned long long>(d.non_finite),
+          static_cast<unsigned long long>(d.other_senders), d.writer_matches,
+          d.peak_matched_writers);
+    }
+    if (log) std::printf("  log: %s (%zu rows)\n", log->path().c_str(), log->rows_written());
+    if (!args.record_file.empty()) {
+      std::printf("  record: %s (%zu rows%s)\n", args.record_file.c_str(), record.size(),
+                  s.record_rows_dropped > 0 ? ", SOME DROPPED" : "");
+    }
+    telemetry.finish();
+    if (s.log_rows_dropped > 0) spdlog::warn("{} log rows dropped", s.log_rows_dropped);
+    if (s.machine_fault) spdlog::error("the machine reported a fault: run stopped");
+    if (const int rc = machines.finish(); rc != kExitOk) return rc;
+  } catch (const std::exception& e) {
+    input::KeyboardSource::restore_terminal();
+    spdlog::error("{}", e.what());
+    return kExitRuntime;
+  }
+  return kExitOk;
+}
+
+}  // namespace craneassist::cli

@@ -1,0 +1,50 @@
+// DDS telemetry of `craneassist sim` and `craneassist replay`: the options, the settings file
+// (config/telemetry/default.yaml or --telemetry-config), and the publisher with its loop
+// observer. One place for both commands.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "craneassist/config/crane_config.hpp"
+#include "craneassist/config/telemetry_config.hpp"
+#include "craneassist/dds/telemetry_publisher.hpp"
+#include "telemetry_observer.hpp"
+
+namespace craneassist::cli {
+
+struct TelemetryArgs {
+  bool on = false;            // replay: --telemetry (replay publishes only when asked)
+  bool off = false;           // sim: --no-telemetry
+  std::string config_file;    // --telemetry-config FILE; empty: the embedded default
+  std::optional<int> domain;  // --domain N overrides the file's domain_id
+};
+
+// sim (publishes by default, as the settings file says): --no-telemetry, --telemetry-config,
+// --domain. replay (off by default): --telemetry, --telemetry-config (implies --telemetry),
+// --domain.
+void add_telemetry_options(CLI::App& command, TelemetryArgs& args, bool on_by_default);
+
+// Reads the settings file and applies --domain; throws config::ConfigError.
+config::TelemetryConfig load_telemetry_settings(const TelemetryArgs& args);
+
+class Telemetry {
+ public:
+  // Starts publishing when `wanted` (and the settings enable it); returns kExitOk, or logs why
+  // DDS could not start and returns kExitRuntime.
+  int open(const config::TelemetryConfig& settings, bool wanted, const config::CraneConfig& cfg,
+           const char* backend);
+  // The loop observer, or nullptr when not publishing.
+  control::CycleObserver* observer() { return observer_ ? &*observer_ : nullptr; }
+  // Publishes the last frames, prints the counters line.
+  void finish();
+
+ private:
+  std::unique_ptr<dds::TelemetryPublisher> publisher_;
+  std::optional<cli::TelemetryObserver> observer_;
+  int domain_ = 0;
+};
+
+}  // namespace craneassist::cli

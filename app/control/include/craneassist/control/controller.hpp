@@ -1,0 +1,116 @@
+// The per-cycle control pipeline, read top to bottom (MoveIt Servo's shape). With full scaling
+// (the default):
+//   tip-velocity command
+//   -> the path direction u: the reference velocity's (at rest: the command's)  scaling::TipScaler
+//   -> redundancy resolution of u, f' and f'', joints kept off their ends       scaling::TipPath
+//   -> speed limits along u: flow, cylinder speeds, end damping, power, tracking error,
+//      singularity: one factor on the whole command
+//   -> acceleration bounds from the ODE dynamics (load-sensing power, cylinder accelerations)
+//   -> the reference tip velocity moved towards the scaled command along the straight segment
+//      between them, jerk-limited                                                scaling::TipScaler
+//   -> reference integration along the path (the reference runs on its own joint state q_ref)
+//   -> valve commands: dead-zone inverse of the cylinder velocity reference plus P feedback on
+//      the cylinder position error against the reference of one valve delay ago
+// The other modes are baselines: kFlowOnly prescales the joint rates for flow and cylinder speed
+// only (no power limit, no filter); kNone passes the command through unscaled.
+// Constructed once with the model; update() allocates nothing and throws nothing.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "craneassist/config/crane_config.hpp"
+#include "craneassist/control/control_loop.hpp"
+#include "craneassist/dynamics/kinematics.hpp"
+#include "craneassist/dynamics/redundancy.hpp"
+#include "craneassist/dynamics/rigid_body_terms.hpp"
+#include "craneassist/scaling/active_limit.hpp"
+#include "craneassist/scaling/flow_prescaling.hpp"
+#include "craneassist/scaling/tip_path.hpp"
+#include "craneassist/scaling/tip_scaler.hpp"
+#include "craneassist/valves/machine_interface.hpp"
+#include "craneassist/valves/reference_follower.hpp"
+
+namespace craneassist::control {
+
+using dynamics::JointVector;
+
+enum class ScalingMode {
+  kFull,      // power-limited, jerk-bounded path scaling
+  kFlowOnly,  // uniform flow and cylinder-speed prescaling only
+  kNone,      // no scaling (what a machine without craneassist does)
+};
+const char* to_string(ScalingMode mode);
+
+struct ControllerOptions {
+  ScalingMode mode = ScalingMode::kFull;
+  // How often a command reaches the valves (MachineInterface::command_period_s; 0: every cycle).
+  double valve_command_period_s = 0.0;
+};
+
+struct ControllerOutput {
+  valves::ValveCommand valves;
+  JointVector q_ref, qdot_ref;
+  Eigen::Vector3d ref_tip_velocity_m_s = Eigen::Vector3d::Zero();
+  double scale = 1.0;             // reference tip speed over commanded tip speed
+  double flow_demand_m3_s = 0.0;  // of the unscaled command
+  scaling::ActiveLimit limit = scaling::ActiveLimit::kNone;
+  // Path scaling (kFull; zero otherwise).
+  double s = 0.0, sdot = 0.0, sddot = 0.0, sdddot = 0.0;
+  double sddot_min = 0.0, sddot_max = 0.0;
+  double tip_error_m = 0.0;  // filtered tracking error used for the slow-down
+  double ref_power_w = 0.0;  // pump power (LS, or p_s Q) the model predicts for the reference
+};
+
+// The controller's status is the cycle status of the loop (control_loop.hpp).
+using ControllerStatus = CycleStatus;
+
+class Controller {
+ public:
+  Controller(const config::CraneConfig& config, const ControllerOptions& options);
+  ~Controller();
+
+  // Starts the reference at the measured configuration, at rest.
+  void reset(const valves::MachineState& state);
+
+  // One control period. An invalid measurement or a non-finite command brings the motion to a
+  // jerk-limited stop along the current direction (kStopping, limit stale_input) and then holds
+  // with neutral valves (kStopped); the other modes stop at once. The first valid cycle after
+  // kStopped restarts the reference at the measured configuration (as reset()).
+  ControllerStatus update(const valves::MachineState& state, const Eigen::Vector3d& v_cmd_m_s,
+                          ControllerOutput& out);
+
+  double period_s() const { return period_s_; }
+  // How often a command reaches the valves (ControllerOptions::valve_command_period_s).
+  void set_valve_command_period(double period_s);
+
+ private:
+  void update_full(const valves::MachineState& state, const Eigen::Vector3d& v_cmd, bool stale,
+                   ControllerOutput& out);
+  void update_rate_prescaled(const Eigen::Vector3d& v_cmd, ControllerOutput& out);
+
+  const dynamics::CraneModel& model_;
+  ControllerOptions options_;
+  double period_s_;
+  double flow_reserve_;
+  double tracking_error_ok_m_;
+  double tracking_alpha_;
+  valves::ReferenceFollower follower_;
+  std::unique_ptr<dynamics::RigidBodyTerms> terms_;
+  std::unique_ptr<scaling::TipPath> tip_path_;
+  std::unique_ptr<scaling::TipScaler> scaler_;
+  // Per-cycle working data (Pinocchio's Data), preallocated.
+  dynamics::KinematicsData kin_;
+  dynamics::TaskJacobian jacobian_;
+  dynamics::JointRateBounds bounds_;
+  dynamics::SnsResult sns_;
+  scaling::FlowPrescalingResult prescale_;
+  scaling::TipPathOutput tip_out_;
+  scaling::TipScalerOutput scaler_out_;
+  JointVector dc_dq_, qddot_max_, cylinder_force_;
+  JointVector q_ref_;
+  double tip_error_filtered_m_ = 0.0;
+  bool neutral_ = false;  // the last update returned kStopped (valves neutral)
+};
+
+}  // namespace craneassist::control

@@ -1,0 +1,92 @@
+// The per-cycle CSV log (columns in docs/log-format.md).
+//
+// The control loop hands each row to a fixed-size single-producer/single-consumer ring and
+// returns at once: no lock, no allocation, no I/O on the loop thread. A writer thread formats
+// and writes the rows. If the writer falls behind and the ring fills, rows are dropped and
+// counted (never the loop blocked); close() reports the count.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "craneassist/dynamics/model.hpp"
+#include "craneassist/valves/machine_interface.hpp"
+
+namespace craneassist::control {
+
+struct LogRow {
+  static constexpr int kMaxJoints = dynamics::kMaxJoints;
+  double t = 0.0;
+  std::array<double, 3> cmd{}, ref_v{}, tip{}, tip_v{};
+  std::array<double, kMaxJoints> q{}, q_ref{}, spool{}, load_pressure{};
+  double pump_flow_m3s = 0.0, pump_pressure_pa = 0.0, pump_power_w = 0.0, energy_j = 0.0;
+  double scale = 0.0, flow_demand_m3s = 0.0;
+  double s = 0.0, sdot = 0.0, sddot = 0.0, sdddot = 0.0, sddot_min = 0.0, sddot_max = 0.0;
+  double tip_error_m = 0.0;
+  double ref_power_w = 0.0;       // pump power the model predicts for the reference
+  const char* active_limit = "";  // static strings only (to_string of the enums)
+  const char* pump_limit = "";
+  // Live-loop fields (the live loop and telemetry fill them; the CSV writer does not write them):
+  // joint rates, cylinder positions and velocities, loop and input status. Static strings only.
+  std::array<double, kMaxJoints> qdot{}, cylinder_pos{}, cylinder_vel{};
+  const char* status = "";       // "running", "stopping", "stopped"
+  const char* stop_reason = "";  // why the loop stops or holds ("" while running)
+  const char* input_source = "";
+  bool deadman = false;
+  // Cycle timing (the control loop fills them, cycle_timing.hpp): the worst start latency of the
+  // run so far (0 when not paced), the previous cycle's compute time, the overruns so far.
+  double loop_latency_max_s = 0.0, loop_compute_s = 0.0;
+  long loop_overruns = 0;
+
+  // The pump columns from a measurement.
+  void set_pump(const valves::PumpMeasurement& pump) {
+    pump_flow_m3s = pump.flow_m3_s;
+    pump_pressure_pa = pump.pressure_pa;
+    pump_power_w = pump.power_w;
+    energy_j = pump.energy_j;
+    pump_limit = valves::to_string(pump.limit);
+  }
+};
+
+class CsvLog {
+ public:
+  // Opens the file and writes the header; throws std::runtime_error naming the file on failure.
+  CsvLog(const std::filesystem::path& path, int dof, std::size_t capacity_rows = 1 << 14);
+  ~CsvLog();
+  CsvLog(const CsvLog&) = delete;
+  CsvLog& operator=(const CsvLog&) = delete;
+
+  // Real-time safe: copies the row into the ring; returns false (and counts) when full.
+  bool push(const LogRow& row) noexcept;
+
+  // Drains the ring, stops the writer and closes the file. Returns the number of dropped rows.
+  std::size_t close();
+
+  std::size_t rows_written() const { return written_.load(); }
+  const std::filesystem::path& path() const { return path_; }
+
+  static std::string header(int dof);
+
+ private:
+  void writer_loop();
+  void write_row(const LogRow& row);
+
+  std::filesystem::path path_;
+  int dof_;
+  std::FILE* file_ = nullptr;
+  std::vector<LogRow> ring_;
+  std::atomic<std::size_t> head_{0};  // next slot the producer writes
+  std::atomic<std::size_t> tail_{0};  // next slot the consumer reads
+  std::atomic<bool> stop_{false};
+  std::atomic<std::size_t> dropped_{0};
+  std::atomic<std::size_t> written_{0};
+  std::thread writer_;
+};
+
+}  // namespace craneassist::control

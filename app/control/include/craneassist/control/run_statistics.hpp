@@ -1,0 +1,74 @@
+// What a run did, gathered cycle by cycle by an observer of the control loop: pump energy and
+// peaks, tip speed and path, and for tip-velocity runs the direction errors, the active limits,
+// stops and the operator feel (motion_quality.hpp). The replay summary and the live summary
+// both come from it.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+
+#include "craneassist/control/control_loop.hpp"
+#include "craneassist/control/motion_quality.hpp"
+#include "craneassist/scaling/active_limit.hpp"
+
+namespace craneassist::control {
+
+struct RunStatisticsOptions {
+  // Direction statistics count a cycle when the reference direction has been on the command
+  // (within 0.5 deg, i.e. direction blending done) this long and the measured tip moves faster
+  // than min_speed_m_s.
+  double steady_after_s = 0.5;
+  double min_speed_m_s = 0.05;
+};
+
+struct RunSummary {
+  int cycles = 0;
+  double duration_s = 0.0;   // machine time
+  double wall_time_s = 0.0;  // computer time
+  double energy_j = 0.0;
+  double peak_power_w = 0.0;
+  double peak_flow_m3_s = 0.0;
+  double peak_tip_speed_m_s = 0.0;
+  double tip_path_m = 0.0;  // over valid measurements
+  // Angle between commanded and measured tip velocity (steady cycles, see RunStatisticsOptions).
+  double max_direction_error_deg = 0.0;
+  double rms_direction_error_deg = 0.0;
+  int direction_samples = 0;
+  // Angle between commanded and reference tip velocity (what the controller asked for).
+  double max_reference_direction_error_deg = 0.0;
+  int pump_saturated_cycles = 0;
+  double peak_path_jerk = 0.0;   // max |sdddot| of the reference (full scaling)
+  int stopped_cycles = 0;        // the controller stopping or stopped (kStopping, kStopped)
+  int input_stop_cycles = 0;     // cycles without a command (a replay stop row, an input fault)
+  int neutral_valve_cycles = 0;  // kStopped: at rest with every valve neutral
+  std::array<int, scaling::kActiveLimitCount> limit_cycles{};  // indexed by scaling::ActiveLimit
+  bool machine_fault = false;                                  // the loop stopped for it
+  std::size_t log_rows_dropped = 0;
+  MotionQualityResult feel;  // stall events and lateral speed (motion_quality.hpp)
+};
+
+class RunStatistics final : public CycleObserver {
+ public:
+  RunStatistics(double period_s, const RunStatisticsOptions& options = {});
+  void on_cycle(const CycleRecord& cycle) noexcept override;
+  void on_finish(const CycleTime& last, const valves::MachineState& state) override;
+
+  // The statistics with the loop's own figures (cycles, times, fault, dropped rows).
+  RunSummary summary(const LoopSummary& loop) const;
+
+ private:
+  double period_s_;
+  RunStatisticsOptions options_;
+  RunSummary s_;
+  MotionQuality quality_;
+  double sum_sq_direction_ = 0.0;
+  Eigen::Vector3d last_cmd_ = Eigen::Vector3d::Zero();
+  double cmd_since_s_ = 0.0;
+  Eigen::Vector3d last_tip_ = Eigen::Vector3d::Zero();
+  bool last_tip_valid_ = false;
+};
+
+// Angle between two vectors in degrees (0 when either is zero).
+double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b);
+
+}  // namespace craneassist::control

@@ -1,0 +1,229 @@
+#include "craneassist/control/controller.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "craneassist/dynamics/cylinders.hpp"
+
+namespace craneassist::control {
+namespace {
+
+scaling::PowerBound to_power_bound(config::PowerBoundSetting s) {
+  switch (s) {
+    case config::PowerBoundSetting::kLoadSensing:
+      return scaling::PowerBound::kLoadSensing;
+    case config::PowerBoundSetting::kActuatorSum:
+      return scaling::PowerBound::kActuatorPowerSum;
+    case config::PowerBoundSetting::kNone:
+      return scaling::PowerBound::kNone;
+  }
+  return scaling::PowerBound::kLoadSensing;
+}
+
+}  // namespace
+
+const char* to_string(ScalingMode mode) {
+  switch (mode) {
+    case ScalingMode::kFull:
+      return "full";
+    case ScalingMode::kFlowOnly:
+      return "flow";
+    case ScalingMode::kNone:
+      return "none";
+  }
+  return "?";
+}
+
+Controller::Controller(const config::CraneConfig& config, const ControllerOptions& options)
+    : model_(config.model),
+      options_(options),
+      period_s_(1.0 / config.control.rate_hz),
+      flow_reserve_(config.control.flow_reserve),
+      tracking_error_ok_m_(config.scaling.tracking_error_ok_m),
+      tracking_alpha_(period_s_ / (config.scaling.tracking_error_filter_s + period_s_)),
+      // The live loop keeps every section under feedback: the activation rule is for executing
+      // planned trajectories (trajectory_runner.hpp), whose at-rest cylinders the planner counts
+      // as closed.
+      follower_(config.model, config.control.position_gain_1_s, period_s_) {
+  follower_.set_command_period(options.valve_command_period_s);
+  const int n = model_.dof();
+  q_ref_ = config.simulation.q_initial;
+  dc_dq_.setZero(n);
+  qddot_max_.setZero(n);
+  if (options_.mode == ScalingMode::kFull) {
+    const auto& sc = config.scaling;
+    terms_ = std::make_unique<dynamics::RigidBodyTerms>(model_);
+    scaling::TipPathConfig path;
+    path.period_s = period_s_;
+    path.jerk_max = sc.jerk_max_m_s3;
+    path.deceleration_max = sc.deceleration_max_m_s2;
+    path.flow_reserve = flow_reserve_;
+    path.resolution = config.redundancy.resolution;
+    tip_path_ = std::make_unique<scaling::TipPath>(model_, path);
+    scaling::TipScalerConfig scaler;
+    scaler.period_s = period_s_;
+    scaler.jerk_max = sc.jerk_max_m_s3;
+    scaler.acceleration_max = sc.acceleration_max_m_s2;
+    scaler.deceleration_max = sc.deceleration_max_m_s2;
+    scaler.normal_acceleration_max = sc.direction_change_acceleration_m_s2;
+    scaler.flow_reserve = flow_reserve_;
+    scaler.power_bound = to_power_bound(sc.power_bound);
+    scaler.power_reserve = sc.power_reserve;
+    scaler_ = std::make_unique<scaling::TipScaler>(model_, scaler, *terms_);
+  }
+}
+
+Controller::~Controller() = default;
+
+void Controller::set_valve_command_period(double period_s) {
+  options_.valve_command_period_s = period_s;
+  follower_.set_command_period(period_s);
+}
+
+void Controller::reset(const valves::MachineState& state) {
+  q_ref_ = state.q;
+  follower_.reset(q_ref_);
+  tip_error_filtered_m_ = 0.0;
+  neutral_ = false;
+  if (tip_path_) tip_path_->reset();
+  if (scaler_) scaler_->reset();
+}
+
+ControllerStatus Controller::update(const valves::MachineState& state, const Eigen::Vector3d& v_cmd,
+                                    ControllerOutput& out) {
+  const int n = model_.dof();
+  const bool state_ok =
+      state.valid && state.q.size() == n && state.q.allFinite() && state.qdot.allFinite();
+  const bool command_ok = v_cmd.allFinite();
+  const bool stale = !state_ok || !command_ok;
+  out.flow_demand_m3_s = 0.0;
+  // Resuming after a stop with neutral valves: the machine stood on its holding valves, so the
+  // reference starts again from where it is measured (no P-feedback jump towards the old one).
+  if (neutral_ && !stale) reset(state);
+
+  if (options_.mode == ScalingMode::kFull) {
+    update_full(state, command_ok ? v_cmd : Eigen::Vector3d::Zero(), stale, out);
+  } else if (stale) {
+    out.qdot_ref.setZero(n);
+    out.ref_tip_velocity_m_s.setZero();
+    out.scale = 0.0;
+    out.limit = scaling::ActiveLimit::kStaleInput;
+    out.s = out.sdot = out.sddot = out.sdddot = out.sddot_min = out.sddot_max = 0.0;
+  } else {
+    update_rate_prescaled(v_cmd, out);
+  }
+  out.q_ref = q_ref_;
+
+  const bool at_rest = out.qdot_ref.isZero(0.0) && out.sddot == 0.0 &&
+                       (options_.mode != ScalingMode::kFull || scaler_out_.at_rest);
+  if (stale && at_rest) {
+    follower_.neutral(out.valves);  // stopped: valves neutral
+    neutral_ = true;
+    return ControllerStatus::kStopped;
+  }
+  follower_.update(q_ref_, out.qdot_ref, state_ok ? &state.q : nullptr, out.valves);
+  return stale ? ControllerStatus::kStopping : ControllerStatus::kRunning;
+}
+
+void Controller::update_full(const valves::MachineState& state, const Eigen::Vector3d& v_cmd,
+                             bool stale, ControllerOutput& out) {
+  // Tracking error of the measured tip against the reference of one valve delay ago, filtered.
+  const bool state_ok = state.valid && state.q.size() == model_.dof() && state.q.allFinite();
+  if (state_ok) {
+    const Eigen::Vector3d tip_meas = dynamics::tip_position(model_, kin_, state.q);
+    const Eigen::Vector3d tip_ref =
+        dynamics::tip_position(model_, kin_, follower_.delayed_reference_q());
+    const double error = (tip_ref - tip_meas).norm();
+    tip_error_filtered_m_ += tracking_alpha_ * (error - tip_error_filtered_m_);
+  }
+
+  // The present cylinder forces, from last cycle's dynamics terms (min-ls-power resolves the
+  // redundancy at the current loads).
+  const JointVector* forces = nullptr;
+  if (scaler_out_.terms.b.size() == model_.dof()) {
+    dynamics::cylinder_arms(model_, q_ref_, dc_dq_);
+    cylinder_force_ = scaler_out_.terms.b.cwiseQuotient(dc_dq_);
+    forces = &cylinder_force_;
+  }
+  const Eigen::Vector3d u = scaler_->direction(v_cmd);
+  scaling::TipPathInput path_in;
+  path_in.direction = u;
+  path_in.sdot = scaler_->speed();
+  path_in.intended_speed = stale ? path_in.sdot : scaler_->intended_speed(v_cmd);
+  path_in.cylinder_force = forces;
+  tip_path_->update(q_ref_, path_in, tip_out_);
+  scaling::TipScalerInput in;
+  in.command = v_cmd;
+  in.direction = u;
+  in.tracking_factor = scaling::tracking_factor(tip_error_filtered_m_, tracking_error_ok_m_);
+  in.sdot_joint_limit = tip_out_.sdot_joint_limit;
+  in.end_distance_m = tip_out_.end_distance_m;
+  in.stop_deceleration_m_s2 = tip_out_.stop_deceleration_m_s2;
+  in.stop_jerk_m_s3 = tip_out_.stop_jerk_m_s3;
+  in.near_singular = tip_out_.near_singular;
+  in.stale_input = stale;
+  scaler_->update(q_ref_, tip_out_.geometry, in, scaler_out_);
+
+  // The reference moves along u by the tip displacement of this cycle.
+  const auto& g = tip_out_.geometry;
+  const double ds = scaler_out_.ds;
+  for (int i = 0; i < model_.dof(); ++i) {
+    const auto& joint = model_.joints[static_cast<std::size_t>(i)];
+    q_ref_[i] =
+        std::clamp(q_ref_[i] + g.f1[i] * ds + 0.5 * g.f2[i] * ds * ds, joint.q_min, joint.q_max);
+  }
+  const double along = scaler_out_.velocity.dot(u);
+  out.qdot_ref = g.f1 * along;
+  out.ref_tip_velocity_m_s = u * along;  // = J(q_ref) qdot_ref
+  const double v_cmd_norm = v_cmd.norm();
+  out.scale = v_cmd_norm > 0.0 ? scaler_out_.sdot / v_cmd_norm : 1.0;
+  out.flow_demand_m3_s = scaler_out_.speed.flow_per_speed_m3 * v_cmd_norm;
+  out.limit = scaler_out_.limit;
+  out.s = scaler_out_.s;
+  out.sdot = scaler_out_.sdot;
+  out.sddot = scaler_out_.at_rest ? 0.0 : scaler_out_.sddot;
+  out.sdddot = scaler_out_.sdddot;
+  out.sddot_min = scaler_out_.bounds.sddot_min;
+  out.sddot_max = scaler_out_.bounds.sddot_max;
+  out.tip_error_m = tip_error_filtered_m_;
+  out.ref_power_w =
+      scaling::pump_power(model_, g, scaler_out_.terms, std::abs(along), scaler_out_.sddot);
+}
+
+void Controller::update_rate_prescaled(const Eigen::Vector3d& v_cmd, ControllerOutput& out) {
+  const int n = model_.dof();
+  dynamics::cylinder_arms(model_, q_ref_, dc_dq_);
+  for (int i = 0; i < n; ++i) {
+    qddot_max_[i] = model_.cylinders[static_cast<std::size_t>(i)].a_max_m_s2 / std::abs(dc_dq_[i]);
+  }
+  // Redundancy resolution. Its bounds only keep the joints off their ends; speed limits are the
+  // prescaling's job, applied uniformly.
+  dynamics::tip_jacobian(model_, kin_, q_ref_, jacobian_);
+  constexpr double kUnbounded = 1e3;
+  dynamics::joint_rate_bounds(model_, q_ref_, JointVector::Constant(n, kUnbounded), qddot_max_,
+                              period_s_, bounds_);
+  dynamics::sns_velocity_ik(jacobian_, v_cmd, bounds_, sns_);
+
+  double scale = sns_.task_scale;
+  out.limit = sns_.task_scale < 1.0 - 1e-9 ? scaling::ActiveLimit::kJointLimit
+                                           : scaling::ActiveLimit::kNone;
+  scaling::flow_prescale(model_, dc_dq_, sns_.qdot, flow_reserve_, prescale_);
+  out.flow_demand_m3_s = prescale_.flow_demand_m3_s;
+  const bool prescale = options_.mode == ScalingMode::kFlowOnly;
+  if (prescale && prescale_.scale < 1.0) {
+    scale *= prescale_.scale;
+    out.limit = prescale_.limit;
+  }
+  out.qdot_ref = sns_.qdot * (prescale ? prescale_.scale : 1.0);
+  out.scale = v_cmd.norm() > 0.0 ? scale : 1.0;
+  out.ref_tip_velocity_m_s = jacobian_ * out.qdot_ref;
+  for (int i = 0; i < n; ++i) {
+    const auto& joint = model_.joints[static_cast<std::size_t>(i)];
+    q_ref_[i] = std::clamp(q_ref_[i] + out.qdot_ref[i] * period_s_, joint.q_min, joint.q_max);
+  }
+  out.s = out.sdot = out.sddot = out.sdddot = out.sddot_min = out.sddot_max = 0.0;
+  out.tip_error_m = 0.0;
+  out.ref_power_w = 0.0;
+}
+
+}  // namespace craneassist::control

@@ -1,0 +1,66 @@
+#include "craneassist/control/log_row_builder.hpp"
+
+#include <cmath>
+
+#include "craneassist/dynamics/cylinders.hpp"
+
+namespace craneassist::control {
+
+LogRowBuilder::LogRowBuilder(const dynamics::CraneModel& model)
+    : model_(model), cyl_pos_(model.dof()), cyl_arm_(model.dof()) {
+  // Size the working data once (forward kinematics at the zero configuration).
+  dynamics::JointVector q = dynamics::JointVector::Zero(model.dof());
+  dynamics::tip_jacobian(model_, kin_, q, jac_);
+}
+
+void LogRowBuilder::measure(const valves::MachineState& state) noexcept {
+  const int n = model_.dof();
+  if (state.valid) {
+    dynamics::tip_jacobian(model_, kin_, state.q, jac_);
+    tip_ = model_.task_from_base * kin_.frames[static_cast<std::size_t>(n)].translation();
+    tip_v_ = jac_ * state.qdot;
+    dynamics::cylinder_lengths(model_, state.q, cyl_pos_);
+    dynamics::cylinder_arms(model_, state.q, cyl_arm_);
+  } else {
+    tip_.setZero();
+    tip_v_.setZero();
+  }
+}
+
+void LogRowBuilder::fill(LogRow& row, double t, const Eigen::Vector3d& cmd,
+                         const ControllerOutput& out,
+                         const valves::MachineState& state) const noexcept {
+  const int n = model_.dof();
+  row.t = t;
+  for (int a = 0; a < 3; ++a) {
+    const auto s = static_cast<std::size_t>(a);
+    row.cmd[s] = cmd[a];
+    row.ref_v[s] = out.ref_tip_velocity_m_s[a];
+    row.tip[s] = tip_[a];
+    row.tip_v[s] = tip_v_[a];
+  }
+  for (int i = 0; i < n; ++i) {
+    const auto s = static_cast<std::size_t>(i);
+    row.q[s] = state.valid ? state.q[i] : NAN;
+    row.q_ref[s] = out.q_ref[i];
+    row.spool[s] = out.valves.spool[i];
+    row.load_pressure[s] = state.valid ? state.load_pressure_pa[i] : NAN;
+    row.qdot[s] = state.valid ? state.qdot[i] : NAN;
+    row.cylinder_pos[s] = state.valid ? cyl_pos_[i] : NAN;
+    row.cylinder_vel[s] = state.valid ? cyl_arm_[i] * state.qdot[i] : NAN;
+  }
+  row.set_pump(state.pump);
+  row.active_limit = scaling::to_string(out.limit);
+  row.scale = out.scale;
+  row.s = out.s;
+  row.sdot = out.sdot;
+  row.sddot = out.sddot;
+  row.sdddot = out.sdddot;
+  row.sddot_min = out.sddot_min;
+  row.sddot_max = out.sddot_max;
+  row.tip_error_m = out.tip_error_m;
+  row.ref_power_w = out.ref_power_w;
+  row.flow_demand_m3s = out.flow_demand_m3_s;
+}
+
+}  // namespace craneassist::control

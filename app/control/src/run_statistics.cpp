@@ -1,0 +1,85 @@
+#include "craneassist/control/run_statistics.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "craneassist/control/controller.hpp"
+
+namespace craneassist::control {
+
+double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const double na = a.norm(), nb = b.norm();
+  if (na == 0.0 || nb == 0.0) return 0.0;
+  return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
+}
+
+RunStatistics::RunStatistics(double period_s, const RunStatisticsOptions& options)
+    : period_s_(period_s), options_(options), quality_(period_s) {}
+
+void RunStatistics::on_cycle(const CycleRecord& c) noexcept {
+  const LogRow& row = c.row;
+  const double t = c.time.t_s;
+  const Eigen::Vector3d cmd(row.cmd[0], row.cmd[1], row.cmd[2]);
+  const Eigen::Vector3d tip(row.tip[0], row.tip[1], row.tip[2]);
+  const Eigen::Vector3d tip_v(row.tip_v[0], row.tip_v[1], row.tip_v[2]);
+  const bool input_stop = !cmd.allFinite();
+
+  if (c.status != CycleStatus::kRunning) ++s_.stopped_cycles;
+  s_.neutral_valve_cycles += c.status == CycleStatus::kStopped;
+  s_.input_stop_cycles += input_stop;
+  s_.peak_power_w = std::max(s_.peak_power_w, c.state.pump.power_w);
+  s_.peak_flow_m3_s = std::max(s_.peak_flow_m3_s, c.state.pump.flow_m3_s);
+  s_.pump_saturated_cycles += c.state.pump.limit != valves::PumpLimit::kNone;
+  const double speed = tip_v.norm();
+  s_.peak_tip_speed_m_s = std::max(s_.peak_tip_speed_m_s, speed);
+  // The path over valid measurements only (an invalid one, e.g. a CAN fault, has no tip).
+  if (c.time.k > 0 && c.state.valid && last_tip_valid_) s_.tip_path_m += (tip - last_tip_).norm();
+  last_tip_ = tip;
+  last_tip_valid_ = c.state.valid;
+  quality_.add(t, cmd, tip, tip_v);
+
+  const ControllerOutput* out = c.controller;
+  if (out == nullptr) return;
+  s_.peak_path_jerk = std::max(s_.peak_path_jerk, std::abs(out->sdddot));
+  ++s_.limit_cycles[static_cast<std::size_t>(out->limit)];
+  if (!(cmd == last_cmd_ || (input_stop && !last_cmd_.allFinite()))) {
+    last_cmd_ = cmd;
+    cmd_since_s_ = t;
+  }
+  // Direction statistics: the reference has been on the command (direction blending done) for
+  // the settling window, and the tip moves.
+  const bool moving_cmd = cmd.norm() > 0.0;  // false for a non-finite command too
+  if (!(moving_cmd && angle_deg(cmd, out->ref_tip_velocity_m_s) < 0.5)) {
+    cmd_since_s_ = t + period_s_;  // not on the command yet: the window starts later
+  }
+  if (moving_cmd && speed > options_.min_speed_m_s && t - cmd_since_s_ >= options_.steady_after_s) {
+    const double err = angle_deg(cmd, tip_v);
+    s_.max_direction_error_deg = std::max(s_.max_direction_error_deg, err);
+    sum_sq_direction_ += err * err;
+    ++s_.direction_samples;
+  }
+  if (moving_cmd && out->ref_tip_velocity_m_s.norm() > 1e-9) {
+    s_.max_reference_direction_error_deg =
+        std::max(s_.max_reference_direction_error_deg, angle_deg(cmd, out->ref_tip_velocity_m_s));
+  }
+}
+
+void RunStatistics::on_finish(const CycleTime&, const valves::MachineState& state) {
+  s_.energy_j = state.pump.energy_j;
+}
+
+RunSummary RunStatistics::summary(const LoopSummary& loop) const {
+  RunSummary s = s_;
+  s.feel = quality_.result();
+  s.cycles = static_cast<int>(loop.cycles);
+  s.duration_s = loop.duration_s;
+  s.wall_time_s = loop.wall_time_s;
+  s.machine_fault = loop.machine_fault;
+  s.log_rows_dropped = loop.log_rows_dropped;
+  s.rms_direction_error_deg =
+      s.direction_samples > 0 ? std::sqrt(sum_sq_direction_ / s.direction_samples) : 0.0;
+  return s;
+}
+
+}  // namespace craneassist::control

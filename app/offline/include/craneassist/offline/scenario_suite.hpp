@@ -1,0 +1,67 @@
+// A scenario suite: replays, start poses, payloads and the targets each run must meet, read from
+// a YAML manifest (format craneassist-suite/1, docs/suite-format.md; the operator-feel suite is
+// examples/replays/suite.yaml). Each run goes through the same loop as `craneassist replay` on the
+// simulated crane and is checked against its targets (stall events, lateral speed, peak pump
+// power, direction error; app/motion_quality.hpp).
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "craneassist/config/crane_config.hpp"
+#include "craneassist/control/replay_runner.hpp"
+
+namespace craneassist::offline {
+
+struct SuiteTargets {
+  std::optional<int> stall_events;            // at most this many
+  std::optional<double> lateral_speed_m_s;    // one-line replays only, over 50 ms
+  std::optional<double> peak_power_share;     // measured pump power over P_max
+  std::optional<double> direction_error_rad;  // commanded vs measured, steady cycles
+};
+
+struct SuiteRun {
+  std::string replay_text;       // as the manifest writes it
+  std::filesystem::path replay;  // resolved against the manifest's folder
+  std::string pose;              // "default" or a name from poses:
+  std::string pose_text;         // NAME=VALUE UNIT, ...; empty for default
+  double payload_kg = 0.0;
+  SuiteTargets targets;
+  int line = 0;       // of the run in the manifest
+  int pose_line = 0;  // of its pose
+  std::string name() const { return replay_text + " @" + pose; }
+};
+
+struct Suite {
+  std::string source;
+  std::vector<SuiteRun> runs;  // one per replay and pose
+};
+
+// Read and validate a manifest; replay files must exist. Throw config::ConfigError naming the
+// file, line and field.
+Suite load_suite(const std::filesystem::path& path);
+Suite parse_suite(std::string_view yaml_text, std::string_view source_name,
+                  const std::filesystem::path& base_dir);
+
+// Checks every pose against the crane that runs the suite (joint names, ranges); throws
+// config::ConfigError naming the manifest, the pose's line and field.
+void check_suite(const Suite& suite, const config::CraneConfig& cfg);
+
+struct SuiteOutcome {
+  control::RunSummary summary;
+  double p_max_w = 0.0;
+  std::vector<std::string> missed;  // the targets the run missed, each with its figure
+  bool ok() const { return missed.empty(); }
+};
+
+// Runs one entry on the simulated crane described by base (its payload and start pose applied)
+// with the given resolution (a name config::set_resolution takes; empty: base's). log_file empty:
+// no log. Throws what loading the replay or the pose throws (the manifest was checked, so only
+// for files changed since).
+SuiteOutcome run_suite_run(const config::CraneConfig& base, const SuiteRun& run,
+                           const std::string& resolution, const std::filesystem::path& log_file);
+
+}  // namespace craneassist::offline

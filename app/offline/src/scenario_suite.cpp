@@ -1,0 +1,216 @@
+#include "craneassist/offline/scenario_suite.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <optional>
+
+#include "craneassist/config/quantity.hpp"
+#include "craneassist/config/yaml_reader.hpp"
+#include "craneassist/control/csv_log.hpp"
+#include "craneassist/input/replay.hpp"
+#include "craneassist/offline/sim_setup.hpp"
+#include "craneassist/sim_backend/sim_backend.hpp"
+
+namespace craneassist::offline {
+namespace {
+
+constexpr const char* kFormat = "craneassist-suite/1";
+
+class SuiteReader : public config::YamlReader {
+ public:
+  using YamlReader::YamlReader;
+
+  double quantity(const YAML::Node& map, const std::string& key, const std::string& path,
+                  config::Dimension dimension, double lo, double hi) const {
+    const YAML::Node node = child(map, key, path);
+    const std::string field = join(path, key);
+    if (!node.IsScalar()) fail(node, field, "expected a single value");
+    std::string error;
+    const auto q = config::parse_quantity(node.Scalar(), dimension, error);
+    if (!q || q->si_values.size() != 1) fail(node, field, error.empty() ? "one value" : error);
+    const double v = q->si_values[0];
+    if (!(v >= lo && v <= hi)) fail(node, field, "out of range");
+    return v;
+  }
+
+  void targets(const YAML::Node& node, const std::string& path, SuiteTargets& t) const {
+    check_keys(node, path, {"stall_events", "lateral_speed", "peak_power", "direction_error"});
+    if (node["stall_events"].IsDefined()) {
+      const YAML::Node n = node["stall_events"];
+      int v = -1;
+      if (!n.IsScalar() || !YAML::convert<int>::decode(n, v) || v < 0) {
+        fail(n, join(path, "stall_events"), "expected a count (0, 1, ...)");
+      }
+      t.stall_events = v;
+    }
+    if (node["lateral_speed"].IsDefined()) {
+      t.lateral_speed_m_s =
+          quantity(node, "lateral_speed", path, config::Dimension::kVelocity, 0.0, 100.0);
+    }
+    if (node["peak_power"].IsDefined()) {
+      t.peak_power_share =
+          quantity(node, "peak_power", path, config::Dimension::kDimensionless, 0.0, 10.0);
+    }
+    if (node["direction_error"].IsDefined()) {
+      t.direction_error_rad =
+          quantity(node, "direction_error", path, config::Dimension::kAngle, 0.0, M_PI);
+    }
+  }
+};
+
+void merge(const SuiteTargets& over, SuiteTargets& t) {
+  if (over.stall_events) t.stall_events = over.stall_events;
+  if (over.lateral_speed_m_s) t.lateral_speed_m_s = over.lateral_speed_m_s;
+  if (over.peak_power_share) t.peak_power_share = over.peak_power_share;
+  if (over.direction_error_rad) t.direction_error_rad = over.direction_error_rad;
+}
+
+std::string figure(const char* format, double value) {
+  char text[96];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
+}
+
+}  // namespace
+
+Suite parse_suite(std::string_view yaml_text, std::string_view source_name,
+                  const std::filesystem::path& base_dir) {
+  return config::read_yaml(yaml_text, source_name, [&](const YAML::Node& root) {
+    const SuiteReader r{std::string(source_name)};
+    Suite suite;
+    suite.source = std::string(source_name);
+    r.check_keys(root, "", {"format", "poses", "targets", "runs"});
+    const std::string format = r.text(root, "format", "");
+    if (format != kFormat) {
+      r.fail(root["format"], "format",
+             "unsupported format '" + format + "' (expected " + kFormat + ")");
+    }
+    // Poses: name -> text and line (check_suite checks them against the crane that runs them).
+    struct Pose {
+      std::string name, text;
+      int line;
+    };
+    std::vector<Pose> poses;
+    if (root["poses"].IsDefined()) {
+      const YAML::Node p = root["poses"];
+      if (!p.IsMap()) r.fail(p, "poses", "expected name: pose pairs");
+      for (const auto& kv : p) {
+        const std::string name = kv.first.Scalar();
+        if (name == "default") r.fail(kv.first, "poses.default", "default is the config's pose");
+        if (!kv.second.IsScalar()) {
+          r.fail(kv.second, "poses." + name, "expected NAME=VALUE UNIT, ...");
+        }
+        poses.push_back({name, kv.second.Scalar(), kv.second.Mark().line + 1});
+      }
+    }
+    SuiteTargets defaults;
+    if (root["targets"].IsDefined()) r.targets(root["targets"], "targets", defaults);
+
+    const YAML::Node runs = r.child(root, "runs", "");
+    if (!runs.IsSequence() || runs.size() == 0) r.fail(runs, "runs", "expected a list of runs");
+    for (std::size_t k = 0; k < runs.size(); ++k) {
+      const YAML::Node node = runs[k];
+      const std::string path = "runs[" + std::to_string(k) + "]";
+      r.check_keys(node, path, {"replay", "poses", "payload", "targets"});
+      SuiteRun run;
+      run.line = node.Mark().line + 1;
+      run.replay_text = r.text(node, "replay", path);
+      run.replay = base_dir / run.replay_text;
+      if (!std::filesystem::is_regular_file(run.replay)) {
+        r.fail(node["replay"], path + ".replay", "no such file: " + run.replay.string());
+      }
+      if (node["payload"].IsDefined()) {
+        run.payload_kg = r.quantity(node, "payload", path, config::Dimension::kMass, 0.0, 1e5);
+      }
+      run.targets = defaults;
+      if (node["targets"].IsDefined()) {
+        SuiteTargets own;
+        r.targets(node["targets"], path + ".targets", own);
+        merge(own, run.targets);
+      }
+      std::vector<std::string> names{"default"};
+      if (node["poses"].IsDefined()) {
+        const YAML::Node list = node["poses"];
+        if (!list.IsSequence() || list.size() == 0) {
+          r.fail(list, path + ".poses", "expected a list of pose names");
+        }
+        names.clear();
+        for (const auto& n : list) names.push_back(n.Scalar());
+      }
+      for (const auto& name : names) {
+        SuiteRun entry = run;
+        entry.pose = name;
+        if (name != "default") {
+          bool found = false;
+          for (const auto& pose : poses) {
+            if (pose.name == name) {
+              entry.pose_text = pose.text;
+              entry.pose_line = pose.line;
+              found = true;
+            }
+          }
+          if (!found) r.fail(node["poses"], path + ".poses", "no pose named '" + name + "'");
+        }
+        suite.runs.push_back(entry);
+      }
+    }
+    return suite;
+  });
+}
+
+void check_suite(const Suite& suite, const config::CraneConfig& cfg) {
+  for (const auto& run : suite.runs) {
+    if (run.pose_text.empty()) continue;
+    try {
+      config::parse_joint_pose(cfg.model, run.pose_text, cfg.simulation.q_initial);
+    } catch (const std::invalid_argument& e) {
+      throw config::ConfigError(suite.source, run.pose_line, "poses." + run.pose,
+                                std::string(e.what()) + " (crane " + cfg.model.name + ")");
+    }
+  }
+}
+
+Suite load_suite(const std::filesystem::path& path) {
+  return parse_suite(config::read_text_file(path), path.string(), path.parent_path());
+}
+
+SuiteOutcome run_suite_run(const config::CraneConfig& base, const SuiteRun& run,
+                           const std::string& resolution, const std::filesystem::path& log_file) {
+  config::CraneConfig cfg = base;
+  config::set_payload_mass(cfg.model, run.payload_kg);
+  if (!run.pose_text.empty()) {
+    cfg.simulation.q_initial =
+        config::parse_joint_pose(cfg.model, run.pose_text, cfg.simulation.q_initial);
+  }
+  if (!resolution.empty()) config::set_resolution(cfg, resolution);
+  const auto replay = input::Replay::load_file(run.replay);
+  sim_backend::SimBackend machine(cfg.model, sim_settings(cfg));
+  std::optional<control::CsvLog> log;
+  if (!log_file.empty()) log.emplace(log_file, cfg.model.dof());
+  control::RunOptions options;
+  SuiteOutcome out;
+  out.summary = control::run_replay(cfg, replay, machine, options, log ? &*log : nullptr);
+  out.p_max_w = cfg.model.pump.prime_mover_power_w;
+
+  const auto& s = out.summary;
+  const auto& t = run.targets;
+  if (t.stall_events && s.feel.stall_events > *t.stall_events) {
+    out.missed.push_back("stall events " + std::to_string(s.feel.stall_events) + " > " +
+                         std::to_string(*t.stall_events));
+  }
+  if (t.lateral_speed_m_s && s.feel.one_line && s.feel.lateral_peak_m_s > *t.lateral_speed_m_s) {
+    out.missed.push_back(figure("lateral speed %.3f m/s", s.feel.lateral_peak_m_s) +
+                         figure(" > %.3f", *t.lateral_speed_m_s));
+  }
+  if (t.peak_power_share && s.peak_power_w > *t.peak_power_share * out.p_max_w) {
+    out.missed.push_back(figure("peak power %.3f of P_max", s.peak_power_w / out.p_max_w) +
+                         figure(" > %.3f", *t.peak_power_share));
+  }
+  if (t.direction_error_rad && s.max_direction_error_deg * M_PI / 180.0 > *t.direction_error_rad) {
+    out.missed.push_back(figure("direction error %.2f deg", s.max_direction_error_deg) +
+                         figure(" > %.2f", *t.direction_error_rad * 180.0 / M_PI));
+  }
+  return out;
+}
+
+}  // namespace craneassist::offline
