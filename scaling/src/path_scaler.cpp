@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "craneassist/dynamics/rigid_body_terms.hpp"
+
 namespace craneassist::scaling {
 
 double tracking_factor(double error_m, double error_ok_m) {

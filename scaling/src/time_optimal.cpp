@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "craneassist/dynamics/rigid_body_terms.hpp"
+
 namespace craneassist::scaling {
 namespace {
 

@@ -26,37 +26,26 @@
 //
 // Path terms (path_terms()): the per-cycle m = H f' and b = H f'' sdot^2 + C(q, f' sdot) f' sdot
 // + g of the power-limited scaling, in 2 ODE steps, without forming H. See path_terms() below.
+//
+// ODE stays an implementation detail: this header includes no ODE header (the world, its
+// threading implementation, the OdeCrane and the joint feedback live behind Impl), and the
+// dynamics target links ODE privately. The plain terms are in path_terms.hpp.
 #pragma once
-
-#include <ode/ode.h>
 
 #include <Eigen/Cholesky>
 #include <array>
 #include <memory>
 
 #include "craneassist/dynamics/model.hpp"
+#include "craneassist/dynamics/path_terms.hpp"
 
 namespace craneassist::dynamics {
-
-class OdeCrane;
-
-struct DynamicsTerms {
-  JointMatrix mass;      // H(q)
-  JointVector coriolis;  // C(q, qdot) qdot
-  JointVector gravity;   // g(q)
-};
-
-// The dynamics along a path q = f(s) (algorithms.md section 3, corrected):
-// tau = m sddot + b with m = H(q) f' and b = H(q) f'' sdot^2 + C(q, f' sdot) f' sdot + g(q).
-struct PathTerms {
-  JointVector m;
-  JointVector b;
-};
 
 class RigidBodyTerms {
  public:
   // Builds its own ODE world and OdeCrane from `model` (copied) and runs a warm-up probe so that
-  // ODE's step memory is allocated here, not in the control cycle.
+  // ODE's step memory is allocated here, not in the control cycle. Throws std::runtime_error (ODE
+  // resources, a failed warm-up step) and std::invalid_argument (the model, see OdeCrane).
   explicit RigidBodyTerms(const CraneModel& model);
   ~RigidBodyTerms();
   RigidBodyTerms(const RigidBodyTerms&) = delete;
@@ -121,24 +110,28 @@ class RigidBodyTerms {
   void probe_gravity_acceleration(const JointVector& q, JointVector& qddot);
 
   // Velocity motors on (unlimited force) or off (the state of compute()'s probes).
-  void power_motors(bool on);
+  void power_motors(bool on) noexcept;
   // Motor reactions after one step from (q, 0) with motor targets qddot, gravity on or off, and,
   // when velocity_products is given, minus the velocity-product inertial wrenches at that qdot.
   void motor_step(const JointVector& q, const JointVector& qddot, bool with_gravity,
                   const JointVector* velocity_products, JointVector& effort);
   // Adds minus the inertial wrench of the qddot = 0 motion at joint rates qdot to every body
   // (uses the frames of the last set_state()).
-  void add_velocity_product_wrenches(const JointVector& qdot);
+  void add_velocity_product_wrenches(const JointVector& qdot) noexcept;
   // Generalized motor efforts from the joint feedback of the last step.
-  void read_motor_efforts(JointVector& effort) const;
+  void read_motor_efforts(JointVector& effort) const noexcept;
+  // The probe world's gravity: the model's, or none.
+  void set_gravity(bool on) noexcept;
+  // One dWorldStep of the probe world; false when it failed (ODE out of memory).
+  [[nodiscard]] bool step_world() noexcept;
 
-  void release();
+  // The ODE side: the probe world, its own threading implementation, the OdeCrane in it and the
+  // joint feedback registered with ODE. Allocated once, in the constructor.
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 
   int n_ = 0;
   Eigen::Vector3d gravity_m_s2_;
-  dWorldID world_ = nullptr;
-  dThreadingImplementationID threading_ = nullptr;  // this world's own (see the constructor)
-  std::unique_ptr<OdeCrane> crane_;
 
   // Preallocated work space (bounded-size Eigen types live inline: no heap).
   JointVector zero_, effort_, qddot_, q_work_, hdot_qdot_, d_qdot_;
@@ -148,7 +141,6 @@ class RigidBodyTerms {
   // Path terms.
   bool motors_on_ = false;
   JointVector path_acc_, path_qdot_;
-  std::array<dJointFeedback, kMaxJoints + 1> feedback_{};     // 1..n, registered with ODE
   std::array<Eigen::Matrix3d, kMaxJoints + 1> inertia_body_;  // ODE's, body axes, about the CoM
 };
 

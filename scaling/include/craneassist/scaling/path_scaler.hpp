@@ -15,9 +15,13 @@
 // No allocation after construction, no exceptions, bounded work.
 #pragma once
 
-#include "craneassist/dynamics/rigid_body_terms.hpp"
+#include "craneassist/dynamics/path_terms.hpp"
 #include "craneassist/scaling/path_constraints.hpp"
 #include "craneassist/scaling/scaling_filter.hpp"
+
+namespace craneassist::dynamics {
+class RigidBodyTerms;
+}
 
 namespace craneassist::scaling {
 

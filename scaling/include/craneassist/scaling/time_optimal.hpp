@@ -19,8 +19,11 @@
 
 #include <vector>
 
-#include "craneassist/dynamics/rigid_body_terms.hpp"
 #include "craneassist/scaling/path_constraints.hpp"
+
+namespace craneassist::dynamics {
+class RigidBodyTerms;
+}
 
 namespace craneassist::scaling {
 

@@ -29,10 +29,14 @@
 
 #include <Eigen/Core>
 
-#include "craneassist/dynamics/rigid_body_terms.hpp"
+#include "craneassist/dynamics/path_terms.hpp"
 #include "craneassist/scaling/path_constraints.hpp"
 #include "craneassist/scaling/path_scaler.hpp"
 #include "craneassist/scaling/scaling_filter.hpp"
+
+namespace craneassist::dynamics {
+class RigidBodyTerms;
+}
 
 namespace craneassist::scaling {
 
