@@ -138,19 +138,17 @@ void Controller::update_full(const valves::MachineState& state, const Eigen::Vec
   }
 
   // The present cylinder forces, from last cycle's dynamics terms (min-ls-power resolves the
-  // redundancy at the current loads).
-  const JointVector* forces = nullptr;
-  if (scaler_out_.terms.b.size() == model_.dof()) {
-    dynamics::cylinder_arms(model_, q_ref_, dc_dq_);
-    cylinder_force_ = scaler_out_.terms.b.cwiseQuotient(dc_dq_);
-    forces = &cylinder_force_;
-  }
+  // redundancy at the current loads); unknown before the first cycle.
   const Eigen::Vector3d u = scaler_->direction(v_cmd);
   scaling::TipPathInput path_in;
   path_in.direction = u;
   path_in.sdot = scaler_->speed();
   path_in.intended_speed = stale ? path_in.sdot : scaler_->intended_speed(v_cmd);
-  path_in.cylinder_force = forces;
+  path_in.forces_known = scaler_out_.terms.b.size() == model_.dof();
+  if (path_in.forces_known) {
+    dynamics::cylinder_arms(model_, q_ref_, dc_dq_);
+    path_in.cylinder_force = scaler_out_.terms.b.cwiseQuotient(dc_dq_);
+  }
   tip_path_->update(q_ref_, path_in, tip_out_);
   scaling::TipScalerInput in;
   in.command = v_cmd;

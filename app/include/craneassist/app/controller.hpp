@@ -107,7 +107,7 @@ class Controller {
   scaling::FlowPrescalingResult prescale_;
   scaling::TipPathOutput tip_out_;
   scaling::TipScalerOutput scaler_out_;
-  JointVector dc_dq_, qddot_max_, cylinder_force_;
+  JointVector dc_dq_, qddot_max_;
   JointVector q_ref_;
   double tip_error_filtered_m_ = 0.0;
   bool neutral_ = false;  // the last update returned kStopped (valves neutral)
