@@ -78,7 +78,7 @@ void compare_with_rnea(const CraneModel& model, unsigned seed, ErrorLog& log) {
                  << model.name << " trial " << trial << " q " << q.transpose() << " f' "
                  << f1.transpose() << " f'' " << f2.transpose() << " sdot " << sdot);
 
-    terms.path_terms(q, f1, f2, sdot, out);
+    ASSERT_TRUE(terms.path_terms(q, f1, f2, sdot, out));
     const JointVector gravity = rnea(model, q, zero, zero, model.gravity_m_s2);
     const double e_m = relative_error(out.m, rnea(model, q, zero, f1, no_gravity));
     const double e_b =
@@ -91,7 +91,7 @@ void compare_with_rnea(const CraneModel& model, unsigned seed, ErrorLog& log) {
     EXPECT_LT(e_dynamic, 1e-6);
 
     // Velocity products alone (f'' = 0): b - g = C(q, f' sdot) f' sdot.
-    terms.path_terms(q, f1, zero, sdot, out);
+    ASSERT_TRUE(terms.path_terms(q, f1, zero, sdot, out));
     const JointVector b_velocity = out.b - gravity;
     const double e_velocity =
         relative_error(b_velocity, rnea(model, q, f1 * sdot, zero, no_gravity));
@@ -142,8 +142,8 @@ TEST(PathTerms, AtRestBIsGravity) {
   f1 << 0.2, -0.4, 0.7, 0.3;
   f2 << 3.0, -2.0, 1.0, 5.0;
   PathTerms at_rest, moving;
-  terms.path_terms(q, f1, f2, 0.0, at_rest);
-  terms.path_terms(q, f1, f2, 0.8, moving);
+  ASSERT_TRUE(terms.path_terms(q, f1, f2, 0.0, at_rest));
+  ASSERT_TRUE(terms.path_terms(q, f1, f2, 0.8, moving));
   JointVector g;
   terms.gravity(q, g);
   EXPECT_LT(relative_error(at_rest.b, g), 1e-12);
@@ -167,7 +167,7 @@ TEST(PathTerms, AgreesWithComputeFormula) {
       const JointVector m = full.mass * f1;
       const JointVector b = full.mass * f2 * (sdot * sdot) + full.coriolis + full.gravity;
       PathTerms out;
-      terms.path_terms(q, f1, f2, sdot, out);
+      ASSERT_TRUE(terms.path_terms(q, f1, f2, sdot, out));
       worst_m = std::max(worst_m, relative_error(out.m, m));
       worst_b = std::max(worst_b, relative_error(out.b, b));
       // And path_terms() leaves compute() as it was (its motors are off again).
@@ -201,10 +201,11 @@ TEST(PathTerms, DoesNotAllocate) {
   out.b.resize(4);
   DynamicsTerms full;
   full.mass.resize(4, 4);
+  bool steps_ok = true;
   const long new_before = craneassist::test::heap_allocations();
   const long ode_before = craneassist::test::ode_allocations();
   for (int k = 0; k < 20; ++k) {
-    terms.path_terms(qs[k], f1s[k], f2s[k], k % 5 == 0 ? 0.0 : 0.1 * k, out);
+    steps_ok = terms.path_terms(qs[k], f1s[k], f2s[k], k % 5 == 0 ? 0.0 : 0.1 * k, out) && steps_ok;
     if (k % 7 == 0) terms.compute(qs[k], f1s[k], full);  // motors off and on again
   }
   const long new_calls = craneassist::test::heap_allocations() - new_before;
@@ -216,6 +217,7 @@ TEST(PathTerms, DoesNotAllocate) {
   const long fresh_allocs = craneassist::test::ode_allocations() - before_fresh;
 
   craneassist::test::stop_counting_ode_allocations();
+  EXPECT_TRUE(steps_ok);
   EXPECT_EQ(new_calls, 0);
   EXPECT_EQ(ode_allocs, 0);
   EXPECT_GT(fresh_allocs, 0);
@@ -234,7 +236,7 @@ TEST(PathTerms, Time) {
   double sink = 0;
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < reps; ++k) {
-    terms.path_terms(q, f1, f2, 0.7, out);
+    ASSERT_TRUE(terms.path_terms(q, f1, f2, 0.7, out));
     sink += out.b[1];
   }
   const auto t1 = std::chrono::steady_clock::now();

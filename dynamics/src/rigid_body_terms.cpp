@@ -113,7 +113,9 @@ RigidBodyTerms::RigidBodyTerms(const CraneModel& model)
   probe_gravity_acceleration(q0, qddot_);
   PathTerms warm_up;
   const JointVector ones = JointVector::Ones(n_);
-  path_terms(q0, ones, ones, 1.0, warm_up);
+  if (!path_terms(q0, ones, ones, 1.0, warm_up)) {
+    throw std::runtime_error("RigidBodyTerms: dWorldStep failed (out of memory)");
+  }
 }
 
 RigidBodyTerms::~RigidBodyTerms() = default;
@@ -127,6 +129,7 @@ void RigidBodyTerms::set_gravity(bool on) noexcept {
 }
 
 bool RigidBodyTerms::step_world() noexcept {
+  if (fail_steps_for_testing_) return false;
   return dWorldStep(impl_->world, kProbeStepS) != 0;
 }
 
@@ -223,8 +226,9 @@ void RigidBodyTerms::power_motors(bool on) noexcept {
   motors_on_ = on;
 }
 
-void RigidBodyTerms::motor_step(const JointVector& q, const JointVector& qddot, bool with_gravity,
-                                const JointVector* velocity_products, JointVector& effort) {
+bool RigidBodyTerms::motor_step(const JointVector& q, const JointVector& qddot, bool with_gravity,
+                                const JointVector* velocity_products,
+                                JointVector& effort) noexcept {
   OdeCrane& crane = *impl_->crane;
   power_motors(true);
   crane.set_state(q, zero_);
@@ -241,10 +245,9 @@ void RigidBodyTerms::motor_step(const JointVector& q, const JointVector& qddot, 
   }
   set_gravity(with_gravity);
   if (velocity_products != nullptr) add_velocity_product_wrenches(*velocity_products);
-  if (!step_world()) {
-    throw std::runtime_error("RigidBodyTerms: dWorldStep failed (out of memory)");
-  }
+  if (!step_world()) return false;
   read_motor_efforts(effort);
+  return true;
 }
 
 void RigidBodyTerms::add_velocity_product_wrenches(const JointVector& qdot) noexcept {
@@ -300,19 +303,16 @@ void RigidBodyTerms::read_motor_efforts(JointVector& effort) const noexcept {
   }
 }
 
-void RigidBodyTerms::path_terms(const JointVector& q, const JointVector& f1, const JointVector& f2,
-                                double sdot, PathTerms& out) {
+bool RigidBodyTerms::path_terms(const JointVector& q, const JointVector& f1, const JointVector& f2,
+                                double sdot, PathTerms& out) noexcept {
   // m = H f': gravity off, no external wrenches, motors at qddot = f'.
-  motor_step(q, f1, false, nullptr, out.m);
+  if (!motor_step(q, f1, false, nullptr, out.m)) return false;
   // b = H f'' sdot^2 + C(q, f' sdot) f' sdot + g.
   const double sdot2 = sdot * sdot;
   path_acc_ = f2 * sdot2;
-  if (sdot == 0.0) {
-    motor_step(q, path_acc_, true, nullptr, out.b);
-    return;
-  }
+  if (sdot == 0.0) return motor_step(q, path_acc_, true, nullptr, out.b);
   path_qdot_ = f1 * sdot;
-  motor_step(q, path_acc_, true, &path_qdot_, out.b);
+  return motor_step(q, path_acc_, true, &path_qdot_, out.b);
 }
 
 }  // namespace craneassist::dynamics
