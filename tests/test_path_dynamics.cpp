@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <new>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include "allocation_counter.hpp"
@@ -149,6 +150,33 @@ TEST(PathTerms, AtRestBIsGravity) {
   EXPECT_LT(relative_error(at_rest.b, g), 1e-12);
   EXPECT_LT(relative_error(at_rest.m, moving.m), 1e-14);
   EXPECT_GT(relative_error(moving.b, g), 1e-3);  // the motion does show in b
+}
+
+TEST(PathTerms, AFailedStepIsAStatusNotAnException) {
+  // dWorldStep fails only when ODE runs out of memory; the test hook fails every probe step the
+  // same way. path_terms() (the control cycle's call) reports it; compute() (offline) throws.
+  const CraneModel model = k70m();
+  RigidBodyTerms terms(model);
+  JointVector q(4), f1(4), f2(4);
+  q << 0.3, 0.5, -1.2, 1.5;
+  f1 << 0.2, -0.4, 0.7, 0.3;
+  f2 << 3.0, -2.0, 1.0, 5.0;
+  PathTerms before, after;
+  ASSERT_TRUE(terms.path_terms(q, f1, f2, 0.8, before));
+  static_assert(noexcept(terms.path_terms(q, f1, f2, 0.8, after)));
+
+  terms.fail_steps_for_testing(true);
+  PathTerms failed;
+  EXPECT_FALSE(terms.path_terms(q, f1, f2, 0.8, failed));
+  EXPECT_FALSE(terms.path_terms(q, f1, f2, 0.0, failed));
+  DynamicsTerms full;
+  EXPECT_THROW(terms.compute(q, f1, full), std::runtime_error);
+
+  // Nothing is left behind: the next good step gives the same terms as before.
+  terms.fail_steps_for_testing(false);
+  ASSERT_TRUE(terms.path_terms(q, f1, f2, 0.8, after));
+  EXPECT_EQ(after.m, before.m);
+  EXPECT_EQ(after.b, before.b);
 }
 
 TEST(PathTerms, AgreesWithComputeFormula) {

@@ -86,6 +86,9 @@ class Controller {
                           ControllerOutput& out) noexcept;
 
   double period_s() const { return period_s_; }
+  // The ODE dynamics probe of kFull (nullptr in the other modes). For tests: its
+  // fail_steps_for_testing() hook makes the cycle's dynamics step fail.
+  dynamics::RigidBodyTerms* dynamics_for_testing() noexcept { return terms_.get(); }
   // How often a command reaches the valves (ControllerOptions::valve_command_period_s).
   void set_valve_command_period(double period_s);
 
