@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <new>
+#include <utility>
 #include <vector>
 
 #include "allocation_counter.hpp"
@@ -177,6 +178,64 @@ TEST(Controller, FullScalingStaleInputIsAJerkLimitedStop) {
   EXPECT_GT(stopping, 10) << "a stop from speed takes time, not one cycle";
   EXPECT_EQ(out.sdot, 0.0);
   EXPECT_EQ(out.valves.spool.cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(Controller, AFailedDynamicsStepStopsInsteadOfThrowing) {
+  // update() cannot throw (a throw inside would end this test binary); a failed ODE step (the
+  // RigidBodyTerms test hook; on a machine: ODE out of memory) stops the reference jerk-limited
+  // with the operator still commanding motion, reports it, and then holds with neutral valves.
+  static_assert(noexcept(std::declval<control::Controller&>().update(
+      std::declval<const valves::MachineState&>(), std::declval<const Eigen::Vector3d&>(),
+      std::declval<control::ControllerOutput&>())));
+  const auto cfg = config::default_crane_config();
+  control::Controller controller(cfg, {control::ScalingMode::kFull});
+  ASSERT_NE(controller.dynamics_for_testing(), nullptr);
+  auto state = still_state(cfg);
+  controller.reset(state);
+  control::ControllerOutput out;
+  const Eigen::Vector3d v(0.4, 0.0, 0.3);
+  // A machine one valve delay late (as in FullScalingStaleInputIsAJerkLimitedStop).
+  const auto lag = static_cast<std::size_t>(std::lround(
+      (cfg.model.valves.delay_s + cfg.model.valves.time_constant_s) / controller.period_s()));
+  std::vector<dynamics::JointVector> history(lag, state.q);
+  for (std::size_t k = 0; k < 200; ++k) {
+    ASSERT_EQ(controller.update(state, v, out), control::ControllerStatus::kRunning);
+    history[k % lag] = out.q_ref;
+    state.q = history[(k + 1) % lag];
+  }
+  ASSERT_GT(out.sdot, 0.45);
+
+  controller.dynamics_for_testing()->fail_steps_for_testing(true);
+  double prev_sddot = out.sddot;
+  int stopping = 0;
+  control::ControllerStatus status = control::ControllerStatus::kRunning;
+  for (int k = 0; k < 500 && status != control::ControllerStatus::kStopped; ++k) {
+    status = controller.update(state, v, out);
+    EXPECT_NE(status, control::ControllerStatus::kRunning);
+    EXPECT_EQ(out.limit, scaling::ActiveLimit::kDynamicsFailed);
+    EXPECT_STREQ(scaling::to_string(out.limit), "dynamics_failed");
+    EXPECT_EQ(out.ref_power_w, 0.0);
+    EXPECT_LE(std::abs(out.sddot - prev_sddot),
+              cfg.scaling.jerk_max_m_s3 * controller.period_s() * (1 + 1e-9));
+    prev_sddot = out.sddot;
+    stopping += status == control::ControllerStatus::kStopping;
+    state.q = out.q_ref;
+  }
+  EXPECT_EQ(status, control::ControllerStatus::kStopped);
+  EXPECT_GT(stopping, 10) << "a stop from speed takes time, not one cycle";
+  EXPECT_EQ(out.sdot, 0.0);
+  EXPECT_EQ(out.valves.spool.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(controller.update(state, v, out), control::ControllerStatus::kStopped);
+
+  // The dynamics back: the controller restarts from the measured pose and runs.
+  controller.dynamics_for_testing()->fail_steps_for_testing(false);
+  for (int k = 0; k < 50; ++k) {
+    status = controller.update(state, v, out);
+    state.q = out.q_ref;
+  }
+  EXPECT_EQ(status, control::ControllerStatus::kRunning);
+  EXPECT_NE(out.limit, scaling::ActiveLimit::kDynamicsFailed);
+  EXPECT_GT(out.sdot, 0.0);
 }
 
 // Largest joint acceleration of the reference while the operator swings the stick from one

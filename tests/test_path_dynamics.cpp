@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <new>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include "allocation_counter.hpp"
@@ -78,7 +79,7 @@ void compare_with_rnea(const CraneModel& model, unsigned seed, ErrorLog& log) {
                  << model.name << " trial " << trial << " q " << q.transpose() << " f' "
                  << f1.transpose() << " f'' " << f2.transpose() << " sdot " << sdot);
 
-    terms.path_terms(q, f1, f2, sdot, out);
+    ASSERT_TRUE(terms.path_terms(q, f1, f2, sdot, out));
     const JointVector gravity = rnea(model, q, zero, zero, model.gravity_m_s2);
     const double e_m = relative_error(out.m, rnea(model, q, zero, f1, no_gravity));
     const double e_b =
@@ -91,7 +92,7 @@ void compare_with_rnea(const CraneModel& model, unsigned seed, ErrorLog& log) {
     EXPECT_LT(e_dynamic, 1e-6);
 
     // Velocity products alone (f'' = 0): b - g = C(q, f' sdot) f' sdot.
-    terms.path_terms(q, f1, zero, sdot, out);
+    ASSERT_TRUE(terms.path_terms(q, f1, zero, sdot, out));
     const JointVector b_velocity = out.b - gravity;
     const double e_velocity =
         relative_error(b_velocity, rnea(model, q, f1 * sdot, zero, no_gravity));
@@ -142,13 +143,40 @@ TEST(PathTerms, AtRestBIsGravity) {
   f1 << 0.2, -0.4, 0.7, 0.3;
   f2 << 3.0, -2.0, 1.0, 5.0;
   PathTerms at_rest, moving;
-  terms.path_terms(q, f1, f2, 0.0, at_rest);
-  terms.path_terms(q, f1, f2, 0.8, moving);
+  ASSERT_TRUE(terms.path_terms(q, f1, f2, 0.0, at_rest));
+  ASSERT_TRUE(terms.path_terms(q, f1, f2, 0.8, moving));
   JointVector g;
   terms.gravity(q, g);
   EXPECT_LT(relative_error(at_rest.b, g), 1e-12);
   EXPECT_LT(relative_error(at_rest.m, moving.m), 1e-14);
   EXPECT_GT(relative_error(moving.b, g), 1e-3);  // the motion does show in b
+}
+
+TEST(PathTerms, AFailedStepIsAStatusNotAnException) {
+  // dWorldStep fails only when ODE runs out of memory; the test hook fails every probe step the
+  // same way. path_terms() (the control cycle's call) reports it; compute() (offline) throws.
+  const CraneModel model = k70m();
+  RigidBodyTerms terms(model);
+  JointVector q(4), f1(4), f2(4);
+  q << 0.3, 0.5, -1.2, 1.5;
+  f1 << 0.2, -0.4, 0.7, 0.3;
+  f2 << 3.0, -2.0, 1.0, 5.0;
+  PathTerms before, after;
+  ASSERT_TRUE(terms.path_terms(q, f1, f2, 0.8, before));
+  static_assert(noexcept(terms.path_terms(q, f1, f2, 0.8, after)));
+
+  terms.fail_steps_for_testing(true);
+  PathTerms failed;
+  EXPECT_FALSE(terms.path_terms(q, f1, f2, 0.8, failed));
+  EXPECT_FALSE(terms.path_terms(q, f1, f2, 0.0, failed));
+  DynamicsTerms full;
+  EXPECT_THROW(terms.compute(q, f1, full), std::runtime_error);
+
+  // Nothing is left behind: the next good step gives the same terms as before.
+  terms.fail_steps_for_testing(false);
+  ASSERT_TRUE(terms.path_terms(q, f1, f2, 0.8, after));
+  EXPECT_EQ(after.m, before.m);
+  EXPECT_EQ(after.b, before.b);
 }
 
 TEST(PathTerms, AgreesWithComputeFormula) {
@@ -167,7 +195,7 @@ TEST(PathTerms, AgreesWithComputeFormula) {
       const JointVector m = full.mass * f1;
       const JointVector b = full.mass * f2 * (sdot * sdot) + full.coriolis + full.gravity;
       PathTerms out;
-      terms.path_terms(q, f1, f2, sdot, out);
+      ASSERT_TRUE(terms.path_terms(q, f1, f2, sdot, out));
       worst_m = std::max(worst_m, relative_error(out.m, m));
       worst_b = std::max(worst_b, relative_error(out.b, b));
       // And path_terms() leaves compute() as it was (its motors are off again).
@@ -201,10 +229,11 @@ TEST(PathTerms, DoesNotAllocate) {
   out.b.resize(4);
   DynamicsTerms full;
   full.mass.resize(4, 4);
+  bool steps_ok = true;
   const long new_before = craneassist::test::heap_allocations();
   const long ode_before = craneassist::test::ode_allocations();
   for (int k = 0; k < 20; ++k) {
-    terms.path_terms(qs[k], f1s[k], f2s[k], k % 5 == 0 ? 0.0 : 0.1 * k, out);
+    steps_ok = terms.path_terms(qs[k], f1s[k], f2s[k], k % 5 == 0 ? 0.0 : 0.1 * k, out) && steps_ok;
     if (k % 7 == 0) terms.compute(qs[k], f1s[k], full);  // motors off and on again
   }
   const long new_calls = craneassist::test::heap_allocations() - new_before;
@@ -216,6 +245,7 @@ TEST(PathTerms, DoesNotAllocate) {
   const long fresh_allocs = craneassist::test::ode_allocations() - before_fresh;
 
   craneassist::test::stop_counting_ode_allocations();
+  EXPECT_TRUE(steps_ok);
   EXPECT_EQ(new_calls, 0);
   EXPECT_EQ(ode_allocs, 0);
   EXPECT_GT(fresh_allocs, 0);
@@ -234,7 +264,7 @@ TEST(PathTerms, Time) {
   double sink = 0;
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < reps; ++k) {
-    terms.path_terms(q, f1, f2, 0.7, out);
+    ASSERT_TRUE(terms.path_terms(q, f1, f2, 0.7, out));
     sink += out.b[1];
   }
   const auto t1 = std::chrono::steady_clock::now();

@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "allocation_counter.hpp"
@@ -62,6 +63,7 @@ class TipMotion {
   }
 
   double period() const { return 1.0 / cfg_.control.rate_hz; }
+  dynamics::RigidBodyTerms& terms() { return terms_; }
 
   // Largest cylinder speed of the reference over its limit (1: at the limit).
   double cylinder_speed_share() const {
@@ -208,6 +210,56 @@ TEST(TipMotion, AStaleInputStopsAlongTheDirectionAndHoldsExactlyAtRest) {
   for (int k = 0; k < 50; ++k) m.step(Eigen::Vector3d::Zero(), true);
   EXPECT_TRUE(m.out.at_rest);
   EXPECT_EQ((m.q - q).norm(), 0.0) << "at rest nothing moves";
+}
+
+TEST(TipMotion, AFailedDynamicsStepStopsInsteadOfThrowing) {
+  // The scaler's update cannot throw (a throw inside would end this test binary), and a failed
+  // ODE step (the RigidBodyTerms test hook; on a machine: ODE out of memory) stops the reference
+  // jerk-limited along its direction, with the operator still commanding motion.
+  static_assert(noexcept(std::declval<scaling::TipScaler&>().update(
+      std::declval<const JointVector&>(), std::declval<const scaling::PathGeometry&>(),
+      std::declval<const scaling::TipScalerInput&>(), std::declval<scaling::TipScalerOutput&>())));
+  static_assert(noexcept(std::declval<scaling::TipPath&>().update(
+      std::declval<const JointVector&>(), std::declval<const scaling::TipPathInput&>(),
+      std::declval<scaling::TipPathOutput&>())));
+  const auto cfg = config::default_crane_config();
+  TipMotion m(cfg);
+  const double jerk = cfg.scaling.jerk_max_m_s3;
+  const Eigen::Vector3d v(0.3, 0.2, 0.4);
+  for (int k = 0; k < 200; ++k) m.step(v);
+  ASSERT_GT(m.out.sdot, 0.5);
+  ASSERT_FALSE(m.out.dynamics_failed);
+
+  m.terms().fail_steps_for_testing(true);
+  Eigen::Vector3d last_a = m.out.acceleration;
+  double last_speed = m.out.sdot;
+  int cycles = 0;
+  while (!m.out.at_rest && cycles < 500) {
+    m.step(v);  // the command stays: the failure alone stops the motion
+    EXPECT_TRUE(m.out.dynamics_failed);
+    EXPECT_EQ(m.out.limit, scaling::ActiveLimit::kDynamicsFailed);
+    EXPECT_EQ(m.out.terms.b.norm(), 0.0) << "no terms without the dynamics";
+    EXPECT_LT(angle_deg(m.out.velocity, v), 1e-6 + (m.out.sdot == 0.0 ? 180.0 : 0.0));
+    EXPECT_LE((m.out.acceleration - last_a).norm(), jerk * m.period() * (1 + 1e-9));
+    EXPECT_LE(m.out.sdot, last_speed + 1e-12) << "cycle " << cycles;
+    last_a = m.out.acceleration;
+    last_speed = m.out.sdot;
+    ++cycles;
+  }
+  EXPECT_TRUE(m.out.at_rest);
+  EXPECT_GT(cycles, 10) << "a jerk-limited stop from speed takes time";
+  EXPECT_LT(cycles, 100);
+  const JointVector q = m.q;
+  for (int k = 0; k < 50; ++k) m.step(v);
+  EXPECT_TRUE(m.out.at_rest);
+  EXPECT_EQ((m.q - q).norm(), 0.0) << "held exactly at rest while the dynamics fail";
+
+  // The dynamics back: the motion goes on.
+  m.terms().fail_steps_for_testing(false);
+  for (int k = 0; k < 100; ++k) m.step(v);
+  EXPECT_FALSE(m.out.dynamics_failed);
+  EXPECT_NE(m.out.limit, scaling::ActiveLimit::kDynamicsFailed);
+  EXPECT_GT(m.out.sdot, 0.3);
 }
 
 // The tip speed along the stick from the default pose, pushing out: the reference keeps the

@@ -1,5 +1,7 @@
 #include "craneassist/dynamics/rigid_body_terms.hpp"
 
+#include <ode/ode.h>
+
 #include <stdexcept>
 
 #include "craneassist/dynamics/kinematics.hpp"
@@ -34,100 +36,119 @@ JointVector mid_range(const CraneModel& model) {
 
 }  // namespace
 
-RigidBodyTerms::RigidBodyTerms(const CraneModel& model)
-    : n_(model.dof()), gravity_m_s2_(model.gravity_m_s2) {
-  ensure_ode_initialized();
-  world_ = dWorldCreate();
-  // A world without its own threading implementation steps with one process-wide default
-  // instance, and two worlds stepped in parallel threads then abort inside ODE ("assertion
-  // current_job->m_dependencies_count != 0 failed in ReleaseAJob"). Give this world its own.
-  threading_ = dThreadingAllocateSelfThreadedImplementation();
-  if (threading_ == nullptr) {
-    dWorldDestroy(world_);
-    throw std::runtime_error("RigidBodyTerms: cannot allocate an ODE threading implementation");
+struct RigidBodyTerms::Impl {
+  dWorldID world = nullptr;
+  dThreadingImplementationID threading = nullptr;  // this world's own (see below)
+  std::unique_ptr<OdeCrane> crane;
+  std::array<dJointFeedback, kMaxJoints + 1> feedback{};  // 1..n, registered with ODE
+
+  Impl() {
+    ensure_ode_initialized();
+    world = dWorldCreate();
+    // A world without its own threading implementation steps with one process-wide default
+    // instance, and two worlds stepped in parallel threads then abort inside ODE ("assertion
+    // current_job->m_dependencies_count != 0 failed in ReleaseAJob"). Give this world its own.
+    threading = dThreadingAllocateSelfThreadedImplementation();
+    if (threading == nullptr) {
+      dWorldDestroy(world);
+      throw std::runtime_error("RigidBodyTerms: cannot allocate an ODE threading implementation");
+    }
+    dWorldSetStepThreadingImplementation(world, dThreadingImplementationGetFunctions(threading),
+                                         threading);
   }
-  dWorldSetStepThreadingImplementation(world_, dThreadingImplementationGetFunctions(threading_),
-                                       threading_);
+  ~Impl() {
+    crane.reset();  // its bodies and joints belong to world
+    dWorldSetStepThreadingImplementation(world, nullptr, nullptr);
+    dWorldDestroy(world);
+    dThreadingFreeImplementation(threading);
+  }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+};
+
+RigidBodyTerms::RigidBodyTerms(const CraneModel& model)
+    : impl_(std::make_unique<Impl>()), n_(model.dof()), gravity_m_s2_(model.gravity_m_s2) {
+  // impl_ is a member: should anything below throw, its destructor releases the world.
+  dWorldID world = impl_->world;
   // The probe's own settings, independent of the simulator's: exact constraints (CFM = 0) and no
   // position-error feedback (ERP = 0), so a step from rest yields the exact acceleration.
-  dWorldSetERP(world_, 0.0);
-  dWorldSetCFM(world_, 0.0);
-  dWorldSetGravity(world_, 0.0, 0.0, 0.0);
-  dWorldSetStepMemoryReservationPolicy(world_, nullptr);  // ODE's defaults, stated explicitly
-  try {
-    const JointVector q0 = mid_range(model);
-    crane_ = std::make_unique<OdeCrane>(model, world_, q0);
-    zero_ = JointVector::Zero(n_);
-    effort_ = JointVector::Zero(n_);
-    qddot_ = JointVector::Zero(n_);
-    q_work_ = JointVector::Zero(n_);
-    hdot_qdot_ = JointVector::Zero(n_);
-    d_qdot_ = JointVector::Zero(n_);
-    inverse_mass_ = JointMatrix::Zero(n_, n_);
-    mass_work_ = JointMatrix::Zero(n_, n_);
-    mass_plus_ = JointMatrix::Zero(n_, n_);
-    mass_minus_ = JointMatrix::Zero(n_, n_);
-    identity_ = JointMatrix::Identity(n_, n_);
-    path_acc_ = JointVector::Zero(n_);
-    path_qdot_ = JointVector::Zero(n_);
-    for (int i = 1; i <= n_; ++i) {
-      dMass mass;
-      dBodyGetMass(crane_->body(i), &mass);  // inertia in body axes, about the centre of mass
-      for (int row = 0; row < 3; ++row) {
-        for (int col = 0; col < 3; ++col) inertia_body_[i](row, col) = mass.I[4 * row + col];
-      }
-      // Motor reactions of path_terms(); ODE fills these on every step.
-      dJointSetFeedback(crane_->joint(i), &feedback_[i]);
-      // Rigid motor rows (the motor CFM defaults to the world's CFM at joint creation; say it).
-      if (crane_->model().joints[i - 1].type == JointType::kRevolute) {
-        dJointSetHingeParam(crane_->joint(i), dParamCFM, 0.0);
-      } else {
-        dJointSetSliderParam(crane_->joint(i), dParamCFM, 0.0);
-      }
+  dWorldSetERP(world, 0.0);
+  dWorldSetCFM(world, 0.0);
+  dWorldSetGravity(world, 0.0, 0.0, 0.0);
+  dWorldSetStepMemoryReservationPolicy(world, nullptr);  // ODE's defaults, stated explicitly
+  const JointVector q0 = mid_range(model);
+  impl_->crane = std::make_unique<OdeCrane>(model, world, q0);
+  OdeCrane& crane = *impl_->crane;
+  zero_ = JointVector::Zero(n_);
+  effort_ = JointVector::Zero(n_);
+  qddot_ = JointVector::Zero(n_);
+  q_work_ = JointVector::Zero(n_);
+  hdot_qdot_ = JointVector::Zero(n_);
+  d_qdot_ = JointVector::Zero(n_);
+  inverse_mass_ = JointMatrix::Zero(n_, n_);
+  mass_work_ = JointMatrix::Zero(n_, n_);
+  mass_plus_ = JointMatrix::Zero(n_, n_);
+  mass_minus_ = JointMatrix::Zero(n_, n_);
+  identity_ = JointMatrix::Identity(n_, n_);
+  path_acc_ = JointVector::Zero(n_);
+  path_qdot_ = JointVector::Zero(n_);
+  for (int i = 1; i <= n_; ++i) {
+    dMass mass;
+    dBodyGetMass(crane.body(i), &mass);  // inertia in body axes, about the centre of mass
+    for (int row = 0; row < 3; ++row) {
+      for (int col = 0; col < 3; ++col) inertia_body_[i](row, col) = mass.I[4 * row + col];
     }
-    // Warm-up: the first dWorldStep allocates ODE's step arena; the motor steps of path_terms()
-    // have n more constraint rows, so size it for those too.
-    probe_mass_matrix(q0, mass_plus_);
-    probe_gravity_acceleration(q0, qddot_);
-    PathTerms warm_up;
-    const JointVector ones = JointVector::Ones(n_);
-    path_terms(q0, ones, ones, 1.0, warm_up);
-  } catch (...) {
-    release();
-    throw;
+    // Motor reactions of path_terms(); ODE fills these on every step.
+    dJointSetFeedback(crane.joint(i), &impl_->feedback[i]);
+    // Rigid motor rows (the motor CFM defaults to the world's CFM at joint creation; say it).
+    if (crane.model().joints[i - 1].type == JointType::kRevolute) {
+      dJointSetHingeParam(crane.joint(i), dParamCFM, 0.0);
+    } else {
+      dJointSetSliderParam(crane.joint(i), dParamCFM, 0.0);
+    }
+  }
+  // Warm-up: the first dWorldStep allocates ODE's step arena; the motor steps of path_terms()
+  // have n more constraint rows, so size it for those too.
+  probe_mass_matrix(q0, mass_plus_);
+  probe_gravity_acceleration(q0, qddot_);
+  PathTerms warm_up;
+  const JointVector ones = JointVector::Ones(n_);
+  if (!path_terms(q0, ones, ones, 1.0, warm_up)) {
+    throw std::runtime_error("RigidBodyTerms: dWorldStep failed (out of memory)");
   }
 }
 
-RigidBodyTerms::~RigidBodyTerms() {
-  release();
+RigidBodyTerms::~RigidBodyTerms() = default;
+
+void RigidBodyTerms::set_gravity(bool on) noexcept {
+  if (on) {
+    dWorldSetGravity(impl_->world, gravity_m_s2_.x(), gravity_m_s2_.y(), gravity_m_s2_.z());
+  } else {
+    dWorldSetGravity(impl_->world, 0.0, 0.0, 0.0);
+  }
 }
 
-void RigidBodyTerms::release() {
-  crane_.reset();  // its bodies and joints belong to world_
-  dWorldSetStepThreadingImplementation(world_, nullptr, nullptr);
-  dWorldDestroy(world_);
-  dThreadingFreeImplementation(threading_);
+bool RigidBodyTerms::step_world() noexcept {
+  if (fail_steps_for_testing_) return false;
+  return dWorldStep(impl_->world, kProbeStepS) != 0;
 }
 
 void RigidBodyTerms::step_from_rest(const JointVector& q, const JointVector& effort,
                                     bool with_gravity, JointVector& qddot) {
+  OdeCrane& crane = *impl_->crane;
   power_motors(false);
-  crane_->set_state(q, zero_);
+  crane.set_state(q, zero_);
   for (int i = 1; i <= n_; ++i) {
-    dBodySetForce(crane_->body(i), 0.0, 0.0, 0.0);
-    dBodySetTorque(crane_->body(i), 0.0, 0.0, 0.0);
+    dBodySetForce(crane.body(i), 0.0, 0.0, 0.0);
+    dBodySetTorque(crane.body(i), 0.0, 0.0, 0.0);
   }
-  if (with_gravity) {
-    dWorldSetGravity(world_, gravity_m_s2_.x(), gravity_m_s2_.y(), gravity_m_s2_.z());
-  } else {
-    dWorldSetGravity(world_, 0.0, 0.0, 0.0);
-  }
-  crane_->add_joint_efforts(effort);
-  if (dWorldStep(world_, kProbeStepS) == 0) {
+  set_gravity(with_gravity);
+  crane.add_joint_efforts(effort);
+  if (!step_world()) {
     throw std::runtime_error("RigidBodyTerms: dWorldStep failed (out of memory)");
   }
   // Rates with the pre-step geometry: exact, see OdeCrane::read_rates_at_set_pose.
-  crane_->read_rates_at_set_pose(qddot);
+  crane.read_rates_at_set_pose(qddot);
   qddot /= kProbeStepS;
 }
 
@@ -190,53 +211,52 @@ void RigidBodyTerms::compute(const JointVector& q, const JointVector& qdot, Dyna
   coriolis(q, qdot, out.coriolis);
 }
 
-void RigidBodyTerms::power_motors(bool on) {
+void RigidBodyTerms::power_motors(bool on) noexcept {
   if (on == motors_on_) return;
+  const OdeCrane& crane = *impl_->crane;
   // dInfinity makes the motor row an unbounded (equality) row of ODE's LCP; 0 removes the row.
   const double fmax = on ? dInfinity : 0.0;
   for (int i = 1; i <= n_; ++i) {
-    if (crane_->model().joints[i - 1].type == JointType::kRevolute) {
-      dJointSetHingeParam(crane_->joint(i), dParamFMax, fmax);
+    if (crane.model().joints[i - 1].type == JointType::kRevolute) {
+      dJointSetHingeParam(crane.joint(i), dParamFMax, fmax);
     } else {
-      dJointSetSliderParam(crane_->joint(i), dParamFMax, fmax);
+      dJointSetSliderParam(crane.joint(i), dParamFMax, fmax);
     }
   }
   motors_on_ = on;
 }
 
-void RigidBodyTerms::motor_step(const JointVector& q, const JointVector& qddot, bool with_gravity,
-                                const JointVector* velocity_products, JointVector& effort) {
+bool RigidBodyTerms::motor_step(const JointVector& q, const JointVector& qddot, bool with_gravity,
+                                const JointVector* velocity_products,
+                                JointVector& effort) noexcept {
+  OdeCrane& crane = *impl_->crane;
   power_motors(true);
-  crane_->set_state(q, zero_);
+  crane.set_state(q, zero_);
   for (int i = 1; i <= n_; ++i) {
-    dBodySetForce(crane_->body(i), 0.0, 0.0, 0.0);
-    dBodySetTorque(crane_->body(i), 0.0, 0.0, 0.0);
+    dBodySetForce(crane.body(i), 0.0, 0.0, 0.0);
+    dBodySetTorque(crane.body(i), 0.0, 0.0, 0.0);
     // From rest the motor row enforces rate = dParamVel after the step: dt * qddot.
     const double rate = kProbeStepS * qddot[i - 1];
-    if (crane_->model().joints[i - 1].type == JointType::kRevolute) {
-      dJointSetHingeParam(crane_->joint(i), dParamVel, rate);
+    if (crane.model().joints[i - 1].type == JointType::kRevolute) {
+      dJointSetHingeParam(crane.joint(i), dParamVel, rate);
     } else {
-      dJointSetSliderParam(crane_->joint(i), dParamVel, rate);
+      dJointSetSliderParam(crane.joint(i), dParamVel, rate);
     }
   }
-  if (with_gravity) {
-    dWorldSetGravity(world_, gravity_m_s2_.x(), gravity_m_s2_.y(), gravity_m_s2_.z());
-  } else {
-    dWorldSetGravity(world_, 0.0, 0.0, 0.0);
-  }
+  set_gravity(with_gravity);
   if (velocity_products != nullptr) add_velocity_product_wrenches(*velocity_products);
-  if (dWorldStep(world_, kProbeStepS) == 0) {
-    throw std::runtime_error("RigidBodyTerms: dWorldStep failed (out of memory)");
-  }
+  if (!step_world()) return false;
   read_motor_efforts(effort);
+  return true;
 }
 
-void RigidBodyTerms::add_velocity_product_wrenches(const JointVector& qdot) {
+void RigidBodyTerms::add_velocity_product_wrenches(const JointVector& qdot) noexcept {
+  const OdeCrane& crane = *impl_->crane;
   // Forward recursion at qddot = 0 in base-frame coordinates: w = angular velocity of frame i,
   // alpha = its angular acceleration, acc = acceleration of its origin o_i. The axis z_{i-1} is
   // fixed in frame i-1; o_i - o_{i-1} is fixed in frame i for a hinge (o_{i-1} is on its axis)
   // and grows by z_{i-1} qdot_i for a slider.
-  const KinematicsData& kin = crane_->kinematics();
+  const KinematicsData& kin = crane.kinematics();
   Eigen::Vector3d w = Eigen::Vector3d::Zero();
   Eigen::Vector3d alpha = Eigen::Vector3d::Zero();
   Eigen::Vector3d acc = Eigen::Vector3d::Zero();
@@ -244,7 +264,7 @@ void RigidBodyTerms::add_velocity_product_wrenches(const JointVector& qdot) {
     const Eigen::Vector3d z = kin.frames[i - 1].linear().col(2);
     const Eigen::Vector3d link = kin.frames[i].translation() - kin.frames[i - 1].translation();
     const double rate = qdot[i - 1];
-    if (crane_->model().joints[i - 1].type == JointType::kRevolute) {
+    if (crane.model().joints[i - 1].type == JointType::kRevolute) {
       alpha += w.cross(z * rate);
       w += z * rate;
       acc += alpha.cross(link) + w.cross(w.cross(link));
@@ -252,28 +272,29 @@ void RigidBodyTerms::add_velocity_product_wrenches(const JointVector& qdot) {
       acc += alpha.cross(link) + w.cross(w.cross(link)) + 2.0 * w.cross(z * rate);
     }
     const Eigen::Matrix3d& r = kin.frames[i].linear();
-    const Eigen::Vector3d arm = r * crane_->com_local(i);
+    const Eigen::Vector3d arm = r * crane.com_local(i);
     const Eigen::Vector3d acc_com = acc + alpha.cross(arm) + w.cross(w.cross(arm));
     const Eigen::Matrix3d inertia = r * inertia_body_[i] * r.transpose();
-    const Eigen::Vector3d force = crane_->mass(i) * acc_com;
+    const Eigen::Vector3d force = crane.mass(i) * acc_com;
     const Eigen::Vector3d torque = inertia * alpha + w.cross(inertia * w);  // about the CoM
-    dBodyAddForce(crane_->body(i), -force.x(), -force.y(), -force.z());
-    dBodyAddTorque(crane_->body(i), -torque.x(), -torque.y(), -torque.z());
+    dBodyAddForce(crane.body(i), -force.x(), -force.y(), -force.z());
+    dBodyAddTorque(crane.body(i), -torque.x(), -torque.y(), -torque.z());
   }
 }
 
-void RigidBodyTerms::read_motor_efforts(JointVector& effort) const {
+void RigidBodyTerms::read_motor_efforts(JointVector& effort) const noexcept {
   // Geometry of the set_state() pose, which is the pose ODE built the constraint rows at (the
   // step has since moved the bodies). Joint i attaches body i first, so f1, t1 act on the child.
-  const KinematicsData& kin = crane_->kinematics();
+  const OdeCrane& crane = *impl_->crane;
+  const KinematicsData& kin = crane.kinematics();
   effort.resize(n_);
   for (int i = 1; i <= n_; ++i) {
-    const dJointFeedback& fb = feedback_[i];
+    const dJointFeedback& fb = impl_->feedback[i];
     const Eigen::Vector3d z = kin.frames[i - 1].linear().col(2);
     const Eigen::Vector3d f1 = vec(fb.f1);
-    if (crane_->model().joints[i - 1].type == JointType::kRevolute) {
+    if (crane.model().joints[i - 1].type == JointType::kRevolute) {
       // Moment about the hinge axis through o_{i-1} of the wrench on the child.
-      const Eigen::Vector3d com = kin.frames[i] * crane_->com_local(i);
+      const Eigen::Vector3d com = kin.frames[i] * crane.com_local(i);
       const Eigen::Vector3d arm = com - kin.frames[i - 1].translation();
       effort[i - 1] = z.dot(vec(fb.t1) + arm.cross(f1));
     } else {
@@ -282,19 +303,16 @@ void RigidBodyTerms::read_motor_efforts(JointVector& effort) const {
   }
 }
 
-void RigidBodyTerms::path_terms(const JointVector& q, const JointVector& f1, const JointVector& f2,
-                                double sdot, PathTerms& out) {
+bool RigidBodyTerms::path_terms(const JointVector& q, const JointVector& f1, const JointVector& f2,
+                                double sdot, PathTerms& out) noexcept {
   // m = H f': gravity off, no external wrenches, motors at qddot = f'.
-  motor_step(q, f1, false, nullptr, out.m);
+  if (!motor_step(q, f1, false, nullptr, out.m)) return false;
   // b = H f'' sdot^2 + C(q, f' sdot) f' sdot + g.
   const double sdot2 = sdot * sdot;
   path_acc_ = f2 * sdot2;
-  if (sdot == 0.0) {
-    motor_step(q, path_acc_, true, nullptr, out.b);
-    return;
-  }
+  if (sdot == 0.0) return motor_step(q, path_acc_, true, nullptr, out.b);
   path_qdot_ = f1 * sdot;
-  motor_step(q, path_acc_, true, &path_qdot_, out.b);
+  return motor_step(q, path_acc_, true, &path_qdot_, out.b);
 }
 
 }  // namespace craneassist::dynamics

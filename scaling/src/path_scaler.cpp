@@ -3,7 +3,25 @@
 #include <algorithm>
 #include <cmath>
 
+#include "craneassist/dynamics/rigid_body_terms.hpp"
+
 namespace craneassist::scaling {
+
+bool path_terms_and_bounds(const dynamics::CraneModel& model, dynamics::RigidBodyTerms& terms,
+                           const JointVector& q, const PathGeometry& geometry, double sdot,
+                           const AccelerationLimits& limits, dynamics::PathTerms& path_terms,
+                           AccelerationBounds& bounds) noexcept {
+  if (terms.path_terms(q, geometry.f1, geometry.f2, sdot, path_terms)) {
+    path_acceleration_bounds(model, geometry, path_terms, sdot, limits, bounds);
+    return true;
+  }
+  path_terms.m.setZero(model.dof());
+  path_terms.b.setZero(model.dof());
+  AccelerationLimits without_dynamics = limits;
+  without_dynamics.power_bound = PowerBound::kNone;  // the only bound that reads m and b
+  path_acceleration_bounds(model, geometry, path_terms, sdot, without_dynamics, bounds);
+  return false;
+}
 
 double tracking_factor(double error_m, double error_ok_m) {
   if (!(error_m > error_ok_m)) return 1.0;
@@ -54,18 +72,19 @@ void PathScaler::reset(const ScalingFilterState& state) {
 }
 
 void PathScaler::update(const JointVector& q, const PathGeometry& geometry,
-                        const PathScalerInput& in, PathScalerOutput& out) {
+                        const PathScalerInput& in, PathScalerOutput& out) noexcept {
   const double sdot = filter_.state().sdot;
 
-  // Velocity-level limits, uniform along the path.
+  // Velocity-level limits, uniform along the path. Without the dynamics (a failed step) the
+  // acceleration bounds are those that need none: no power bound.
   path_speed_limits(model_, geometry, config_.flow_reserve, out.speed);
-  terms_.path_terms(q, geometry.f1, geometry.f2, sdot, out.terms);
-  path_acceleration_bounds(model_, geometry, out.terms, sdot, acceleration_limits_, out.bounds);
+  out.dynamics_failed = !path_terms_and_bounds(model_, terms_, q, geometry, sdot,
+                                               acceleration_limits_, out.terms, out.bounds);
 
   const SpeedCap lowest = lowest_speed_cap(in.sdot_request, in.tracking_factor, in.sdot_joint_limit,
                                            out.speed, out.bounds);
   out.sdot_d = std::max(lowest.value, 0.0);
-  if (in.stale_input) out.sdot_d = 0.0;
+  if (in.stale_input || out.dynamics_failed) out.sdot_d = 0.0;
 
   // No constraint may force the path to speed up or keep it from stopping (stop_bound).
   const ScalingFilterInput filter_in{
@@ -73,10 +92,13 @@ void PathScaler::update(const JointVector& q, const PathGeometry& geometry,
       out.bounds.sddot_max};
   out.filter_status = filter_.update(filter_in, out.state);
 
-  // What holds the motion back: the stale input, a power bound the filter is pressed against,
-  // or the lowest velocity-level limit when it is below what the operator asks for.
+  // What holds the motion back: the failed dynamics, the stale input, a power bound the filter
+  // is pressed against, or the lowest velocity-level limit when it is below what the operator
+  // asks for.
   out.limit = ActiveLimit::kNone;
-  if (in.stale_input) {
+  if (out.dynamics_failed) {
+    out.limit = ActiveLimit::kDynamicsFailed;
+  } else if (in.stale_input) {
     out.limit = ActiveLimit::kStaleInput;
   } else if (out.filter_status == ScalingFilterStatus::kAccelerationLimited &&
              (out.bounds.limit_max == ActiveLimit::kPower ||

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+
+#include "craneassist/dynamics/rigid_body_terms.hpp"
 
 namespace craneassist::scaling {
 namespace {
@@ -48,7 +51,11 @@ TimeOptimalResult time_optimal_profile(const dynamics::CraneModel& model,
   AccelerationBounds bounds;
   auto path_terms_and_bounds = [&](std::size_t k, double v) {
     const auto& g = samples[k].geometry;
-    terms.path_terms(samples[k].q, g.f1, g.f2, v, path_terms);
+    // Offline: a failed dynamics step (ODE out of memory) is an error here, not a stop.
+    if (!terms.path_terms(samples[k].q, g.f1, g.f2, v, path_terms)) {
+      throw std::runtime_error(
+          "time_optimal_profile: the ODE dynamics step failed (out of memory)");
+    }
     path_acceleration_bounds(model, g, path_terms, v, accel, bounds);
   };
   auto bounds_at = [&](std::size_t k, double v, double& lo, double& hi) {

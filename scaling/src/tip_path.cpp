@@ -52,7 +52,7 @@ TipPath::TipPath(const dynamics::CraneModel& model, const TipPathConfig& config)
   f1_plus_.setZero(n);
   f1_minus_.setZero(n);
   arms_.setZero(n);
-  force_.setZero(n);  // no loads known: min-ls-power then minimises flow at the margin
+  force_.setZero(n);
 }
 
 void TipPath::reset() {
@@ -61,7 +61,7 @@ void TipPath::reset() {
 }
 
 void TipPath::resolve(const JointVector& q, const Eigen::Vector3d& u, const Shape& shape,
-                      JointVector& f1, dynamics::NullSpaceStatus& status) {
+                      JointVector& f1, dynamics::NullSpaceStatus& status) noexcept {
   const int n = model_.dof();
   dynamics::tip_jacobian(model_, kin_, q, jacobian_);
   dynamics::cylinder_arms(model_, q, arms_);
@@ -91,7 +91,7 @@ void TipPath::resolve(const JointVector& q, const Eigen::Vector3d& u, const Shap
   if (n == 4 && dynamics::solution_line(jacobian_, u, line_)) {
     problem_.line = &line_;
     problem_.dc_dq = &arms_;
-    problem_.cylinder_force = cylinder_force_ != nullptr ? cylinder_force_ : &force_;
+    problem_.cylinder_force = &force_;  // this update's copy of the forces (update())
     problem_.position = bounds_;
     const double keep = 1.0 - config_.flow_reserve;
     for (int i = 0; i < n; ++i) {
@@ -181,10 +181,15 @@ void TipPath::resolve(const JointVector& q, const Eigen::Vector3d& u, const Shap
                                         : dynamics::NullSpaceStatus::kOptimal;
 }
 
-void TipPath::update(const JointVector& q, const TipPathInput& in, TipPathOutput& out) {
+void TipPath::update(const JointVector& q, const TipPathInput& in, TipPathOutput& out) noexcept {
   const int n = model_.dof();
   const Eigen::Vector3d u = in.direction;
-  cylinder_force_ = in.cylinder_force;
+  // The loads the resolution works with, copied: resolve() points problem_ at force_.
+  if (in.forces_known && in.cylinder_force.size() == n) {
+    force_ = in.cylinder_force;
+  } else {
+    force_.setZero(n);  // no loads known: min-ls-power then minimises flow at the margin
+  }
 
   Shape shape;
   shape.intended_speed = std::max({in.intended_speed, in.sdot, kMinSpeed});
@@ -274,7 +279,7 @@ void TipPath::update(const JointVector& q, const TipPathInput& in, TipPathOutput
 }
 
 void TipPath::weakest_direction(const Eigen::Vector3d& u, const JointVector& arms,
-                                TipPathOutput& out) {
+                                TipPathOutput& out) noexcept {
   // The tip velocities the cylinders can give at full speed form an ellipsoid J D (D: the joint
   // rate limits); its smallest semi-axis is the slowest direction.
   // Joints at an end count only when u moves them away from it: at the end they cannot help in

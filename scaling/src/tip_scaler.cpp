@@ -93,16 +93,19 @@ double TipScaler::cylinder_speed_ahead(const PathGeometry& g, double speed,
 }
 
 void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const TipScalerInput& in,
-                       TipScalerOutput& out) {
+                       TipScalerOutput& out) noexcept {
   const double period = config_.period_s;
   const double jerk = config_.jerk_max;
   const Eigen::Vector3d& u = in.direction;
   const double speed = velocity_.norm();
 
-  // Velocity-level limits along u and the acceleration bounds at the present speed.
+  // Velocity-level limits along u and the acceleration bounds at the present speed. Without the
+  // dynamics (a failed step) the bounds are those that need none: no power bound.
   path_speed_limits(model_, geometry, config_.flow_reserve, out.speed);
-  terms_.path_terms(q, geometry.f1, geometry.f2, speed, out.terms);
-  path_acceleration_bounds(model_, geometry, out.terms, speed, acceleration_limits_, out.bounds);
+  out.dynamics_failed = !path_terms_and_bounds(model_, terms_, q, geometry, speed,
+                                               acceleration_limits_, out.terms, out.bounds);
+  // A stale input or a failed dynamics step: a jerk-limited stop along the present direction.
+  const bool stop = in.stale_input || out.dynamics_failed;
 
   // One factor on the whole command.
   const double request = in.command.norm();
@@ -112,7 +115,7 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
   if (ahead < cap.value) {
     cap = {ahead, in.near_singular ? ActiveLimit::kSingularity : ActiveLimit::kCylinderSpeed};
   }
-  double target = in.stale_input ? 0.0 : std::clamp(cap.value, 0.0, request);
+  double target = stop ? 0.0 : std::clamp(cap.value, 0.0, request);
   // Braking trigger at a joint end: the end damping cap assumes braking from zero acceleration;
   // while the path still accelerates, braking must begin earlier.
   // Once braked there, the reference stays at rest until the end damping would allow a useful
@@ -254,10 +257,13 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
   out.at_rest = v_new.isZero(0.0) && a_new.isZero(0.0);
   if (out.at_rest) reversing_ = false;
 
-  // What holds the motion back: the stale input, a power bound the tangential acceleration is
-  // pressed against, or the lowest velocity-level limit when it is below the request.
+  // What holds the motion back: the failed dynamics, the stale input, a power bound the
+  // tangential acceleration is pressed against, or the lowest velocity-level limit when it is
+  // below the request.
   out.limit = ActiveLimit::kNone;
-  if (in.stale_input) {
+  if (out.dynamics_failed) {
+    out.limit = ActiveLimit::kDynamicsFailed;
+  } else if (in.stale_input) {
     out.limit = ActiveLimit::kStaleInput;
   } else if (status == ScalingFilterStatus::kAccelerationLimited &&
              (out.bounds.limit_max == ActiveLimit::kPower ||

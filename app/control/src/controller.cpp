@@ -90,7 +90,7 @@ void Controller::reset(const valves::MachineState& state) {
 }
 
 ControllerStatus Controller::update(const valves::MachineState& state, const Eigen::Vector3d& v_cmd,
-                                    ControllerOutput& out) {
+                                    ControllerOutput& out) noexcept {
   const int n = model_.dof();
   const bool state_ok =
       state.valid && state.q.size() == n && state.q.allFinite() && state.qdot.allFinite();
@@ -114,19 +114,25 @@ ControllerStatus Controller::update(const valves::MachineState& state, const Eig
   }
   out.q_ref = q_ref_;
 
+  // A failed dynamics step stops the reference as a stale input does (the scaler's target is 0).
+  const bool stopping = stale || dynamics_failed();
   const bool at_rest = out.qdot_ref.isZero(0.0) && out.sddot == 0.0 &&
                        (options_.mode != ScalingMode::kFull || scaler_out_.at_rest);
-  if (stale && at_rest) {
+  if (stopping && at_rest) {
     follower_.neutral(out.valves);  // stopped: valves neutral
     neutral_ = true;
     return ControllerStatus::kStopped;
   }
   follower_.update(q_ref_, out.qdot_ref, state_ok ? &state.q : nullptr, out.valves);
-  return stale ? ControllerStatus::kStopping : ControllerStatus::kRunning;
+  return stopping ? ControllerStatus::kStopping : ControllerStatus::kRunning;
+}
+
+bool Controller::dynamics_failed() const noexcept {
+  return options_.mode == ScalingMode::kFull && scaler_out_.dynamics_failed;
 }
 
 void Controller::update_full(const valves::MachineState& state, const Eigen::Vector3d& v_cmd,
-                             bool stale, ControllerOutput& out) {
+                             bool stale, ControllerOutput& out) noexcept {
   // Tracking error of the measured tip against the reference of one valve delay ago, filtered.
   const bool state_ok = state.valid && state.q.size() == model_.dof() && state.q.allFinite();
   if (state_ok) {
@@ -138,19 +144,17 @@ void Controller::update_full(const valves::MachineState& state, const Eigen::Vec
   }
 
   // The present cylinder forces, from last cycle's dynamics terms (min-ls-power resolves the
-  // redundancy at the current loads).
-  const JointVector* forces = nullptr;
-  if (scaler_out_.terms.b.size() == model_.dof()) {
-    dynamics::cylinder_arms(model_, q_ref_, dc_dq_);
-    cylinder_force_ = scaler_out_.terms.b.cwiseQuotient(dc_dq_);
-    forces = &cylinder_force_;
-  }
+  // redundancy at the current loads); unknown before the first cycle and after a failed step.
   const Eigen::Vector3d u = scaler_->direction(v_cmd);
   scaling::TipPathInput path_in;
   path_in.direction = u;
   path_in.sdot = scaler_->speed();
   path_in.intended_speed = stale ? path_in.sdot : scaler_->intended_speed(v_cmd);
-  path_in.cylinder_force = forces;
+  path_in.forces_known = scaler_out_.terms.b.size() == model_.dof() && !scaler_out_.dynamics_failed;
+  if (path_in.forces_known) {
+    dynamics::cylinder_arms(model_, q_ref_, dc_dq_);
+    path_in.cylinder_force = scaler_out_.terms.b.cwiseQuotient(dc_dq_);
+  }
   tip_path_->update(q_ref_, path_in, tip_out_);
   scaling::TipScalerInput in;
   in.command = v_cmd;
@@ -186,11 +190,15 @@ void Controller::update_full(const valves::MachineState& state, const Eigen::Vec
   out.sddot_min = scaler_out_.bounds.sddot_min;
   out.sddot_max = scaler_out_.bounds.sddot_max;
   out.tip_error_m = tip_error_filtered_m_;
+  // No prediction without the dynamics.
   out.ref_power_w =
-      scaling::pump_power(model_, g, scaler_out_.terms, std::abs(along), scaler_out_.sddot);
+      scaler_out_.dynamics_failed
+          ? 0.0
+          : scaling::pump_power(model_, g, scaler_out_.terms, std::abs(along), scaler_out_.sddot);
 }
 
-void Controller::update_rate_prescaled(const Eigen::Vector3d& v_cmd, ControllerOutput& out) {
+void Controller::update_rate_prescaled(const Eigen::Vector3d& v_cmd,
+                                       ControllerOutput& out) noexcept {
   const int n = model_.dof();
   dynamics::cylinder_arms(model_, q_ref_, dc_dq_);
   for (int i = 0; i < n; ++i) {

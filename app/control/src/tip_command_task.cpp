@@ -49,7 +49,10 @@ CycleStatus TipCommandTask::step(const CycleTime& time, const valves::MachineSta
   builder_.fill(row, time.t_s, v, out_, state);
   row.status = status_word(status);
   const char* reason = stop_cause != nullptr ? stop_cause : command_.reason;
-  if (v.allFinite() && status != CycleStatus::kRunning) reason = "measurement invalid";
+  if (v.allFinite() && status != CycleStatus::kRunning) {
+    reason = out_.limit == scaling::ActiveLimit::kDynamicsFailed ? "dynamics failed"
+                                                                 : "measurement invalid";
+  }
   row.stop_reason = reason;
   row.deadman = command_.deadman;
   row.input_source = input_.name();

@@ -8,11 +8,21 @@
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/inverse_kinematics.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
+#include "craneassist/dynamics/rigid_body_terms.hpp"
 
 namespace craneassist::planner {
 namespace {
 
 constexpr double kUnreachablePenaltyFactor = 100.0;
+
+// The planner is offline: a failed dynamics step (ODE out of memory) is an error, not a stop.
+void path_terms_or_throw(dynamics::RigidBodyTerms& terms, const JointVector& q,
+                         const JointVector& f1, const JointVector& f2, double sdot,
+                         dynamics::PathTerms& out) {
+  if (!terms.path_terms(q, f1, f2, sdot, out)) {
+    throw std::runtime_error("planner: the ODE dynamics step failed (out of memory)");
+  }
+}
 
 }  // namespace
 
@@ -113,7 +123,7 @@ void StageModel::position_terms(int k, double c, dynamics::RigidBodyTerms& terms
     w[s].setZero(n);
     w[s].head<3>() = lu.solve(samples_.a_m_s2[ku] - jdot * qdot);
     // tau(t, 0) = H w(t) + C(q, qdot(t)) qdot(t) + g: path terms with f' = qdot, f'' = w, sdot = 1.
-    terms.path_terms(out.q, qdot, w[s], 1.0, pt);
+    path_terms_or_throw(terms, out.q, qdot, w[s], 1.0, pt);
     tau[s] = pt.b;
   }
   const auto fit = [&](const std::array<JointVector, 3>& y, JointVector& c0, JointVector& c1,
@@ -125,7 +135,7 @@ void StageModel::position_terms(int k, double c, dynamics::RigidBodyTerms& terms
   fit(w, out.w0, out.w1, out.w2);
   fit(tau, out.tau0, out.tau1, out.tau2);
   // m = H slope (the effort per unit extension acceleration).
-  terms.path_terms(out.q, out.slope, JointVector::Zero(n), 0.0, pt);
+  path_terms_or_throw(terms, out.q, out.slope, JointVector::Zero(n), 0.0, pt);
   out.m = pt.m;
 
   out.arm.resize(n);

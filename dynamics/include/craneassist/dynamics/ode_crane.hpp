@@ -23,6 +23,12 @@
 // threading implementation (dThreadingAllocateSelfThreadedImplementation, then
 // dWorldSetStepThreadingImplementation): by default all worlds share one process-wide instance,
 // and parallel steps abort inside ODE. RigidBodyTerms does this for its probe world.
+//
+// The one public dynamics header that includes <ode/ode.h>. ODE is a private dependency of the
+// dynamics target (RigidBodyTerms keeps its ODE state behind a pimpl), so a target that includes
+// this header links PkgConfig::ODE itself: sim_backend (privately) and the tests that step or
+// count ODE directly. It stays public rather than in a private include directory because the
+// simulator, another module, builds its crane from it.
 #pragma once
 
 #include <ode/ode.h>

@@ -26,50 +26,49 @@
 //
 // Path terms (path_terms()): the per-cycle m = H f' and b = H f'' sdot^2 + C(q, f' sdot) f' sdot
 // + g of the power-limited scaling, in 2 ODE steps, without forming H. See path_terms() below.
+//
+// Errors. A probe step fails only when ODE cannot get memory for it (dWorldStep returns 0; the
+// constructor's warm-up sizes ODE's step arena, so after it this does not happen in practice).
+//   - Cycle-safe: path_terms() is noexcept and allocates nothing; a failed step is its false
+//     return (the scalers stop on it, ActiveLimit::kDynamicsFailed).
+//   - Not cycle-safe, for tests and offline tools: the constructor, compute(), mass_matrix(),
+//     gravity() and coriolis() throw std::runtime_error for a failed step (and for a probed H^-1
+//     that is not positive definite).
+//
+// ODE stays an implementation detail: this header includes no ODE header (the world, its
+// threading implementation, the OdeCrane and the joint feedback live behind Impl), and the
+// dynamics target links ODE privately. The plain terms are in path_terms.hpp.
 #pragma once
-
-#include <ode/ode.h>
 
 #include <Eigen/Cholesky>
 #include <array>
 #include <memory>
 
 #include "craneassist/dynamics/model.hpp"
+#include "craneassist/dynamics/path_terms.hpp"
 
 namespace craneassist::dynamics {
-
-class OdeCrane;
-
-struct DynamicsTerms {
-  JointMatrix mass;      // H(q)
-  JointVector coriolis;  // C(q, qdot) qdot
-  JointVector gravity;   // g(q)
-};
-
-// The dynamics along a path q = f(s) (algorithms.md section 3, corrected):
-// tau = m sddot + b with m = H(q) f' and b = H(q) f'' sdot^2 + C(q, f' sdot) f' sdot + g(q).
-struct PathTerms {
-  JointVector m;
-  JointVector b;
-};
 
 class RigidBodyTerms {
  public:
   // Builds its own ODE world and OdeCrane from `model` (copied) and runs a warm-up probe so that
-  // ODE's step memory is allocated here, not in the control cycle.
+  // ODE's step memory is allocated here, not in the control cycle. Throws std::runtime_error (ODE
+  // resources, a failed warm-up step) and std::invalid_argument (the model, see OdeCrane).
   explicit RigidBodyTerms(const CraneModel& model);
   ~RigidBodyTerms();
   RigidBodyTerms(const RigidBodyTerms&) = delete;
   RigidBodyTerms& operator=(const RigidBodyTerms&) = delete;
 
-  // All three terms; skips the Coriolis work when qdot is exactly zero.
+  // All three terms; skips the Coriolis work when qdot is exactly zero. These four throw
+  // std::runtime_error when a probe step fails (see Errors above): not for the control cycle.
   void compute(const JointVector& q, const JointVector& qdot, DynamicsTerms& out);
   void mass_matrix(const JointVector& q, JointMatrix& mass);
   void gravity(const JointVector& q, JointVector& gravity);
   void coriolis(const JointVector& q, const JointVector& qdot, JointVector& coriolis);
 
   // m and b of PathTerms at q for path tangent f1 = f' (joint velocity per unit path speed), its
-  // path derivative f2 = f'' and path speed sdot. No heap allocation.
+  // path derivative f2 = f'' and path speed sdot. No heap allocation, no exception: cycle-safe.
+  // Returns false when an ODE step failed (out of memory); out is then unspecified.
   //
   // Cost: 2 ODE steps whatever sdot is (compute() takes n + 1 + 2 n (n - 1) = 29 for the K70M);
   // about 9 us on the K70M. Exact up to rounding: no finite differences, about 1e-13 relative
@@ -98,10 +97,15 @@ class RigidBodyTerms {
   // gyroscopic part would appear. The alternative of central differences of motor-probed
   // H(q') f' (2 steps for (dH/dq . f') f', 2 per joint 2..n for grad_q f'^T H f') needs 2 n more
   // steps (10 in all for the K70M, about 50 us) and is accurate to about 2e-8 only.
-  void path_terms(const JointVector& q, const JointVector& f1, const JointVector& f2, double sdot,
-                  PathTerms& out);
+  [[nodiscard]] bool path_terms(const JointVector& q, const JointVector& f1, const JointVector& f2,
+                                double sdot, PathTerms& out) noexcept;
 
   int dof() const { return n_; }
+
+  // Test hook, nothing else sets it: while on, every probe step fails as dWorldStep does when
+  // ODE runs out of memory (the step is not taken), so tests can reach the failure paths that a
+  // real machine reaches only on memory exhaustion. Off by default.
+  void fail_steps_for_testing(bool fail) noexcept { fail_steps_for_testing_ = fail; }
 
   // Any dt gives the same result from rest; this one keeps the step's position update small.
   static constexpr double kProbeStepS = 1e-3;
@@ -121,24 +125,30 @@ class RigidBodyTerms {
   void probe_gravity_acceleration(const JointVector& q, JointVector& qddot);
 
   // Velocity motors on (unlimited force) or off (the state of compute()'s probes).
-  void power_motors(bool on);
+  void power_motors(bool on) noexcept;
   // Motor reactions after one step from (q, 0) with motor targets qddot, gravity on or off, and,
   // when velocity_products is given, minus the velocity-product inertial wrenches at that qdot.
-  void motor_step(const JointVector& q, const JointVector& qddot, bool with_gravity,
-                  const JointVector* velocity_products, JointVector& effort);
+  // False when the step failed (effort is then left as it was).
+  [[nodiscard]] bool motor_step(const JointVector& q, const JointVector& qddot, bool with_gravity,
+                                const JointVector* velocity_products, JointVector& effort) noexcept;
   // Adds minus the inertial wrench of the qddot = 0 motion at joint rates qdot to every body
   // (uses the frames of the last set_state()).
-  void add_velocity_product_wrenches(const JointVector& qdot);
+  void add_velocity_product_wrenches(const JointVector& qdot) noexcept;
   // Generalized motor efforts from the joint feedback of the last step.
-  void read_motor_efforts(JointVector& effort) const;
+  void read_motor_efforts(JointVector& effort) const noexcept;
+  // The probe world's gravity: the model's, or none.
+  void set_gravity(bool on) noexcept;
+  // One dWorldStep of the probe world; false when it failed (or the test hook is on).
+  [[nodiscard]] bool step_world() noexcept;
 
-  void release();
+  // The ODE side: the probe world, its own threading implementation, the OdeCrane in it and the
+  // joint feedback registered with ODE. Allocated once, in the constructor.
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 
   int n_ = 0;
   Eigen::Vector3d gravity_m_s2_;
-  dWorldID world_ = nullptr;
-  dThreadingImplementationID threading_ = nullptr;  // this world's own (see the constructor)
-  std::unique_ptr<OdeCrane> crane_;
+  bool fail_steps_for_testing_ = false;
 
   // Preallocated work space (bounded-size Eigen types live inline: no heap).
   JointVector zero_, effort_, qddot_, q_work_, hdot_qdot_, d_qdot_;
@@ -148,7 +158,6 @@ class RigidBodyTerms {
   // Path terms.
   bool motors_on_ = false;
   JointVector path_acc_, path_qdot_;
-  std::array<dJointFeedback, kMaxJoints + 1> feedback_{};     // 1..n, registered with ODE
   std::array<Eigen::Matrix3d, kMaxJoints + 1> inertia_body_;  // ODE's, body axes, about the CoM
 };
 

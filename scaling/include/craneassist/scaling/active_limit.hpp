@@ -15,8 +15,9 @@ enum class ActiveLimit {
   kCylinderAcceleration,  // a cylinder's maximum acceleration (path curvature at speed)
   kSingularity,           // a near-singular pose: the direction needs very fast joints
   kPressure,              // a load pressure at the pump's ceiling (relief; p_s with a CP pump)
+  kDynamicsFailed,        // the ODE dynamics step failed (out of memory): stopping without it
 };
-inline constexpr int kActiveLimitCount = 10;
+inline constexpr int kActiveLimitCount = static_cast<int>(ActiveLimit::kDynamicsFailed) + 1;
 
 const char* to_string(ActiveLimit limit);
 

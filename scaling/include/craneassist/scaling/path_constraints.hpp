@@ -18,7 +18,7 @@
 #pragma once
 
 #include "craneassist/dynamics/model.hpp"
-#include "craneassist/dynamics/rigid_body_terms.hpp"
+#include "craneassist/dynamics/path_terms.hpp"
 #include "craneassist/scaling/active_limit.hpp"
 
 namespace craneassist::scaling {

@@ -12,12 +12,20 @@
 // A lower acceleration bound above zero is lowered to zero before the filter: no constraint
 // may force the path to speed up (slowing down always lowers the pump flow).
 //
-// No allocation after construction, no exceptions, bounded work.
+// A failed dynamics step (RigidBodyTerms::path_terms: ODE out of memory) is a stop request, as
+// a stale input is, within the bounds that need no dynamics (no power bound); it is reported
+// (dynamics_failed, limit kDynamicsFailed) and the next cycle tries again.
+//
+// No allocation after construction, no exceptions (update() is noexcept), bounded work.
 #pragma once
 
-#include "craneassist/dynamics/rigid_body_terms.hpp"
+#include "craneassist/dynamics/path_terms.hpp"
 #include "craneassist/scaling/path_constraints.hpp"
 #include "craneassist/scaling/scaling_filter.hpp"
+
+namespace craneassist::dynamics {
+class RigidBodyTerms;
+}
 
 namespace craneassist::scaling {
 
@@ -44,8 +52,9 @@ struct PathScalerOutput {
   double sdot_d = 0.0;  // the prescaled speed request given to the filter
   SpeedLimits speed;
   AccelerationBounds bounds;
-  dynamics::PathTerms terms;  // m(s), b(s) at the start of the cycle
+  dynamics::PathTerms terms;  // m(s), b(s) at the start of the cycle (zero: failed)
   ActiveLimit limit = ActiveLimit::kNone;
+  bool dynamics_failed = false;  // this cycle's dynamics step failed: stopping without it
 };
 
 class PathScaler {
@@ -59,7 +68,7 @@ class PathScaler {
   const PathScalerConfig& config() const { return config_; }
 
   void update(const JointVector& q, const PathGeometry& geometry, const PathScalerInput& in,
-              PathScalerOutput& out);
+              PathScalerOutput& out) noexcept;
 
  private:
   const dynamics::CraneModel& model_;
@@ -68,6 +77,16 @@ class PathScaler {
   ScalingFilter filter_;
   AccelerationLimits acceleration_limits_;
 };
+
+// The scalers' per-cycle dynamics: m, b at (q, sdot) from `terms` and the acceleration bounds
+// with them. When the dynamics step fails: zero m and b, the bounds that need no dynamics
+// (limits without the power bound), and false. Allocates nothing, throws nothing.
+[[nodiscard]] bool path_terms_and_bounds(const dynamics::CraneModel& model,
+                                         dynamics::RigidBodyTerms& terms, const JointVector& q,
+                                         const PathGeometry& geometry, double sdot,
+                                         const AccelerationLimits& limits,
+                                         dynamics::PathTerms& path_terms,
+                                         AccelerationBounds& bounds) noexcept;
 
 // delta(|e|) of algorithms.md section 6: 1 below e_ok, e_ok / |e| above.
 double tracking_factor(double error_m, double error_ok_m);

@@ -14,13 +14,16 @@
 // dt = 2 ds / (sdot_k + sdot_k+1). No speed grid: the profile is exact to the sampling in s.
 // The path jerk bound is not part of it (a (s, sdot) state cannot carry the acceleration): the
 // bound is the acceleration-limited optimum, a lower bound for any jerk bound.
-// An offline tool: it allocates.
+// An offline tool: it allocates, and throws std::runtime_error when a dynamics step fails.
 #pragma once
 
 #include <vector>
 
-#include "craneassist/dynamics/rigid_body_terms.hpp"
 #include "craneassist/scaling/path_constraints.hpp"
+
+namespace craneassist::dynamics {
+class RigidBodyTerms;
+}
 
 namespace craneassist::scaling {
 

@@ -66,7 +66,11 @@ struct TipPathInput {
   Eigen::Vector3d direction = Eigen::Vector3d::UnitX();  // u, unit
   double sdot = 0.0;                                     // present path speed, m/s (>= 0)
   double intended_speed = 0.0;  // the speed the motion heads for, m/s (>= sdot; shapes bounds)
-  const JointVector* cylinder_force = nullptr;  // present forces (min-ls-power); null: unknown
+  // The present cylinder forces, N (min-ls-power resolves at them), when known; unknown: the
+  // resolution assumes no loads (min-ls-power then minimises flow at the margin). Copied in
+  // update(); TipPath keeps no reference to the caller's data.
+  bool forces_known = false;
+  JointVector cylinder_force;  // one per joint when forces_known
 };
 
 struct TipPathOutput {
@@ -93,8 +97,8 @@ class TipPath {
   // Forgets the previous solution (no window on the next update).
   void reset();
 
-  // q: the reference configuration.
-  void update(const JointVector& q, const TipPathInput& in, TipPathOutput& out);
+  // q: the reference configuration. No allocation, no exception.
+  void update(const JointVector& q, const TipPathInput& in, TipPathOutput& out) noexcept;
 
  private:
   struct Shape {  // per-update values shared by the three resolves
@@ -104,8 +108,9 @@ class TipPath {
     bool smooth = false;       // move the null coordinate jerk-limited from the previous solution
   };
   void resolve(const JointVector& q, const Eigen::Vector3d& u, const Shape& shape, JointVector& f1,
-               dynamics::NullSpaceStatus& status);
-  void weakest_direction(const Eigen::Vector3d& u, const JointVector& arms, TipPathOutput& out);
+               dynamics::NullSpaceStatus& status) noexcept;
+  void weakest_direction(const Eigen::Vector3d& u, const JointVector& arms,
+                         TipPathOutput& out) noexcept;
 
   const dynamics::CraneModel& model_;
   TipPathConfig config_;
@@ -115,7 +120,6 @@ class TipPath {
   double null_rate_ = 0.0, null_rate_next_ = 0.0;
   JointVector target_f1_, heading_f1_;  // the resolution's optimum (of the last resolve, at q)
   Eigen::Vector3d previous_u_ = Eigen::Vector3d::UnitX();
-  const JointVector* cylinder_force_ = nullptr;  // of the present update
   // Working data.
   JointVector joint_accel_max_;                      // at the configuration being resolved
   std::array<bool, dynamics::kMaxJoints> at_end_{};  // pinned at an end
@@ -126,7 +130,8 @@ class TipPath {
   dynamics::NullSpaceResult result_;
   dynamics::JointRateBounds bounds_;
   dynamics::SnsResult sns_;
-  JointVector arms_, force_, q_shift_, f1_plus_, f1_minus_;
+  JointVector arms_, q_shift_, f1_plus_, f1_minus_;
+  JointVector force_;  // the present update's cylinder forces (zero: unknown); problem_ reads it
 };
 
 }  // namespace craneassist::scaling

@@ -23,16 +23,23 @@
 //      and the normal part within normal_acceleration_max.
 //
 // A stale input stops along the present direction (target 0) within the same bounds; at rest
-// with a zero target the reference stays exactly at rest. No allocation, no exceptions, bounded
-// work per cycle.
+// with a zero target the reference stays exactly at rest. A failed dynamics step (the ODE step of
+// RigidBodyTerms::path_terms, out of memory) stops the same way, within the bounds that need no
+// dynamics (cylinder accelerations, the path's acceleration and deceleration; no power bound),
+// and is reported (dynamics_failed, limit kDynamicsFailed); the next cycle tries again. No
+// allocation, no exceptions (update() is noexcept), bounded work per cycle.
 #pragma once
 
 #include <Eigen/Core>
 
-#include "craneassist/dynamics/rigid_body_terms.hpp"
+#include "craneassist/dynamics/path_terms.hpp"
 #include "craneassist/scaling/path_constraints.hpp"
 #include "craneassist/scaling/path_scaler.hpp"
 #include "craneassist/scaling/scaling_filter.hpp"
+
+namespace craneassist::dynamics {
+class RigidBodyTerms;
+}
 
 namespace craneassist::scaling {
 
@@ -73,9 +80,10 @@ struct TipScalerOutput {
   double scale = 1.0;         // k = |c*| / |c| (1 without a command)
   SpeedLimits speed;
   AccelerationBounds bounds;
-  dynamics::PathTerms terms;  // m(s), b(s) along u at the start of the cycle
+  dynamics::PathTerms terms;  // m(s), b(s) along u at the start of the cycle (zero: failed)
   ActiveLimit limit = ActiveLimit::kNone;
-  bool at_rest = true;  // velocity and acceleration exactly zero
+  bool at_rest = true;           // velocity and acceleration exactly zero
+  bool dynamics_failed = false;  // this cycle's dynamics step failed: stopping without it
 };
 
 class TipScaler {
@@ -98,7 +106,7 @@ class TipScaler {
 
   // geometry: TipPath's resolution of in.direction at q.
   void update(const JointVector& q, const PathGeometry& geometry, const TipScalerInput& in,
-              TipScalerOutput& out);
+              TipScalerOutput& out) noexcept;
 
  private:
   // The lowest cylinder-speed cap ahead along the path (see the header comment), m/s.

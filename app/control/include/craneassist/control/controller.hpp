@@ -13,7 +13,10 @@
 //      the cylinder position error against the reference of one valve delay ago
 // The other modes are baselines: kFlowOnly prescales the joint rates for flow and cylinder speed
 // only (no power limit, no filter); kNone passes the command through unscaled.
-// Constructed once with the model; update() allocates nothing and throws nothing.
+// Constructed once with the model (the constructor allocates and may throw); update() allocates
+// nothing and throws nothing (noexcept): the one dynamics call in the cycle,
+// RigidBodyTerms::path_terms, reports a failed ODE step as a status, and the controller stops on
+// it (see update()).
 #pragma once
 
 #include <memory>
@@ -76,18 +79,25 @@ class Controller {
   // One control period. An invalid measurement or a non-finite command brings the motion to a
   // jerk-limited stop along the current direction (kStopping, limit stale_input) and then holds
   // with neutral valves (kStopped); the other modes stop at once. The first valid cycle after
-  // kStopped restarts the reference at the measured configuration (as reset()).
+  // kStopped restarts the reference at the measured configuration (as reset()). A cycle whose
+  // dynamics step fails (kFull; ODE out of memory) stops the same way (kStopping, then kStopped;
+  // limit dynamics_failed, ref_power_w 0); each cycle tries the dynamics again.
   ControllerStatus update(const valves::MachineState& state, const Eigen::Vector3d& v_cmd_m_s,
-                          ControllerOutput& out);
+                          ControllerOutput& out) noexcept;
 
   double period_s() const { return period_s_; }
+  // The ODE dynamics probe of kFull (nullptr in the other modes). For tests: its
+  // fail_steps_for_testing() hook makes the cycle's dynamics step fail.
+  dynamics::RigidBodyTerms* dynamics_for_testing() noexcept { return terms_.get(); }
   // How often a command reaches the valves (ControllerOptions::valve_command_period_s).
   void set_valve_command_period(double period_s);
 
  private:
   void update_full(const valves::MachineState& state, const Eigen::Vector3d& v_cmd, bool stale,
-                   ControllerOutput& out);
-  void update_rate_prescaled(const Eigen::Vector3d& v_cmd, ControllerOutput& out);
+                   ControllerOutput& out) noexcept;
+  void update_rate_prescaled(const Eigen::Vector3d& v_cmd, ControllerOutput& out) noexcept;
+  // This cycle's dynamics step failed (kFull only).
+  bool dynamics_failed() const noexcept;
 
   const dynamics::CraneModel& model_;
   ControllerOptions options_;
@@ -107,7 +117,7 @@ class Controller {
   scaling::FlowPrescalingResult prescale_;
   scaling::TipPathOutput tip_out_;
   scaling::TipScalerOutput scaler_out_;
-  JointVector dc_dq_, qddot_max_, cylinder_force_;
+  JointVector dc_dq_, qddot_max_;
   JointVector q_ref_;
   double tip_error_filtered_m_ = 0.0;
   bool neutral_ = false;  // the last update returned kStopped (valves neutral)
