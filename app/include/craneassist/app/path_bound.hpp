@@ -8,8 +8,8 @@
 
 #include "craneassist/app/planning.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/input/prescribed_path.hpp"
 #include "craneassist/input/replay.hpp"
-#include "craneassist/input/tip_path.hpp"
 #include "craneassist/scaling/time_optimal.hpp"
 
 namespace craneassist::app {

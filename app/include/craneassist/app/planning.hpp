@@ -8,7 +8,7 @@
 #include <string_view>
 
 #include "craneassist/input/joint_trajectory.hpp"
-#include "craneassist/input/tip_path.hpp"
+#include "craneassist/input/prescribed_path.hpp"
 #include "craneassist/planner/dp_planner.hpp"
 
 namespace craneassist::app {

@@ -1,4 +1,4 @@
-#include "craneassist/input/tip_path.hpp"
+#include "craneassist/input/prescribed_path.hpp"
 
 #include <algorithm>
 #include <array>

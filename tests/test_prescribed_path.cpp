@@ -1,5 +1,5 @@
-// Prescribed tip paths (input/tip_path.hpp): the quintic line and the clamped cubic spline, their
-// derivatives, the strict reader and the writer.
+// Prescribed tip paths (input/prescribed_path.hpp): the quintic line and the clamped cubic spline,
+// their derivatives, the strict reader and the writer.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "allocation_counter.hpp"
-#include "craneassist/input/tip_path.hpp"
+#include "craneassist/input/prescribed_path.hpp"
 
 namespace craneassist::input {
 namespace {
