@@ -115,6 +115,7 @@ int run_bound_command(const BoundArgs& args) {
   std::string header;
   std::optional<input::PrescribedPath> path;
   std::optional<input::Replay> replay;
+  const char* format = "replay";  // the file's format, for its errors
   try {
     cfg = args.config_file.empty() ? config::default_crane_config()
                                    : config::load_crane_config(args.config_file);
@@ -122,6 +123,7 @@ int run_bound_command(const BoundArgs& args) {
     if (!args.resolution.empty()) config::set_resolution(cfg, args.resolution);
     header = header_of(config::read_text_file(args.file));
     if (header == "t,x,y,z") {
+      format = "path";
       path = input::PrescribedPath::load_file(args.file);
     } else if (header == "t,v_x,v_y,v_z" || header == "t,v_x,v_y,v_z,stop") {
       replay = input::Replay::load_file(args.file);
@@ -133,11 +135,8 @@ int run_bound_command(const BoundArgs& args) {
   } catch (const config::ConfigError& e) {
     spdlog::error("{}", e.what());
     return kExitUsage;
-  } catch (const input::PrescribedPathError& e) {
-    spdlog::error("path: {}", e.what());
-    return kExitUsage;
-  } catch (const input::ReplayError& e) {
-    spdlog::error("replay: {}", e.what());
+  } catch (const input::FileError& e) {
+    spdlog::error("{}: {}", format, e.what());
     return kExitUsage;
   } catch (const std::invalid_argument& e) {
     spdlog::error("{}", e.what());

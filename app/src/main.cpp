@@ -212,7 +212,7 @@ int run_trajectory_command(const ReplayArgs& args, const config::CraneConfig& cf
                     traj->joints(), cfg.model.name, cfg.model.dof());
       return kExitUsage;
     }
-  } catch (const input::TrajectoryError& e) {
+  } catch (const input::FileError& e) {
     spdlog::error("trajectory: {}", e.what());
     return kExitUsage;
   }
@@ -309,7 +309,7 @@ int run_replay_command(const ReplayArgs& args) {
   } catch (const config::ConfigError& e) {
     spdlog::error("config: {}", e.what());
     return kExitUsage;
-  } catch (const input::ReplayError& e) {
+  } catch (const input::FileError& e) {
     spdlog::error("replay: {}", e.what());
     return kExitUsage;
   } catch (const std::exception& e) {

@@ -128,7 +128,7 @@ int run_plan_command(const PlanArgs& args) {
   } catch (const config::ConfigError& e) {
     spdlog::error("config: {}", e.what());
     return kExitUsage;
-  } catch (const input::PrescribedPathError& e) {
+  } catch (const input::FileError& e) {
     spdlog::error("path: {}", e.what());
     return kExitUsage;
   } catch (const CLI::Error&) {
@@ -287,7 +287,7 @@ int run_energy_command(const EnergyArgs& args) {
                   runs[i + 1].energy_j / 1e3,
                   runs[i].penalised_stages > 0 ? "  (plan violates limits)" : "");
     }
-  } catch (const input::PrescribedPathError& e) {
+  } catch (const input::FileError& e) {
     spdlog::error("path: {}", e.what());
     return kExitUsage;
   } catch (const std::exception& e) {
