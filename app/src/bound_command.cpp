@@ -18,7 +18,6 @@ namespace {
 
 using app::JointPath;
 using app::JointPathOptions;
-using app::StartExtension;
 
 // The header of a CSV file: its first line that is neither blank nor a comment.
 std::string header_of(const std::string& text) {
@@ -100,7 +99,7 @@ CLI::App* add_bound_command(CLI::App& cli, BoundArgs& args) {
       ->add_option("--start", args.start,
                    "A path file's start configuration: the shortest feasible extension or the "
                    "middle of the feasible range (paper 000)")
-      ->check(CLI::IsMember({"shortest", "middle"}))
+      ->check(CLI::IsMember(names_of(app::kStartExtensions)))
       ->capture_default_str();
   bound->add_option("--ds", args.ds_m, "Path sample spacing, m")
       ->check(CLI::Range(1e-3, 0.1))
@@ -154,9 +153,7 @@ int run_bound_command(const BoundArgs& args) {
     if (path) {
       JointPathOptions options;
       options.ds_m = args.ds_m;
-      StartExtension start = StartExtension::kShortest;
-      app::parse_start_extension(args.start, start);
-      options.start = start;
+      options.start = app::parse_start_extension(args.start).value();
       parts.push_back(app::joint_path_for(cfg, *path, options));
       auto lifted = cfg;
       lifted.scaling.jerk_max_m_s3 *= kJerkLift;
@@ -175,8 +172,7 @@ int run_bound_command(const BoundArgs& args) {
       "  resolution %s; limits: pump flow and cylinder speeds (with the %.0f %% reserve), "
       "%s power with m(s), b(s), cylinder and path accelerations\n",
       config::resolution_description(cfg).c_str(), 100.0 * cfg.control.flow_reserve,
-      cfg.scaling.power_bound == config::PowerBoundSetting::kLoadSensing ? "load-sensing"
-                                                                         : "baseline");
+      cfg.scaling.power_bound == dynamics::PowerBound::kLoadSensing ? "load-sensing" : "baseline");
   if (path) {
     std::printf("  tip path %.2f m (%.1f s in the file), start extension %s (%.3f m)\n",
                 path->length_m(), path->duration_s(), args.start.c_str(),
