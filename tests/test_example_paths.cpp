@@ -7,7 +7,7 @@
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/dynamics/inverse_kinematics.hpp"
-#include "craneassist/input/tip_path.hpp"
+#include "craneassist/input/prescribed_path.hpp"
 
 namespace {
 

@@ -27,7 +27,7 @@ constexpr const char* kTwoJoints =
 std::string error_of(std::string_view text) {
   try {
     input::JointTrajectory::parse(text, "traj.csv");
-  } catch (const input::TrajectoryError& e) {
+  } catch (const input::FileError& e) {
     return e.what();
   }
   return "no error";

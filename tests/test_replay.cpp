@@ -26,21 +26,21 @@ namespace fs = std::filesystem;
 constexpr const char* kSource = "bad_replay.csv";
 
 // Parses text that must be rejected; returns the error for further checks.
-ReplayError parse_error(std::string_view text, const ReplayLimits& limits = {}) {
+FileError parse_error(std::string_view text, const ReplayLimits& limits = {}) {
   try {
     Replay::parse(text, kSource, limits);
-  } catch (const ReplayError& e) {
+  } catch (const FileError& e) {
     return e;
   }
   ADD_FAILURE() << "accepted:\n" << text;
-  return ReplayError("", 0, "", "");
+  return FileError("", 0, "", "");
 }
 
 // Checks line, field, that the reason contains reason_part, and the what() layout.
 void expect_rejected(std::string_view text, std::size_t line, std::string_view field,
                      std::string_view reason_part, const ReplayLimits& limits = {}) {
   SCOPED_TRACE(std::string("text:\n") + std::string(text));
-  const ReplayError e = parse_error(text, limits);
+  const FileError e = parse_error(text, limits);
   EXPECT_EQ(e.file(), kSource);
   EXPECT_EQ(e.line(), line);
   EXPECT_EQ(e.field(), field);
@@ -235,7 +235,7 @@ TEST(ReplayFile, ErrorsInAFileNameTheFile) {
   try {
     Replay::load_file(file.path());
     FAIL() << "accepted";
-  } catch (const ReplayError& e) {
+  } catch (const FileError& e) {
     EXPECT_EQ(e.file(), file.path().string());
     EXPECT_EQ(e.line(), 3u);
     EXPECT_EQ(e.field(), "v_y");
@@ -249,7 +249,7 @@ TEST(ReplayFile, MissingFileIsLineZero) {
   try {
     Replay::load_file(missing);
     FAIL() << "accepted";
-  } catch (const ReplayError& e) {
+  } catch (const FileError& e) {
     EXPECT_EQ(e.line(), 0u);
     EXPECT_EQ(e.field(), "");
     EXPECT_EQ(std::string(e.what()), missing.string() + ":0: file not found");
@@ -260,7 +260,7 @@ TEST(ReplayFile, DirectoryIsRejected) {
   try {
     Replay::load_file(fs::temp_directory_path());
     FAIL() << "accepted";
-  } catch (const ReplayError& e) {
+  } catch (const FileError& e) {
     EXPECT_EQ(e.line(), 0u);
     EXPECT_NE(e.reason().find("directory"), std::string::npos) << e.what();
   }
@@ -460,7 +460,7 @@ TEST(ReplayStopColumn, StrictErrorsNameTheStopField) {
                   "expected the header 't,v_x,v_y,v_z' or 't,v_x,v_y,v_z,stop', got "
                   "'t,v_x,v_y,v_z,Stop'");
   expect_rejected("t,v_x,v_y,v_z\n0,0,0,0,1\n", 2, "", "expected 4 fields (t,v_x,v_y,v_z), got 5");
-  const ReplayError e = parse_error(h + "0,0,0,0,0\n1,0,0,0,x\n");
+  const FileError e = parse_error(h + "0,0,0,0,0\n1,0,0,0,x\n");
   EXPECT_EQ(std::string(e.what()), "bad_replay.csv:3: field 'stop': expected 0 or 1, got 'x'");
 }
 

@@ -65,17 +65,6 @@ ExtensionResolutionResult solve(Resolution r, const Case& c, const JointRateBoun
 
 }  // namespace
 
-TEST(Resolutions, NamesRoundTrip) {
-  for (Resolution r : {Resolution::kPinvJoint, Resolution::kPinvActuator, Resolution::kMinFlow,
-                       Resolution::kMinLsPower}) {
-    Resolution parsed;
-    ASSERT_TRUE(parse_resolution(to_string(r), parsed));
-    EXPECT_EQ(parsed, r);
-  }
-  Resolution parsed;
-  EXPECT_FALSE(parse_resolution("min-fuel", parsed));
-}
-
 TEST(Resolutions, EveryResolutionMeetsTheTipTask) {
   std::mt19937 rng(11);
   int checked = 0;

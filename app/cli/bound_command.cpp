@@ -18,7 +18,6 @@ namespace {
 
 using offline::JointPath;
 using offline::JointPathOptions;
-using offline::StartExtension;
 
 // The header of a CSV file: its first line that is neither blank nor a comment.
 std::string header_of(const std::string& text) {
@@ -100,7 +99,7 @@ CLI::App* add_bound_command(CLI::App& cli, BoundArgs& args) {
       ->add_option("--start", args.start,
                    "A path file's start configuration: the shortest feasible extension or the "
                    "middle of the feasible range (paper 000)")
-      ->check(CLI::IsMember({"shortest", "middle"}))
+      ->check(CLI::IsMember(names_of(offline::kStartExtensions)))
       ->capture_default_str();
   bound->add_option("--ds", args.ds_m, "Path sample spacing, m")
       ->check(CLI::Range(1e-3, 0.1))
@@ -115,6 +114,7 @@ int run_bound_command(const BoundArgs& args) {
   std::string header;
   std::optional<input::PrescribedPath> path;
   std::optional<input::Replay> replay;
+  const char* format = "replay";  // the file's format, for its errors
   try {
     cfg = args.config_file.empty() ? config::default_crane_config()
                                    : config::load_crane_config(args.config_file);
@@ -122,6 +122,7 @@ int run_bound_command(const BoundArgs& args) {
     if (!args.resolution.empty()) config::set_resolution(cfg, args.resolution);
     header = header_of(config::read_text_file(args.file));
     if (header == "t,x,y,z") {
+      format = "path";
       path = input::PrescribedPath::load_file(args.file);
     } else if (header == "t,v_x,v_y,v_z" || header == "t,v_x,v_y,v_z,stop") {
       replay = input::Replay::load_file(args.file);
@@ -133,11 +134,8 @@ int run_bound_command(const BoundArgs& args) {
   } catch (const config::ConfigError& e) {
     spdlog::error("{}", e.what());
     return kExitUsage;
-  } catch (const input::PrescribedPathError& e) {
-    spdlog::error("path: {}", e.what());
-    return kExitUsage;
-  } catch (const input::ReplayError& e) {
-    spdlog::error("replay: {}", e.what());
+  } catch (const input::FileError& e) {
+    spdlog::error("{}: {}", format, e.what());
     return kExitUsage;
   } catch (const std::invalid_argument& e) {
     spdlog::error("{}", e.what());
@@ -155,9 +153,7 @@ int run_bound_command(const BoundArgs& args) {
     if (path) {
       JointPathOptions options;
       options.ds_m = args.ds_m;
-      StartExtension start = StartExtension::kShortest;
-      offline::parse_start_extension(args.start, start);
-      options.start = start;
+      options.start = offline::parse_start_extension(args.start).value();
       parts.push_back(offline::joint_path_for(cfg, *path, options));
       auto lifted = cfg;
       lifted.scaling.jerk_max_m_s3 *= kJerkLift;
@@ -176,8 +172,7 @@ int run_bound_command(const BoundArgs& args) {
       "  resolution %s; limits: pump flow and cylinder speeds (with the %.0f %% reserve), "
       "%s power with m(s), b(s), cylinder and path accelerations\n",
       config::resolution_description(cfg).c_str(), 100.0 * cfg.control.flow_reserve,
-      cfg.scaling.power_bound == config::PowerBoundSetting::kLoadSensing ? "load-sensing"
-                                                                         : "baseline");
+      cfg.scaling.power_bound == dynamics::PowerBound::kLoadSensing ? "load-sensing" : "baseline");
   if (path) {
     std::printf("  tip path %.2f m (%.1f s in the file), start extension %s (%.3f m)\n",
                 path->length_m(), path->duration_s(), args.start.c_str(),

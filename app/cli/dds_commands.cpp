@@ -36,12 +36,6 @@ class StopOnSignal {
   StopOnSignal& operator=(const StopOnSignal&) = delete;
 };
 
-config::DdsTransport parse_transport(const std::string& name) {
-  if (name == "udp") return config::DdsTransport::kUdp;
-  if (name == "shm") return config::DdsTransport::kShm;
-  return config::DdsTransport::kDefault;
-}
-
 void add_common_options(CLI::App& app, int& domain_id, double& timeout_s, std::string& transport,
                         const char* timeout_help) {
   domain_id = config::default_telemetry_config().domain_id;
@@ -51,7 +45,7 @@ void add_common_options(CLI::App& app, int& domain_id, double& timeout_s, std::s
   app.add_option("--timeout", timeout_s, timeout_help)->check(CLI::PositiveNumber);
   app.add_option("--transport", transport,
                  "default (shared memory and UDP), udp (UDPv4 only) or shm (shared memory only)")
-      ->check(CLI::IsMember({"default", "udp", "shm"}))
+      ->check(CLI::IsMember(names_of(config::kDdsTransports)))
       ->capture_default_str();
 }
 
@@ -83,7 +77,7 @@ int run_echo_command(const EchoArgs& args) {
   o.count = args.count;
   o.timeout_s = args.timeout_s;
   o.format = args.format == "csv" ? dds::EchoFormat::kCsv : dds::EchoFormat::kText;
-  o.transport = parse_transport(args.transport);
+  o.transport = config::parse_dds_transport(args.transport).value();
   StopOnSignal stop;
   return dds::run_echo(o);
 }
@@ -105,7 +99,7 @@ int run_dashboard_command(const DashboardArgs& args) {
   o.domain_id = args.domain_id;
   o.once = args.once;
   o.timeout_s = args.timeout_s;
-  o.transport = parse_transport(args.transport);
+  o.transport = config::parse_dds_transport(args.transport).value();
   StopOnSignal stop;
   return dds::run_dashboard(o);
 }

@@ -12,7 +12,7 @@ void add_backend_options(CLI::App& command, BackendArgs& args) {
       .add_option("--backend", args.backend,
                   "Machine backend: sim (the simulated crane) or can (a machine on a CAN bus, "
                   "docs/can.md; implies real-time pacing). Default: the config's `backend:` (sim)")
-      ->check(CLI::IsMember({"sim", "can"}));
+      ->check(CLI::IsMember(names_of(config::kBackendKinds)));
   command.add_option("--can", args.can_iface,
                      "--backend can: the CAN interface (can0, vcan0; default: can.interface)");
   command
@@ -30,8 +30,9 @@ void add_backend_options(CLI::App& command, BackendArgs& args) {
 }
 
 bool uses_can_backend(const BackendArgs& args, const config::CraneConfig& cfg) {
-  return args.backend.empty() ? cfg.backend.kind == config::BackendKind::kCan
-                              : args.backend == "can";
+  const auto kind =
+      args.backend.empty() ? cfg.backend.kind : config::parse_backend_kind(args.backend).value();
+  return kind == config::BackendKind::kCan;
 }
 
 int Machine::open(const config::CraneConfig& cfg, const BackendArgs& args) {

@@ -55,7 +55,7 @@ struct ReplayArgs {
   std::string log_file = "craneassist-log.csv";
   bool no_log = false;
   bool no_scaling = false;
-  std::string scaling = "full";
+  std::string scaling = control::to_string(control::ScalingMode::kFull);
   std::string power_bound;  // empty: the config's
   std::string resolution;   // empty: the config's
   bool realtime = false;
@@ -86,14 +86,14 @@ double cli_pressure(const std::string& option, const std::string& text) {
   return cli_quantity(option, text, config::Dimension::kPressure);
 }
 
-const char* power_bound_name(config::PowerBoundSetting b, dynamics::PumpMode mode) {
+const char* power_bound_name(dynamics::PowerBound b, dynamics::PumpMode mode) {
   switch (b) {
-    case config::PowerBoundSetting::kLoadSensing:
+    case dynamics::PowerBound::kLoadSensing:
       return mode == dynamics::PumpMode::kConstantPressure ? "constant-pressure, p_s Q"
                                                            : "load-sensing";
-    case config::PowerBoundSetting::kActuatorSum:
+    case dynamics::PowerBound::kActuatorPowerSum:
       return "actuator power sum (baseline)";
-    case config::PowerBoundSetting::kNone:
+    case dynamics::PowerBound::kNone:
       return "none";
   }
   return "?";
@@ -212,7 +212,7 @@ int run_trajectory_command(const ReplayArgs& args, const config::CraneConfig& cf
                     traj->joints(), cfg.model.name, cfg.model.dof());
       return kExitUsage;
     }
-  } catch (const input::TrajectoryError& e) {
+  } catch (const input::FileError& e) {
     spdlog::error("trajectory: {}", e.what());
     return kExitUsage;
   }
@@ -260,12 +260,8 @@ int run_replay_command(const ReplayArgs& args) {
         throw CLI::ValidationError("--resolution", e.what());
       }
     }
-    if (args.power_bound == "load_sensing") {
-      cfg.scaling.power_bound = config::PowerBoundSetting::kLoadSensing;
-    } else if (args.power_bound == "actuator_sum") {
-      cfg.scaling.power_bound = config::PowerBoundSetting::kActuatorSum;
-    } else if (args.power_bound == "none") {
-      cfg.scaling.power_bound = config::PowerBoundSetting::kNone;
+    if (!args.power_bound.empty()) {
+      cfg.scaling.power_bound = dynamics::parse_power_bound(args.power_bound).value();
     }
     if (!args.pump_max_flow.empty()) {
       cfg.model.pump.max_flow_m3_s =
@@ -310,7 +306,7 @@ int run_replay_command(const ReplayArgs& args) {
   } catch (const config::ConfigError& e) {
     spdlog::error("config: {}", e.what());
     return kExitUsage;
-  } catch (const input::ReplayError& e) {
+  } catch (const input::FileError& e) {
     spdlog::error("replay: {}", e.what());
     return kExitUsage;
   } catch (const std::exception& e) {
@@ -334,10 +330,8 @@ int run_replay_command(const ReplayArgs& args) {
     if (!args.no_log) log.emplace(args.log_file, cfg.model.dof());
     control::RunOptions options;
     if (control::CycleObserver* o = telemetry.observer()) options.observers.push_back(o);
-    options.controller.mode = args.no_scaling          ? control::ScalingMode::kNone
-                              : args.scaling == "flow" ? control::ScalingMode::kFlowOnly
-                              : args.scaling == "none" ? control::ScalingMode::kNone
-                                                       : control::ScalingMode::kFull;
+    options.controller.mode =
+        args.no_scaling ? control::ScalingMode::kNone : control::parse_scaling_mode(args.scaling).value();
     options.realtime = args.realtime || machine.real_time();
     options.settle_s = args.settle_s;
     options.freeze_at_s = args.freeze_at_s;
@@ -364,7 +358,7 @@ int run_replay_command(const ReplayArgs& args) {
 
 struct ExperimentArgs {
   std::string config_file;  // empty: the embedded planar 2R arm
-  std::string power_bound = "load_sensing";
+  std::string power_bound = dynamics::to_string(dynamics::PowerBound::kLoadSensing);
   double speed = 2.0;
   double duration_s = 8.0;
   double jerk_max = 1000.0;
@@ -391,10 +385,7 @@ int run_experiment_command(const ExperimentArgs& args) {
     options.sdot_request = args.speed;
     options.duration_s = args.duration_s;
     options.jerk_max = args.jerk_max;
-    options.power_bound = args.power_bound == "actuator_sum"
-                              ? scaling::PowerBound::kActuatorPowerSum
-                          : args.power_bound == "none" ? scaling::PowerBound::kNone
-                                                       : scaling::PowerBound::kLoadSensing;
+    options.power_bound = dynamics::parse_power_bound(args.power_bound).value();
     dynamics::JointVector q0, f1, f2;
     offline::sine_path(0.0, q0, f1, f2);
     options.pump_power_limiter = args.pump_limiter;
@@ -408,7 +399,7 @@ int run_experiment_command(const ExperimentArgs& args) {
     std::printf("craneassist experiment-2r: %s, f(s) = [pi/6 - sin s, -pi/6 - 0.5 sin s]\n",
                 cfg.model.name.c_str());
     std::printf("  power bound %s, requested sdot %.2f 1/s, jerk bound %.0f, %d cycles\n",
-                scaling::to_string(options.power_bound), args.speed, args.jerk_max, s.cycles);
+                dynamics::to_string(options.power_bound), args.speed, args.jerk_max, s.cycles);
     std::printf("  path covered s = %.2f in %.1f s, peak path jerk %.1f\n", s.s_final,
                 args.duration_s, s.peak_path_jerk);
     std::printf(
@@ -461,7 +452,7 @@ int main(int argc, char** argv) {
       ->add_option("--scaling", args.scaling,
                    "full: power-limited, jerk-bounded path scaling; flow: flow and cylinder-speed "
                    "prescaling only; none: the command unscaled")
-      ->check(CLI::IsMember({"full", "flow", "none"}))
+      ->check(CLI::IsMember(names_of(control::kScalingModes)))
       ->capture_default_str();
   replay->add_flag("--no-scaling", args.no_scaling,
                    "Same as --scaling none (to see what scaling prevents)");
@@ -469,7 +460,7 @@ int main(int argc, char** argv) {
       ->add_option("--power-bound", args.power_bound,
                    "Override the config's power bound: load_sensing, actuator_sum (the older "
                    "baseline) or none")
-      ->check(CLI::IsMember({"load_sensing", "actuator_sum", "none"}));
+      ->check(CLI::IsMember(names_of(dynamics::kPowerBounds)));
   cli::add_resolution_option(*replay, args.resolution, "for the run");
   replay->add_flag("--realtime", args.realtime,
                    "Pace the loop at real time (default: as fast as possible)");
@@ -504,7 +495,7 @@ int main(int argc, char** argv) {
       ->add_option("--power-bound", exp.power_bound,
                    "load_sensing (the correct LS bound), actuator_sum (the older baseline) "
                    "or none")
-      ->check(CLI::IsMember({"load_sensing", "actuator_sum", "none"}))
+      ->check(CLI::IsMember(names_of(dynamics::kPowerBounds)))
       ->capture_default_str();
   experiment->add_option("--speed", exp.speed, "Requested path speed, 1/s")
       ->check(CLI::Range(0.01, 20.0))

@@ -66,12 +66,12 @@ CLI::App* add_plan_command(CLI::App& cli, PlanArgs& args) {
   plan->add_option("--cost", args.cost,
                    "What to minimise: ls (load-sensing pump energy), cp (constant-pressure pump "
                    "energy), actuator-energy (positive cylinder work), extension (extension use)")
-      ->check(CLI::IsMember({"ls", "cp", "actuator-energy", "extension"}))
+      ->check(CLI::IsMember(names_of(planner::kPlanCosts)))
       ->capture_default_str();
   plan->add_option("--method", args.method,
                    "dp (the global planner) or an online resolution driven along the path: "
                    "pinv-joint, pinv-actuator, min-flow, min-ls-power")
-      ->check(CLI::IsMember({"dp", "pinv-joint", "pinv-actuator", "min-flow", "min-ls-power"}))
+      ->check(CLI::IsMember(offline::plan_methods()))
       ->capture_default_str();
   plan->add_option("--out", args.out_file,
                    "Joint trajectory CSV to write (docs/trajectory-format.md)")
@@ -79,7 +79,7 @@ CLI::App* add_plan_command(CLI::App& cli, PlanArgs& args) {
   plan->add_option("--start", args.start,
                    "Start configuration: shortest feasible extension, or the middle of the "
                    "feasible range")
-      ->check(CLI::IsMember({"shortest", "middle"}))
+      ->check(CLI::IsMember(names_of(offline::kStartExtensions)))
       ->capture_default_str();
   plan->add_option("--grid", args.grid,
                    "DP grid: positions x velocities x accelerations of the extension cylinder")
@@ -117,8 +117,8 @@ int run_plan_command(const PlanArgs& args) {
       throw CLI::ValidationError(
           "--grid", "expected three counts 2..5000 like 356x101x151, got '" + args.grid + "'");
     }
-    planner::parse_plan_cost(args.cost, stage_options.cost);
-    offline::parse_start_extension(args.start, start);
+    stage_options.cost = planner::parse_plan_cost(args.cost).value();
+    start = offline::parse_start_extension(args.start).value();
     if (cfg.model.pump.supply_pressure_pa > 0.0) {
       stage_options.cp_supply_pressure_pa = cfg.model.pump.supply_pressure_pa;
     }
@@ -128,7 +128,7 @@ int run_plan_command(const PlanArgs& args) {
   } catch (const config::ConfigError& e) {
     spdlog::error("config: {}", e.what());
     return kExitUsage;
-  } catch (const input::PrescribedPathError& e) {
+  } catch (const input::FileError& e) {
     spdlog::error("path: {}", e.what());
     return kExitUsage;
   } catch (const CLI::Error&) {
@@ -288,7 +288,7 @@ int run_energy_command(const EnergyArgs& args) {
                   runs[i + 1].energy_j / 1e3,
                   runs[i].penalised_stages > 0 ? "  (plan violates limits)" : "");
     }
-  } catch (const input::PrescribedPathError& e) {
+  } catch (const input::FileError& e) {
     spdlog::error("path: {}", e.what());
     return kExitUsage;
   } catch (const std::exception& e) {

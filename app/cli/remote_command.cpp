@@ -115,7 +115,7 @@ int run_remote_command(const RemoteArgs& args) {
   } catch (const config::ConfigError& e) {
     spdlog::error("config: {}", e.what());
     return kExitUsage;
-  } catch (const input::ReplayError& e) {
+  } catch (const input::FileError& e) {
     spdlog::error("replay: {}", e.what());
     return kExitUsage;
   } catch (const std::exception& e) {

@@ -2,12 +2,13 @@
 
 #include <vector>
 
+#include "craneassist/config/crane_config.hpp"
+
 namespace craneassist::cli {
 
 CLI::Option* add_resolution_option(CLI::App& command, std::string& value, const std::string& what,
                                    bool allow_all) {
-  std::vector<std::string> names{"energy-optimal", "pinv-joint", "pinv-actuator", "min-flow",
-                                 "min-ls-power"};
+  std::vector<std::string> names = config::resolution_names();
   std::string help =
       "Redundancy resolution " + what +
       ": energy-optimal (min-ls-power with a load-sensing pump, min-flow with a constant-pressure "

@@ -229,7 +229,7 @@ int run_sim_command(const SimArgs& args) {
   } catch (const config::ConfigError& e) {
     spdlog::error("config: {}", e.what());
     return kExitUsage;
-  } catch (const input::ReplayError& e) {
+  } catch (const input::FileError& e) {
     spdlog::error("replay: {}", e.what());
     return kExitUsage;
   } catch (const std::exception& e) {

@@ -99,7 +99,7 @@ int run_suite_command(const SuiteArgs& args) {
   }
   std::vector<std::string> resolutions;
   if (args.resolution == "all") {
-    resolutions = {"pinv-joint", "pinv-actuator", "min-flow", "min-ls-power"};
+    resolutions = names_of(dynamics::kResolutions);
   } else {
     resolutions = {args.resolution};  // empty: the config's
   }

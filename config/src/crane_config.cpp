@@ -300,13 +300,11 @@ void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& mo
   // mode only, but may be given in either (--pump-mode cp then uses it).
   if (pump["mode"].IsDefined()) {
     const std::string mode = r.text(pump, "mode", pp);
-    if (mode == "load-sensing") {
-      p.mode = dynamics::PumpMode::kLoadSensing;
-    } else if (mode == "constant-pressure") {
-      p.mode = dynamics::PumpMode::kConstantPressure;
+    if (const auto parsed = dynamics::parse_pump_mode(mode)) {
+      p.mode = *parsed;
     } else {
       r.fail(pump["mode"], pp + ".mode",
-             "expected load-sensing or constant-pressure, got '" + mode + "'");
+             "expected " + alternatives(dynamics::kPumpModes) + ", got '" + mode + "'");
     }
   }
   if (pump["supply_pressure"].IsDefined()) {
@@ -339,12 +337,11 @@ void read_backend(Reader& r, const YAML::Node& root, BackendSettings& backend) {
   const YAML::Node kind = root["backend"];
   if (kind.IsDefined() && !kind.IsNull()) {
     const std::string text = r.text(root, "backend", "");
-    if (text == "sim") {
-      backend.kind = BackendKind::kSim;
-    } else if (text == "can") {
-      backend.kind = BackendKind::kCan;
+    if (const auto parsed = parse_backend_kind(text)) {
+      backend.kind = *parsed;
     } else {
-      r.fail(kind, "backend", "unknown backend '" + text + "' (expected sim or can)");
+      r.fail(kind, "backend",
+             "unknown backend '" + text + "' (expected " + alternatives(kBackendKinds) + ")");
     }
   }
   const YAML::Node can = root["can"];
@@ -437,15 +434,11 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   sc.power_reserve = r.value_in(scaling, "power_reserve", sp, Dimension::kDimensionless, 0.0, 0.5,
                                 "between 0 and 0.5");
   const std::string bound = r.text(scaling, "power_bound", sp);
-  if (bound == "load_sensing") {
-    sc.power_bound = PowerBoundSetting::kLoadSensing;
-  } else if (bound == "actuator_sum") {
-    sc.power_bound = PowerBoundSetting::kActuatorSum;
-  } else if (bound == "none") {
-    sc.power_bound = PowerBoundSetting::kNone;
+  if (const auto parsed = dynamics::parse_power_bound(bound)) {
+    sc.power_bound = *parsed;
   } else {
     r.fail(scaling["power_bound"], sp + ".power_bound",
-           "expected load_sensing, actuator_sum or none, got '" + bound + "'");
+           "expected " + alternatives(dynamics::kPowerBounds) + ", got '" + bound + "'");
   }
 
   const YAML::Node redundancy = r.child(root, "redundancy", "");
@@ -521,15 +514,23 @@ void apply_energy_optimal(CraneConfig& cfg) {
   }
 }
 
+std::vector<std::string> resolution_names() {
+  std::vector<std::string> names = names_of(dynamics::kResolutions);
+  names.emplace(names.begin(), kEnergyOptimal);
+  return names;
+}
+
 void set_resolution(CraneConfig& cfg, std::string_view name) {
   dynamics::Resolution r = dynamics::Resolution::kPinvJoint;
-  const bool energy_optimal = name == "energy-optimal";
+  const bool energy_optimal = name == kEnergyOptimal;
   if (energy_optimal) {
     r = dynamics::energy_optimal_resolution(cfg.model.pump.mode);
-  } else if (!dynamics::parse_resolution(std::string(name).c_str(), r)) {
-    throw std::invalid_argument(
-        "expected energy-optimal, pinv-joint, pinv-actuator, min-flow or min-ls-power, got '" +
-        std::string(name) + "'");
+  } else if (const auto parsed = dynamics::parse_resolution(name)) {
+    r = *parsed;
+  } else {
+    throw std::invalid_argument("expected " + std::string(kEnergyOptimal) + ", " +
+                                alternatives(dynamics::kResolutions) + ", got '" +
+                                std::string(name) + "'");
   }
   if (r != dynamics::Resolution::kPinvJoint && !dynamics::is_loader_structure(cfg.model)) {
     throw std::invalid_argument(

@@ -56,18 +56,17 @@ class Reader : public YamlReader {
     return v;
   }
 
+  // One of the values, by its to_string() name.
   template <typename Enum, std::size_t N>
   Enum choice(const YAML::Node& map, const std::string& key, const std::string& path,
-              const std::pair<const char*, Enum> (&names)[N], Enum fallback) const {
+              const std::array<Enum, N>& values, Enum fallback) const {
     const YAML::Node node = map[key];
     if (!node.IsDefined() || node.IsNull()) return fallback;
     const std::string field = join(path, key);
     if (!node.IsScalar()) fail(node, field, "expected a single value");
+    if (const auto value = parse_name(values, node.Scalar())) return *value;
     std::string list;
-    for (const auto& [name, value] : names) {
-      if (node.Scalar() == name) return value;
-      list += list.empty() ? name : std::string(", ") + name;
-    }
+    for (const std::string& name : names_of(values)) list += (list.empty() ? "" : ", ") + name;
     fail(node, field, "unknown value '" + node.Scalar() + "' (expected one of: " + list + ")");
   }
 
@@ -88,13 +87,6 @@ class Reader : public YamlReader {
  private:
   std::filesystem::path base_dir_;
 };
-
-constexpr std::pair<const char*, Reliability> kReliabilities[] = {
-    {"best_effort", Reliability::kBestEffort}, {"reliable", Reliability::kReliable}};
-constexpr std::pair<const char*, Durability> kDurabilities[] = {
-    {"volatile", Durability::kVolatile}, {"transient_local", Durability::kTransientLocal}};
-constexpr std::pair<const char*, DdsTransport> kTransports[] = {
-    {"default", DdsTransport::kDefault}, {"udp", DdsTransport::kUdp}, {"shm", DdsTransport::kShm}};
 
 TopicSettings read_topic(const Reader& r, const YAML::Node& node, const std::string& path,
                          TopicSettings t, bool with_rate) {
@@ -123,7 +115,7 @@ TelemetryConfig read_config(const Reader& r, const YAML::Node& root, std::string
   if (const std::string name = r.optional_text(root, "participant_name", ""); !name.empty()) {
     c.participant_name = name;
   }
-  c.transport = r.choice(root, "transport", "", kTransports, c.transport);
+  c.transport = r.choice(root, "transport", "", kDdsTransports, c.transport);
   if (const YAML::Node topics = root["topics"]; topics.IsDefined() && !topics.IsNull()) {
     r.check_keys(topics, "topics", {"status", "joints", "hydraulics", "command_path"});
     const std::pair<const char*, TopicSettings*> all[] = {{"status", &c.status},

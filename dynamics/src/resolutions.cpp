@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstring>
 #include <limits>
 
 namespace craneassist::dynamics {
@@ -27,17 +26,6 @@ const char* to_string(Resolution r) {
       return "min-ls-power";
   }
   return "?";
-}
-
-bool parse_resolution(const char* text, Resolution& out) {
-  for (Resolution r : {Resolution::kPinvJoint, Resolution::kPinvActuator, Resolution::kMinFlow,
-                       Resolution::kMinLsPower}) {
-    if (std::strcmp(text, to_string(r)) == 0) {
-      out = r;
-      return true;
-    }
-  }
-  return false;
 }
 
 Resolution energy_optimal_resolution(PumpMode mode) {

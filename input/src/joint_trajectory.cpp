@@ -1,45 +1,36 @@
 #include "craneassist/input/joint_trajectory.hpp"
 
 #include <algorithm>
-#include <fstream>
+#include <cmath>
 #include <ostream>
-#include <sstream>
 #include <stdexcept>
 
-#include "csv_table.hpp"
+#include "csv_reader.hpp"
 #include "text_fields.hpp"
 
 namespace craneassist::input {
 namespace {
 
-std::vector<std::string> columns_for(int n) {
-  std::vector<std::string> c{"t"};
+// The format for n joints: t, then q_1..q_n, qdot_1..qdot_n, qddot_1..qddot_n.
+detail::CsvFormat trajectory_format(int n) {
+  detail::CsvFormat format;
+  format.columns.push_back({"t", detail::CsvKind::kTime});
   for (const char* name : {"q_", "qdot_", "qddot_"}) {
-    for (int i = 1; i <= n; ++i) c.push_back(name + std::to_string(i));
+    for (int i = 1; i <= n; ++i) format.columns.push_back({name + std::to_string(i)});
   }
-  return c;
+  format.max_rows = JointTrajectory::kMaxRows;
+  return format;
 }
 
 // The joint count a header announces: the number of q_ columns (0 when it is not a trajectory
 // header at all).
-int joints_in_header(std::string_view text) {
-  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
-  std::size_t pos = 0;
-  while (pos < text.size()) {
-    std::size_t end = text.find('\n', pos);
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view line = text.substr(pos, end - pos);
-    pos = end + 1;
-    const auto first = line.find_first_not_of(" \t\r");
-    if (first == std::string_view::npos || line[first] == '#') continue;
-    int n = 0;
-    while (line.find("q_" + std::to_string(n + 1)) != std::string_view::npos &&
-           n < JointTrajectory::kMaxJoints) {
-      ++n;
-    }
-    return n;
+int joints_in_header(std::string_view header) {
+  int n = 0;
+  while (header.find("q_" + std::to_string(n + 1)) != std::string_view::npos &&
+         n < JointTrajectory::kMaxJoints) {
+    ++n;
   }
-  return 0;
+  return n;
 }
 
 }  // namespace
@@ -49,37 +40,19 @@ JointTrajectory::JointTrajectory(int joints) : joints_(joints) {
 }
 
 JointTrajectory JointTrajectory::load_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw TrajectoryError(path.string(), 0, "", "cannot open the file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse(text.str(), path.string());
+  return parse(detail::read_file_text(path), path.string());
 }
 
 JointTrajectory JointTrajectory::parse(std::string_view text, std::string_view source_name) {
-  const int n = std::max(joints_in_header(text), 1);
-  const auto table = detail::read_csv_table(text, source_name, columns_for(n), kMaxRows);
+  const int n = std::max(joints_in_header(detail::header_line(text)), 1);
   JointTrajectory traj(n);
-  traj.t_s_.reserve(table.rows());
-  traj.values_.reserve(table.rows() * 3 * static_cast<std::size_t>(n));
-  for (std::size_t r = 0; r < table.rows(); ++r) {
-    traj.t_s_.push_back(table.at(r, 0));
-    for (std::size_t c = 1; c < table.columns.size(); ++c) traj.values_.push_back(table.at(r, c));
-  }
+  detail::CsvFile file =
+      detail::read_csv(text, source_name, trajectory_format(n), [&](const detail::CsvRow& row) {
+        traj.t_s_.push_back(row.values[0]);
+        traj.values_.insert(traj.values_.end(), row.values.begin() + 1, row.values.end());
+      });
   // Keep the comment lines (the planner's summary, for reports).
-  std::size_t pos = 0;
-  while (pos < text.size()) {
-    std::size_t end = text.find('\n', pos);
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view line = text.substr(pos, end - pos);
-    pos = end + 1;
-    const auto first = line.find_first_not_of(" \t");
-    if (first == std::string_view::npos || line[first] != '#') continue;
-    line.remove_prefix(first + 1);
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    if (!line.empty() && line.front() == ' ') line.remove_prefix(1);
-    traj.comments.emplace_back(line);
-  }
+  traj.comments = std::move(file.comments);
   return traj;
 }
 
@@ -140,9 +113,7 @@ void JointTrajectory::sample(double t, Eigen::Ref<Eigen::VectorXd> q,
 
 void write_joint_trajectory(std::ostream& out, const JointTrajectory& traj) {
   for (const auto& c : traj.comments) out << "# " << c << '\n';
-  const auto columns = columns_for(traj.joints());
-  for (std::size_t i = 0; i < columns.size(); ++i) out << (i ? "," : "") << columns[i];
-  out << '\n';
+  out << detail::csv_header(trajectory_format(traj.joints())) << '\n';
   for (std::size_t r = 0; r < traj.size(); ++r) {
     out << detail::number(traj.t_s(r));
     for (const auto& v : {traj.q(r), traj.qdot(r), traj.qddot(r)}) {

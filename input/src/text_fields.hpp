@@ -1,5 +1,5 @@
-// Text helpers shared by the input readers (replays, tip paths, joint trajectories): the common
-// rules of docs/replay-format.md for fields, numbers and the file text quoted in messages.
+// Text helpers of the input file formats (csv_reader.hpp and the writers): the common rules of
+// docs/replay-format.md for fields, numbers and the file text quoted in messages.
 #pragma once
 
 #include <array>
@@ -25,18 +25,5 @@ std::string number(double value);
 // A field as a finite number. On failure returns false with the reason for the message
 // ("missing value", "not a number: 'x'", "number out of range: ...", "not a finite number: ...").
 bool parse_number(std::string_view text, double& value, std::string& reason);
-
-// Splits a line at commas into at most N trimmed fields; returns the total count.
-template <std::size_t N>
-std::size_t split_fields(std::string_view line, std::array<std::string_view, N>& fields) {
-  std::size_t count = 0;
-  while (true) {
-    const std::size_t comma = line.find(',');
-    if (count < N) fields[count] = trim(line.substr(0, comma));
-    ++count;
-    if (comma == std::string_view::npos) return count;
-    line.remove_prefix(comma + 1);
-  }
-}
 
 }  // namespace craneassist::input::detail

@@ -79,18 +79,6 @@ void constant_pressure_bounds(const dynamics::CraneModel& model, const PathGeome
 
 }  // namespace
 
-const char* to_string(PowerBound bound) {
-  switch (bound) {
-    case PowerBound::kLoadSensing:
-      return "load_sensing";
-    case PowerBound::kActuatorPowerSum:
-      return "actuator_sum";
-    case PowerBound::kNone:
-      return "none";
-  }
-  return "?";
-}
-
 void path_speed_limits(const dynamics::CraneModel& model, const PathGeometry& path,
                        double flow_reserve, SpeedLimits& out) {
   out.sdot_cylinder = kInf;

@@ -6,21 +6,6 @@
 #include "craneassist/dynamics/cylinders.hpp"
 
 namespace craneassist::control {
-namespace {
-
-scaling::PowerBound to_power_bound(config::PowerBoundSetting s) {
-  switch (s) {
-    case config::PowerBoundSetting::kLoadSensing:
-      return scaling::PowerBound::kLoadSensing;
-    case config::PowerBoundSetting::kActuatorSum:
-      return scaling::PowerBound::kActuatorPowerSum;
-    case config::PowerBoundSetting::kNone:
-      return scaling::PowerBound::kNone;
-  }
-  return scaling::PowerBound::kLoadSensing;
-}
-
-}  // namespace
 
 const char* to_string(ScalingMode mode) {
   switch (mode) {
@@ -67,7 +52,7 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
     scaler.deceleration_max = sc.deceleration_max_m_s2;
     scaler.normal_acceleration_max = sc.direction_change_acceleration_m_s2;
     scaler.flow_reserve = flow_reserve_;
-    scaler.power_bound = to_power_bound(sc.power_bound);
+    scaler.power_bound = sc.power_bound;
     scaler.power_reserve = sc.power_reserve;
     scaler_ = std::make_unique<scaling::TipScaler>(model_, scaler, *terms_);
   }

@@ -371,11 +371,7 @@ BoundFigures bound_figures(const config::CraneConfig& cfg, const JointPath& path
   settings.acceleration_max = cfg.scaling.acceleration_max_m_s2;
   settings.deceleration_max = cfg.scaling.deceleration_max_m_s2;
   settings.flow_reserve = cfg.control.flow_reserve;
-  settings.power_bound = cfg.scaling.power_bound == config::PowerBoundSetting::kActuatorSum
-                             ? scaling::PowerBound::kActuatorPowerSum
-                         : cfg.scaling.power_bound == config::PowerBoundSetting::kNone
-                             ? scaling::PowerBound::kNone
-                             : scaling::PowerBound::kLoadSensing;
+  settings.power_bound = cfg.scaling.power_bound;
   settings.power_reserve = cfg.scaling.power_reserve;
   out.bound = scaling::time_optimal_profile(cfg.model, terms, path.samples, settings);
   return out;

@@ -24,17 +24,6 @@ const char* to_string(StartExtension start) {
   return start == StartExtension::kShortest ? "shortest" : "middle";
 }
 
-bool parse_start_extension(std::string_view text, StartExtension& out) {
-  if (text == "shortest") {
-    out = StartExtension::kShortest;
-  } else if (text == "middle") {
-    out = StartExtension::kMiddle;
-  } else {
-    return false;
-  }
-  return true;
-}
-
 double start_extension(const planner::StageModel& stages, StartExtension start) {
   double lo = 0.0, hi = 0.0;
   if (!planner::feasible_extension_range(stages, 0, lo, hi)) {
@@ -44,19 +33,22 @@ double start_extension(const planner::StageModel& stages, StartExtension start) 
   return start == StartExtension::kShortest ? lo : 0.5 * (lo + hi);
 }
 
+std::vector<std::string> plan_methods() {
+  std::vector<std::string> methods = names_of(dynamics::kResolutions);
+  methods.emplace(methods.begin(), "dp");
+  return methods;
+}
+
 bool is_plan_method(std::string_view method) {
-  dynamics::Resolution r;
-  return method == "dp" || dynamics::parse_resolution(std::string(method).c_str(), r);
+  return method == "dp" || dynamics::parse_resolution(method);
 }
 
 planner::Plan make_plan(const planner::StageModel& stages, std::string_view method, double c_start,
                         const planner::DpOptions& dp_options) {
   if (method == "dp") return planner::plan_dp(stages, c_start, dp_options);
-  dynamics::Resolution r;
-  if (!dynamics::parse_resolution(std::string(method).c_str(), r)) {
-    throw std::invalid_argument("unknown planning method '" + std::string(method) + "'");
-  }
-  return planner::plan_online(stages, r, c_start);
+  const auto r = dynamics::parse_resolution(method);
+  if (!r) throw std::invalid_argument("unknown planning method '" + std::string(method) + "'");
+  return planner::plan_online(stages, *r, c_start);
 }
 
 input::JointTrajectory to_joint_trajectory(const planner::Plan& plan, const std::string& source) {

@@ -40,17 +40,6 @@ const char* to_string(PlanCost cost) {
   return "?";
 }
 
-bool parse_plan_cost(std::string_view text, PlanCost& out) {
-  for (PlanCost c : {PlanCost::kLoadSensing, PlanCost::kConstantPressure, PlanCost::kActuatorEnergy,
-                     PlanCost::kExtension}) {
-    if (text == to_string(c)) {
-      out = c;
-      return true;
-    }
-  }
-  return false;
-}
-
 StageModel::StageModel(const dynamics::CraneModel& model, TipSamples samples,
                        const StageModelOptions& options)
     : model_(model), samples_(std::move(samples)), options_(options) {

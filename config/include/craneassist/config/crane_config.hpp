@@ -1,11 +1,15 @@
 // Loading and validating a crane configuration file (config/cranes/*.yaml, docs/config.md).
 #pragma once
 
+#include <array>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "craneassist/config/config_error.hpp"
+#include "craneassist/dynamics/enum_names.hpp"
 #include "craneassist/dynamics/model.hpp"
 #include "craneassist/dynamics/resolutions.hpp"
 
@@ -24,8 +28,6 @@ struct ControlSettings {
 };
 
 // The path scaling of the tip motion (docs/scaling.md).
-enum class PowerBoundSetting { kLoadSensing, kActuatorSum, kNone };
-
 struct ScalingSettings {
   double jerk_max_m_s3 = 4.0;                       // path jerk bound
   double acceleration_max_m_s2 = 1.0;               // path acceleration bound
@@ -33,7 +35,7 @@ struct ScalingSettings {
   double direction_change_acceleration_m_s2 = 0.6;  // tip normal acceleration when turning
   double tracking_error_ok_m = 0.05;                // slow-down threshold e_ok
   double tracking_error_filter_s = 0.05;            // first-order filter on the tip error
-  PowerBoundSetting power_bound = PowerBoundSetting::kLoadSensing;
+  dynamics::PowerBound power_bound = dynamics::PowerBound::kLoadSensing;
   double power_reserve = 0.0;  // share of P_max kept for feedback corrections
 };
 
@@ -51,7 +53,11 @@ struct SimulationSettings {
 
 // Which machine the loop drives (`backend: sim | can`) and, for can, where it is.
 enum class BackendKind { kSim, kCan };
-const char* to_string(BackendKind kind);
+inline constexpr std::array kBackendKinds{BackendKind::kSim, BackendKind::kCan};
+const char* to_string(BackendKind kind);  // "sim", "can"
+inline std::optional<BackendKind> parse_backend_kind(std::string_view text) {
+  return parse_name(kBackendKinds, text);
+}
 
 struct CanSettings {
   std::string interface;  // can0, vcan0; empty: must be given on the command line
@@ -89,9 +95,16 @@ CraneConfig planar_2r_config();
 // With redundancy.energy_optimal, sets the resolution for the model's present pump mode.
 void apply_energy_optimal(CraneConfig& cfg);
 
-// Sets the redundancy resolution from its name: pinv-joint, pinv-actuator, min-flow, min-ls-power
-// or energy-optimal. Throws std::invalid_argument for an unknown name, or a resolution other than
-// pinv-joint on a model without the loader structure (slew, lift, tilt, extension).
+// The resolution name that picks the energy-optimal one for the pump mode
+// (redundancy.energy_optimal).
+inline constexpr std::string_view kEnergyOptimal = "energy-optimal";
+// Every name set_resolution takes: energy-optimal, then the resolutions' own
+// (dynamics::kResolutions).
+std::vector<std::string> resolution_names();
+
+// Sets the redundancy resolution from its name: one of resolution_names(). Throws
+// std::invalid_argument for an unknown name, or a resolution other than pinv-joint on a model
+// without the loader structure (slew, lift, tilt, extension).
 void set_resolution(CraneConfig& cfg, std::string_view name);
 
 // "min-ls-power (energy-optimal for load sensing)", "pinv-joint", ...

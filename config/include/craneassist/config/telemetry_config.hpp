@@ -9,19 +9,36 @@
 
 #include <array>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
 
+#include "craneassist/dynamics/enum_names.hpp"
+
 namespace craneassist::config {
 
 enum class Reliability { kBestEffort, kReliable };
-enum class Durability { kVolatile, kTransientLocal };
-enum class DdsTransport { kDefault, kUdp, kShm };
+inline constexpr std::array kReliabilities{Reliability::kBestEffort, Reliability::kReliable};
+const char* to_string(Reliability r);  // "best_effort", "reliable"
+inline std::optional<Reliability> parse_reliability(std::string_view text) {
+  return parse_name(kReliabilities, text);
+}
 
-const char* to_string(Reliability r);
-const char* to_string(Durability d);
-const char* to_string(DdsTransport t);
+enum class Durability { kVolatile, kTransientLocal };
+inline constexpr std::array kDurabilities{Durability::kVolatile, Durability::kTransientLocal};
+const char* to_string(Durability d);  // "volatile", "transient_local"
+inline std::optional<Durability> parse_durability(std::string_view text) {
+  return parse_name(kDurabilities, text);
+}
+
+enum class DdsTransport { kDefault, kUdp, kShm };
+inline constexpr std::array kDdsTransports{DdsTransport::kDefault, DdsTransport::kUdp,
+                                           DdsTransport::kShm};
+const char* to_string(DdsTransport t);  // "default", "udp", "shm"
+inline std::optional<DdsTransport> parse_dds_transport(std::string_view text) {
+  return parse_name(kDdsTransports, text);
+}
 
 struct TopicSettings {
   double rate_hz = 50.0;  // published at most this often (the loop runs at the control rate)

@@ -7,8 +7,12 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
+
+#include "craneassist/dynamics/enum_names.hpp"
 
 namespace craneassist::dynamics {
 
@@ -74,6 +78,40 @@ enum class PumpMode {
   kLoadSensing,       // highest load pressure + ls_margin (standby_pressure when idle)
   kConstantPressure,  // held at supply_pressure whatever the loads
 };
+inline constexpr std::array kPumpModes{PumpMode::kLoadSensing, PumpMode::kConstantPressure};
+// "load-sensing", "constant-pressure" (the config's hydraulics.pump.mode).
+inline const char* to_string(PumpMode mode) {
+  return mode == PumpMode::kConstantPressure ? "constant-pressure" : "load-sensing";
+}
+inline std::optional<PumpMode> parse_pump_mode(std::string_view text) {
+  return parse_name(kPumpModes, text);
+}
+
+// The pump-power bound of the path scaling (docs/scaling.md): the config's scaling.power_bound
+// and --power-bound. Beside PumpMode rather than in scaling/ because config, which must not
+// depend on the scaling algorithms, reads it.
+enum class PowerBound {
+  kLoadSensing,       // the pump's power (default): LS, or p_s Q for a constant-pressure pump
+  kActuatorPowerSum,  // the older sum-of-actuator-powers bound (baseline)
+  kNone,              // no power limit
+};
+inline constexpr std::array kPowerBounds{PowerBound::kLoadSensing, PowerBound::kActuatorPowerSum,
+                                         PowerBound::kNone};
+// "load_sensing", "actuator_sum", "none".
+inline const char* to_string(PowerBound bound) {
+  switch (bound) {
+    case PowerBound::kLoadSensing:
+      return "load_sensing";
+    case PowerBound::kActuatorPowerSum:
+      return "actuator_sum";
+    case PowerBound::kNone:
+      return "none";
+  }
+  return "?";
+}
+inline std::optional<PowerBound> parse_power_bound(std::string_view text) {
+  return parse_name(kPowerBounds, text);
+}
 
 struct Pump {
   PumpMode mode = PumpMode::kLoadSensing;
@@ -85,10 +123,6 @@ struct Pump {
   double standby_pressure_pa = 0.0;  // LS supply pressure with no section open
   double supply_pressure_pa = 0.0;   // constant-pressure setpoint p_s; 0: not given
 };
-
-inline const char* to_string(PumpMode mode) {
-  return mode == PumpMode::kConstantPressure ? "constant-pressure" : "load-sensing";
-}
 
 // Highest supply pressure the pump gives: the relief setting, or in constant-pressure mode the
 // setpoint (capped by the relief).

@@ -16,15 +16,24 @@
 // The joint-limited pseudo-inverse (kPinvJoint) is the SNS of redundancy.hpp.
 #pragma once
 
+#include <array>
+#include <optional>
+#include <string_view>
+
+#include "craneassist/dynamics/enum_names.hpp"
 #include "craneassist/dynamics/model.hpp"
 #include "craneassist/dynamics/redundancy.hpp"
 
 namespace craneassist::dynamics {
 
 enum class Resolution { kPinvJoint, kPinvActuator, kMinFlow, kMinLsPower };
+inline constexpr std::array kResolutions{Resolution::kPinvJoint, Resolution::kPinvActuator,
+                                         Resolution::kMinFlow, Resolution::kMinLsPower};
+// "pinv-joint", "pinv-actuator", "min-flow", "min-ls-power".
 const char* to_string(Resolution r);
-// "pinv-joint", "pinv-actuator", "min-flow", "min-ls-power"; false when unknown.
-bool parse_resolution(const char* text, Resolution& out);
+inline std::optional<Resolution> parse_resolution(std::string_view text) {
+  return parse_name(kResolutions, text);
+}
 
 // The energy-optimal online resolution for a pump: min-ls-power for a load-sensing pump (the
 // pump's power follows the highest load pressure), min-flow for a constant-pressure pump (its

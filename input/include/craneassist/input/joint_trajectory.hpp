@@ -10,12 +10,9 @@
 #include <string_view>
 #include <vector>
 
-#include "craneassist/input/replay.hpp"
+#include "craneassist/input/file_error.hpp"
 
 namespace craneassist::input {
-
-// Errors name file, line and column exactly as for replays.
-using TrajectoryError = ReplayError;
 
 class JointTrajectory {
  public:
@@ -25,7 +22,8 @@ class JointTrajectory {
   explicit JointTrajectory(int joints = 0);
 
   // Reads and validates a file (header t,q_1..q_n,qdot_1..qdot_n,qddot_1..qddot_n with n in
-  // 1..kMaxJoints, time >= 0 and strictly increasing, every value finite). Throws TrajectoryError.
+  // 1..kMaxJoints, time >= 0 and strictly increasing, every value finite). Throws FileError (the
+  // field is the column, e.g. "qdot_2"), as the replay and path readers.
   static JointTrajectory load_file(const std::filesystem::path& path);
   static JointTrajectory parse(std::string_view text, std::string_view source_name);
 

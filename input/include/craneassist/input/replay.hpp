@@ -6,11 +6,12 @@
 #include <cstddef>
 #include <filesystem>
 #include <iosfwd>
-#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
+
+#include "craneassist/input/file_error.hpp"
 
 namespace craneassist::input {
 
@@ -24,26 +25,6 @@ struct ReplayRow {
   bool stop = false;
 };
 
-// A replay that was rejected. what() is "FILE:LINE: field 'NAME': REASON", or "FILE:LINE: REASON"
-// when the problem is not tied to one field. LINE is 1-based; 0 means the file could not be read.
-class ReplayError : public std::runtime_error {
- public:
-  ReplayError(std::string file, std::size_t line, std::string field, std::string reason);
-
-  const std::string& file() const noexcept { return file_; }
-  std::size_t line() const noexcept { return line_; }
-  // Column name ("t", "v_x", "v_y", "v_z", "stop"), or empty when the error concerns no single
-  // field.
-  const std::string& field() const noexcept { return field_; }
-  const std::string& reason() const noexcept { return reason_; }
-
- private:
-  std::string file_;
-  std::size_t line_;
-  std::string field_;
-  std::string reason_;
-};
-
 // Sanity limits enforced while reading.
 struct ReplayLimits {
   double max_speed_m_s = 5.0;         // maximum magnitude of each velocity component
@@ -54,8 +35,9 @@ struct ReplayLimits {
 // components finite and within the limits, zero in stop rows.
 class Replay {
  public:
-  // Reads and validates a file; the source name in errors is path.string(). Throws ReplayError,
-  // and std::invalid_argument if limits.max_speed_m_s is negative or NaN.
+  // Reads and validates a file; the source name in errors is path.string(). Throws FileError
+  // (the field is the column: "t", "v_x", "v_y", "v_z", "stop"), and std::invalid_argument if
+  // limits.max_speed_m_s is negative or NaN.
   static Replay load_file(const std::filesystem::path& path, const ReplayLimits& limits = {});
   // Validates text in the replay format; source_name is used in error messages. Throws as
   // load_file.

@@ -24,13 +24,9 @@
 namespace craneassist::scaling {
 
 using dynamics::JointVector;
-
-enum class PowerBound {
-  kLoadSensing,       // the pump's power (default): LS, or p_s Q for a constant-pressure pump
-  kActuatorPowerSum,  // the older sum-of-actuator-powers bound (baseline)
-  kNone,              // no power limit
-};
-const char* to_string(PowerBound bound);
+// The pump-power bound (load sensing, the actuator power sum, none), with its names:
+// dynamics/model.hpp.
+using dynamics::PowerBound;
 
 // The path geometry at the current configuration.
 struct PathGeometry {

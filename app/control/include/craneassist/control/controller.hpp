@@ -19,11 +19,15 @@
 // it (see update()).
 #pragma once
 
+#include <array>
 #include <memory>
+#include <optional>
+#include <string_view>
 #include <vector>
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/control/control_loop.hpp"
+#include "craneassist/dynamics/enum_names.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
 #include "craneassist/dynamics/redundancy.hpp"
 #include "craneassist/dynamics/rigid_body_terms.hpp"
@@ -43,7 +47,12 @@ enum class ScalingMode {
   kFlowOnly,  // uniform flow and cylinder-speed prescaling only
   kNone,      // no scaling (what a machine without craneassist does)
 };
-const char* to_string(ScalingMode mode);
+inline constexpr std::array kScalingModes{ScalingMode::kFull, ScalingMode::kFlowOnly,
+                                          ScalingMode::kNone};
+const char* to_string(ScalingMode mode);  // "full", "flow", "none" (replay --scaling)
+inline std::optional<ScalingMode> parse_scaling_mode(std::string_view text) {
+  return parse_name(kScalingModes, text);
+}
 
 struct ControllerOptions {
   ScalingMode mode = ScalingMode::kFull;

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/input/prescribed_path.hpp"
 #include "craneassist/input/replay.hpp"
-#include "craneassist/input/tip_path.hpp"
 #include "craneassist/offline/planning.hpp"
 #include "craneassist/scaling/time_optimal.hpp"
 

@@ -3,12 +3,15 @@
 // plan written as a joint trajectory.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
+#include "craneassist/dynamics/enum_names.hpp"
 #include "craneassist/input/joint_trajectory.hpp"
-#include "craneassist/input/tip_path.hpp"
+#include "craneassist/input/prescribed_path.hpp"
 #include "craneassist/planner/dp_planner.hpp"
 
 namespace craneassist::offline {
@@ -19,14 +22,19 @@ planner::TipSamples sample_path(const input::PrescribedPath& path, double dt_s);
 // Paper 000 section 6 starts every path from two configurations: the shortest feasible
 // extension cylinder length, and the middle of the feasible range.
 enum class StartExtension { kShortest, kMiddle };
-const char* to_string(StartExtension start);
-bool parse_start_extension(std::string_view text, StartExtension& out);
+inline constexpr std::array kStartExtensions{StartExtension::kShortest, StartExtension::kMiddle};
+const char* to_string(StartExtension start);  // "shortest", "middle"
+inline std::optional<StartExtension> parse_start_extension(std::string_view text) {
+  return parse_name(kStartExtensions, text);
+}
 
 // The extension cylinder length at stage 0; throws std::runtime_error when no extension keeps
 // every joint within its range at the path's start.
 double start_extension(const planner::StageModel& stages, StartExtension start);
 
-// "dp" or an online resolution's name (pinv-joint, pinv-actuator, min-flow, min-ls-power).
+// The planning methods: "dp", then the online resolutions' names (pinv-joint, pinv-actuator,
+// min-flow, min-ls-power).
+std::vector<std::string> plan_methods();
 bool is_plan_method(std::string_view method);
 
 // Plans with the method from extension cylinder length c_start.

@@ -30,9 +30,11 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string_view>
 #include <vector>
 
+#include "craneassist/dynamics/enum_names.hpp"
 #include "craneassist/dynamics/model.hpp"
 #include "craneassist/dynamics/rigid_body_terms.hpp"
 
@@ -41,8 +43,12 @@ namespace craneassist::planner {
 using dynamics::JointVector;
 
 enum class PlanCost { kLoadSensing, kConstantPressure, kActuatorEnergy, kExtension };
+inline constexpr std::array kPlanCosts{PlanCost::kLoadSensing, PlanCost::kConstantPressure,
+                                       PlanCost::kActuatorEnergy, PlanCost::kExtension};
 const char* to_string(PlanCost cost);  // "ls", "cp", "actuator-energy", "extension"
-bool parse_plan_cost(std::string_view text, PlanCost& out);
+inline std::optional<PlanCost> parse_plan_cost(std::string_view text) {
+  return parse_name(kPlanCosts, text);
+}
 
 // The prescribed tip motion sampled at t_k = k dt, k = 0..N (crane frame, SI).
 struct TipSamples {

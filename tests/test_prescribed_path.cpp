@@ -1,5 +1,5 @@
-// Prescribed tip paths (input/tip_path.hpp): the quintic line and the clamped cubic spline, their
-// derivatives, the strict reader and the writer.
+// Prescribed tip paths (input/prescribed_path.hpp): the quintic line and the clamped cubic spline,
+// their derivatives, the strict reader and the writer.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "allocation_counter.hpp"
-#include "craneassist/input/tip_path.hpp"
+#include "craneassist/input/prescribed_path.hpp"
 
 namespace craneassist::input {
 namespace {
@@ -41,21 +41,21 @@ double sampled_peak_speed(const PrescribedPath& path, double dt_s) {
   return peak;
 }
 
-PrescribedPathError parse_error(std::string_view text) {
+FileError parse_error(std::string_view text) {
   try {
     PrescribedPath::parse(text, kSource);
-  } catch (const PrescribedPathError& e) {
+  } catch (const FileError& e) {
     return e;
   }
   ADD_FAILURE() << "accepted:\n" << text;
-  return PrescribedPathError("", 0, "", "");
+  return FileError("", 0, "", "");
 }
 
 // Checks line, field, that the reason contains reason_part, and the what() layout.
 void expect_rejected(std::string_view text, std::size_t line, std::string_view field,
                      std::string_view reason_part) {
   SCOPED_TRACE(std::string("text:\n") + std::string(text));
-  const PrescribedPathError e = parse_error(text);
+  const FileError e = parse_error(text);
   EXPECT_EQ(e.file(), kSource);
   EXPECT_EQ(e.line(), line);
   EXPECT_EQ(e.field(), field);
@@ -302,7 +302,7 @@ TEST(PrescribedPathReader, ErrorsNameFileLineAndField) {
   expect_rejected("t,x,y,z\n+1,1,2,3\n2,1,2,3\n", 2, "t", "not a number: '+1'");
   expect_rejected("t,x,y,z\n0,1 m,2,3\n2,1,2,3\n", 2, "x", "not a number: '1 m'");
   expect_rejected("t,x,y,z\n0,1,2,3 # end\n2,1,2,3\n", 2, "z", "not a number");
-  expect_rejected("t,x,y,z\n-0.5,1,2,3\n2,1,2,3\n", 2, "t", "negative time: -0.5 s");
+  expect_rejected("t,x,y,z\n-0.5,1,2,3\n2,1,2,3\n", 2, "t", "negative time: '-0.5'");
   expect_rejected("t,x,y,z\n0,1,2,3\n\n2,1,2,3\n1.5,1,2,3\n", 5, "t",
                   "time not strictly increasing: 1.5 s follows 2 s (line 4)");
   expect_rejected("t,x,y,z\n0,1,2,3\n0,1,2,3\n", 3, "t",
@@ -313,7 +313,7 @@ TEST(PrescribedPathReader, ErrorsNameFileLineAndField) {
                   "magnitude of -120 m exceeds the limit of 100 m");
   expect_rejected("t,x,y,z\n0,1,2,3\n# only one via point\n", 3, "",
                   "a path needs at least 2 via points, got 1");
-  expect_rejected("t,x,y,z\n", 1, "", "a path needs at least 2 via points, got 0");
+  expect_rejected("t,x,y,z\n", 1, "", "no data rows after the header");
   expect_rejected("# nothing\n\n", 2, "", "missing header 't,x,y,z'");
   expect_rejected("", 1, "", "missing header");
   expect_rejected("t,x,y,z\n0,1,2,\x01\n", 2, "z", "not a number: '\\x01'");
@@ -341,21 +341,21 @@ TEST(PrescribedPathReader, LoadFile) {
   try {
     PrescribedPath::load_file(path);
     ADD_FAILURE() << "accepted";
-  } catch (const PrescribedPathError& e) {
+  } catch (const FileError& e) {
     EXPECT_EQ(std::string(e.what()), path.string() + ":3: field 'z': not a number: 'abc'");
   }
   fs::remove(path);
   try {
     PrescribedPath::load_file(path);
     ADD_FAILURE() << "accepted";
-  } catch (const PrescribedPathError& e) {
+  } catch (const FileError& e) {
     EXPECT_EQ(e.line(), 0u);
     EXPECT_EQ(e.reason(), "file not found");
   }
   try {
     PrescribedPath::load_file(fs::temp_directory_path());
     ADD_FAILURE() << "accepted";
-  } catch (const PrescribedPathError& e) {
+  } catch (const FileError& e) {
     EXPECT_EQ(e.reason(), "cannot read file: is a directory");
   }
 }

@@ -1,15 +1,13 @@
-#include "craneassist/input/tip_path.hpp"
+#include "craneassist/input/prescribed_path.hpp"
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
-#include <charconv>
 #include <cmath>
-#include <fstream>
 #include <ostream>
-#include <system_error>
+#include <stdexcept>
 #include <utility>
 
+#include "csv_reader.hpp"
 #include "text_fields.hpp"
 
 namespace craneassist::input {
@@ -17,24 +15,34 @@ namespace {
 
 using Limits = PrescribedPathLimits;
 
-constexpr std::array<std::string_view, 4> kColumns = {"t", "x", "y", "z"};
-constexpr std::string_view kHeader = "t,x,y,z";
-constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
 // Quintic rest-to-rest s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5: peak of ds/dtau, at tau = 1/2.
 constexpr double kQuinticPeakRate = 1.875;
 // Samples per spline segment for the peak speed and the arc length (even, for Simpson's rule).
 constexpr int kSamplesPerSegment = 512;
 
-// ---- text helpers: text_fields.hpp (the replay reader's rules) --------------------------------
-
 using detail::format_number;
 using detail::kMaxNumberChars;
 using detail::number;
-using detail::quoted;
-using detail::split_fields;
-using detail::trim;
 
-// ---- via-point rules ---------------------------------------------------------------------------
+// ---- the file format: the shared CSV rules (csv_reader.hpp) and the via-point limits ----------
+
+detail::CsvFormat make_path_format() {
+  detail::CsvFormat format;
+  format.columns = {{"t", detail::CsvKind::kTime},
+                    {"x", detail::CsvKind::kNumber, Limits::kMaxCoordinateM, "m"},
+                    {"y", detail::CsvKind::kNumber, Limits::kMaxCoordinateM, "m"},
+                    {"z", detail::CsvKind::kNumber, Limits::kMaxCoordinateM, "m"}};
+  format.max_rows = Limits::kMaxViaPoints;
+  format.min_time_step_s = Limits::kMinTimeStepS;
+  return format;
+}
+
+const detail::CsvFormat& path_format() {
+  static const detail::CsvFormat format = make_path_format();
+  return format;
+}
+
+// ---- via-point rules for from_via_points (the reader applies the same limits by path_format) ---
 
 // Empty when t is acceptable after previous (nullptr for the first via point), else the reason.
 std::string time_problem(double t, const double* previous) {
@@ -60,112 +68,6 @@ std::string coordinate_problem(double c) {
            number(Limits::kMaxCoordinateM) + " m";
   }
   return {};
-}
-
-// ---- parser ------------------------------------------------------------------------------------
-
-class Parser {
- public:
-  explicit Parser(std::string_view source_name) : source_(source_name) {}
-
-  void parse(std::string_view text);
-
-  std::vector<double> t_s;
-  std::vector<Eigen::Vector3d> p_m;
-
- private:
-  PrescribedPathError error(std::size_t line, std::string_view field, std::string reason) const {
-    return PrescribedPathError(source_, line, std::string(field), std::move(reason));
-  }
-  double parse_field(std::string_view text, std::size_t line, std::string_view field) const;
-  void check_header(std::string_view content, std::size_t line) const;
-  void parse_row(std::string_view content, std::size_t line);
-
-  std::string source_;
-  std::size_t previous_row_line_ = 0;
-};
-
-double Parser::parse_field(std::string_view text, std::size_t line, std::string_view field) const {
-  double value = 0.0;
-  std::string reason;
-  if (!detail::parse_number(text, value, reason)) throw error(line, field, std::move(reason));
-  return value;
-}
-
-void Parser::check_header(std::string_view content, std::size_t line) const {
-  std::array<std::string_view, 4> fields;
-  bool ok = split_fields(content, fields) == kColumns.size();
-  for (std::size_t i = 0; ok && i < kColumns.size(); ++i) ok = fields[i] == kColumns[i];
-  if (!ok) {
-    throw error(line, "",
-                "expected the header '" + std::string(kHeader) + "', got " + quoted(content));
-  }
-}
-
-void Parser::parse_row(std::string_view content, std::size_t line) {
-  std::array<std::string_view, 4> fields;
-  const std::size_t count = split_fields(content, fields);
-  if (count != kColumns.size()) {
-    throw error(line, "",
-                "expected 4 fields (" + std::string(kHeader) + "), got " + std::to_string(count));
-  }
-  if (t_s.size() >= Limits::kMaxViaPoints) {
-    throw error(line, "",
-                "too many via points (limit " + std::to_string(Limits::kMaxViaPoints) + ")");
-  }
-  const double t = parse_field(fields[0], line, kColumns[0]);
-  std::string problem = time_problem(t, t_s.empty() ? nullptr : &t_s.back());
-  if (!problem.empty()) {
-    // Past the negative-time check, a problem is one of order: name the previous row's line.
-    if (!t_s.empty() && t >= 0.0) {
-      problem += " (line " + std::to_string(previous_row_line_) + ")";
-    }
-    throw error(line, kColumns[0], std::move(problem));
-  }
-  Eigen::Vector3d p;
-  for (Eigen::Index i = 0; i < 3; ++i) {
-    const auto column = static_cast<std::size_t>(i + 1);
-    p[i] = parse_field(fields[column], line, kColumns[column]);
-    problem = coordinate_problem(p[i]);
-    if (!problem.empty()) throw error(line, kColumns[column], std::move(problem));
-  }
-  t_s.push_back(t);
-  p_m.push_back(p);
-  previous_row_line_ = line;
-}
-
-void Parser::parse(std::string_view text) {
-  if (text.starts_with(kUtf8Bom)) text.remove_prefix(kUtf8Bom.size());
-  bool have_header = false;
-  std::size_t line = 0;
-  std::size_t pos = 0;
-  while (pos < text.size()) {
-    std::size_t end = text.find('\n', pos);
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view raw = text.substr(pos, end - pos);
-    pos = end + 1;
-    ++line;
-    if (!raw.empty() && raw.back() == '\r') raw.remove_suffix(1);
-    const std::string_view content = trim(raw);
-    if (content.empty() || content.front() == '#') continue;
-    if (!have_header) {
-      check_header(content, line);
-      have_header = true;
-    } else {
-      parse_row(content, line);
-    }
-  }
-  // Whole-file problems are reported at the last line (line 1 for an empty file).
-  const std::size_t last_line = std::max<std::size_t>(line, 1);
-  if (!have_header) {
-    throw error(last_line, "",
-                "missing header '" + std::string(kHeader) +
-                    "' (no line other than comments and blank lines)");
-  }
-  if (t_s.size() < 2) {
-    throw error(last_line, "",
-                "a path needs at least 2 via points, got " + std::to_string(t_s.size()));
-  }
 }
 
 // ---- clamped cubic spline ----------------------------------------------------------------------
@@ -205,15 +107,6 @@ std::vector<Eigen::Vector3d> clamped_spline_accelerations(const std::vector<doub
 
 // ---------------------------------------------------------------------------------------------
 
-PrescribedPathError::PrescribedPathError(std::string file, std::size_t line, std::string field,
-                                         std::string reason)
-    : std::runtime_error(file + ":" + std::to_string(line) + ": " +
-                         (field.empty() ? std::string() : "field '" + field + "': ") + reason),
-      file_(std::move(file)),
-      line_(line),
-      field_(std::move(field)),
-      reason_(std::move(reason)) {}
-
 PrescribedPath PrescribedPath::from_via_points(std::vector<double> t_s,
                                                std::vector<Eigen::Vector3d> p_m) {
   const auto fail = [](const std::string& what) {
@@ -232,7 +125,8 @@ PrescribedPath PrescribedPath::from_via_points(std::vector<double> t_s,
     for (Eigen::Index k = 0; k < 3; ++k) {
       const std::string c = coordinate_problem(p_m[i][k]);
       if (!c.empty()) {
-        fail("via point " + std::to_string(i) + ": " + std::string(kColumns[k + 1]) + ": " + c);
+        fail("via point " + std::to_string(i) + ": " +
+             path_format().columns[static_cast<std::size_t>(k) + 1].name + ": " + c);
       }
     }
   }
@@ -337,36 +231,22 @@ PrescribedPathPoint PrescribedPath::at(double t_s) const noexcept {
 }
 
 PrescribedPath PrescribedPath::parse(std::string_view text, std::string_view source_name) {
-  Parser parser(source_name);
-  parser.parse(text);
-  return PrescribedPath(std::move(parser.t_s), std::move(parser.p_m));
+  std::vector<double> t_s;
+  std::vector<Eigen::Vector3d> p_m;
+  const detail::CsvFile file =
+      detail::read_csv(text, source_name, path_format(), [&](const detail::CsvRow& row) {
+        t_s.push_back(row.values[0]);
+        p_m.emplace_back(row.values[1], row.values[2], row.values[3]);
+      });
+  if (t_s.size() < 2) {
+    throw FileError(std::string(source_name), file.last_line, "",
+                    "a path needs at least 2 via points, got " + std::to_string(t_s.size()));
+  }
+  return PrescribedPath(std::move(t_s), std::move(p_m));
 }
 
 PrescribedPath PrescribedPath::load_file(const std::filesystem::path& path) {
-  const std::string name = path.string();
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    throw PrescribedPathError(name, 0, "", "cannot read file: is a directory");
-  }
-  errno = 0;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    const int open_errno = errno;
-    if (!std::filesystem::exists(path, ec) && !ec) {
-      throw PrescribedPathError(name, 0, "", "file not found");
-    }
-    throw PrescribedPathError(
-        name, 0, "",
-        "cannot open file" +
-            (open_errno != 0 ? ": " + std::generic_category().message(open_errno) : std::string()));
-  }
-  std::string text;
-  std::array<char, 1 << 16> buffer{};
-  while (in.read(buffer.data(), static_cast<std::streamsize>(buffer.size())) || in.gcount() > 0) {
-    text.append(buffer.data(), static_cast<std::size_t>(in.gcount()));
-  }
-  if (in.bad()) throw PrescribedPathError(name, 0, "", "read error");
-  return parse(text, name);
+  return parse(detail::read_file_text(path), path.string());
 }
 
 void write_prescribed_path(std::ostream& out, const PrescribedPath& path,
@@ -382,7 +262,7 @@ void write_prescribed_path(std::ostream& out, const PrescribedPath& path,
     if (end == std::string_view::npos) break;
     comment.remove_prefix(end + 1);
   }
-  out << kHeader << '\n';
+  out << detail::csv_header(path_format()) << '\n';
   std::array<char, kMaxNumberChars> buffer{};
   for (std::size_t i = 0; i < path.via_times_s().size(); ++i) {
     line.clear();

@@ -10,10 +10,11 @@
 #include <cstddef>
 #include <filesystem>
 #include <iosfwd>
-#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "craneassist/input/file_error.hpp"
 
 namespace craneassist::input {
 
@@ -23,26 +24,6 @@ struct PrescribedPathPoint {
   Eigen::Vector3d p_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d v_m_s = Eigen::Vector3d::Zero();
   Eigen::Vector3d a_m_s2 = Eigen::Vector3d::Zero();
-};
-
-// A path file that was rejected. Same shape as ReplayError: what() is "FILE:LINE: field 'NAME':
-// REASON", or "FILE:LINE: REASON" when the problem is not tied to one field. LINE is 1-based; 0
-// means the file could not be read.
-class PrescribedPathError : public std::runtime_error {
- public:
-  PrescribedPathError(std::string file, std::size_t line, std::string field, std::string reason);
-
-  const std::string& file() const noexcept { return file_; }
-  std::size_t line() const noexcept { return line_; }
-  // Column name ("t", "x", "y", "z"), or empty when the error concerns no single field.
-  const std::string& field() const noexcept { return field_; }
-  const std::string& reason() const noexcept { return reason_; }
-
- private:
-  std::string file_;
-  std::size_t line_;
-  std::string field_;
-  std::string reason_;
 };
 
 // Rules on via points, shared by the reader and PrescribedPath::from_via_points.
@@ -63,11 +44,10 @@ class PrescribedPath {
  public:
   enum class Interpolation { kQuinticLine, kClampedCubicSpline };
 
-  // Reads and validates a file; the source name in errors is path.string(). Throws
-  // PrescribedPathError.
+  // Reads and validates a file; the source name in errors is path.string(). Throws FileError (the
+  // field is the column: "t", "x", "y", "z").
   static PrescribedPath load_file(const std::filesystem::path& path);
-  // Validates text in the path format; source_name is used in error messages. Throws
-  // PrescribedPathError.
+  // Validates text in the path format; source_name is used in error messages. Throws FileError.
   static PrescribedPath parse(std::string_view text, std::string_view source_name);
   // Throws std::invalid_argument unless: equal sizes, at least 2 and at most kMaxViaPoints via
   // points, times finite, first >= 0, each at least kMinTimeStepS after the previous, coordinates

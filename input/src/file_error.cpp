@@ -1,0 +1,15 @@
+#include "craneassist/input/file_error.hpp"
+
+#include <utility>
+
+namespace craneassist::input {
+
+FileError::FileError(std::string file, std::size_t line, std::string field, std::string reason)
+    : std::runtime_error(file + ":" + std::to_string(line) + ": " +
+                         (field.empty() ? std::string() : "field '" + field + "': ") + reason),
+      file_(std::move(file)),
+      line_(line),
+      field_(std::move(field)),
+      reason_(std::move(reason)) {}
+
+}  // namespace craneassist::input

@@ -1,0 +1,249 @@
+// The one CSV reader behind the three input file formats (replays, prescribed paths, joint
+// trajectories): each rule gives the same FileError, naming file, line and field in one message
+// style, in every format. The formats' own rules are in test_replay.cpp,
+// test_prescribed_path.cpp and test_joint_trajectory.cpp.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "craneassist/input/file_error.hpp"
+#include "craneassist/input/joint_trajectory.hpp"
+#include "craneassist/input/prescribed_path.hpp"
+#include "craneassist/input/replay.hpp"
+
+namespace craneassist::input {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kSource = "data.csv";
+
+struct Format {
+  std::string name;
+  std::vector<std::string> columns;
+  // When the header is not the format's: the headers it expects (as the message lists them) and
+  // the shortest of them.
+  std::string expected_headers;
+  std::string shortest_header;
+  std::size_t max_rows;
+  std::function<void(std::string_view text)> parse;
+  std::function<void(const fs::path& file)> load;
+
+  std::string header() const {
+    std::string h;
+    for (const auto& c : columns) h += (h.empty() ? "" : ",") + c;
+    return h;
+  }
+};
+
+std::vector<Format> formats() {
+  const std::vector<std::string> trajectory = {"t",      "q_1",     "q_2",    "qdot_1",
+                                               "qdot_2", "qddot_1", "qddot_2"};
+  return {
+      {"replay",
+       {"t", "v_x", "v_y", "v_z"},
+       "'t,v_x,v_y,v_z' or 't,v_x,v_y,v_z,stop'",
+       "t,v_x,v_y,v_z",
+       ReplayLimits{}.max_rows,
+       [](std::string_view text) { Replay::parse(text, kSource); },
+       [](const fs::path& file) { Replay::load_file(file); }},
+      {"path",
+       {"t", "x", "y", "z"},
+       "'t,x,y,z'",
+       "t,x,y,z",
+       PrescribedPathLimits::kMaxViaPoints,
+       [](std::string_view text) { PrescribedPath::parse(text, kSource); },
+       [](const fs::path& file) { PrescribedPath::load_file(file); }},
+      // The joint count comes from the header: one joint when it names none.
+      {"trajectory", trajectory, "'t,q_1,qdot_1,qddot_1'", "t,q_1,qdot_1,qddot_1",
+       JointTrajectory::kMaxRows,
+       [](std::string_view text) { JointTrajectory::parse(text, kSource); },
+       [](const fs::path& file) { JointTrajectory::load_file(file); }},
+  };
+}
+
+// A data row: time t, every other field 0 except `column`, which is `text` (column 0 is t).
+std::string row(const Format& format, std::string t, std::size_t column = 0,
+                const std::string& text = {}) {
+  std::string out = column == 0 && !text.empty() ? text : std::move(t);
+  for (std::size_t i = 1; i < format.columns.size(); ++i) {
+    out += ',';
+    out += i == column ? text : std::string("0");
+  }
+  return out;
+}
+
+// The error a text gives (a failure when it is accepted).
+FileError error_of(const Format& format, std::string_view text) {
+  try {
+    format.parse(text);
+  } catch (const FileError& e) {
+    return e;
+  }
+  ADD_FAILURE() << format.name << " accepted:\n" << text;
+  return FileError("", 0, "", "");
+}
+
+// Checks file, line, field, the whole reason and the what() layout: "FILE:LINE: field 'NAME':
+// REASON", or "FILE:LINE: REASON" without a field.
+void expect_error(const Format& format, std::string_view text, std::size_t line,
+                  const std::string& field, const std::string& reason) {
+  SCOPED_TRACE(format.name + ":\n" + std::string(text));
+  const FileError e = error_of(format, text);
+  EXPECT_EQ(e.file(), kSource);
+  EXPECT_EQ(e.line(), line);
+  EXPECT_EQ(e.field(), field);
+  EXPECT_EQ(e.reason(), reason);
+  const std::string where = std::string(kSource) + ":" + std::to_string(line) + ": ";
+  EXPECT_EQ(std::string(e.what()),
+            where + (field.empty() ? "" : "field '" + field + "': ") + reason);
+}
+
+// A file: a comment, the header, valid rows at t = 0, 1, ... and then `last` if given.
+std::string file_with(const Format& format, std::size_t rows, const std::string& last = {}) {
+  std::string text = "# comment\n";
+  text += format.header();
+  text += '\n';
+  for (std::size_t i = 0; i < rows; ++i) text += row(format, std::to_string(i)) + "\n";
+  if (!last.empty()) text += last + "\n";
+  return text;
+}
+
+TEST(InputFiles, BadHeaderIsReportedAtItsLineWithTheExpectedHeader) {
+  for (const Format& f : formats()) {
+    expect_error(f, "# c\n\nt,a,b\n0,0,0\n", 3, "",
+                 "expected the header " + f.expected_headers + ", got 't,a,b'");
+  }
+}
+
+TEST(InputFiles, MissingHeaderAndNoRows) {
+  for (const Format& f : formats()) {
+    const std::string reason =
+        "missing header '" + f.shortest_header + "' (no line other than comments and blank lines)";
+    expect_error(f, "", 1, "", reason);  // an empty file: line 1
+    expect_error(f, "# only\n\n# comments\n", 3, "", reason);
+    expect_error(f, "# c\n" + f.header() + "\n# end\n", 3, "", "no data rows after the header");
+  }
+}
+
+TEST(InputFiles, BadNumberNamesTheFieldAndTheLine) {
+  for (const Format& f : formats()) {
+    // The second column of the fourth data row: file line 6, after the comment and the header.
+    expect_error(f, file_with(f, 3, row(f, "3", 1, "0.1x")), 6, f.columns[1],
+                 "not a number: '0.1x'");
+    expect_error(f, file_with(f, 3, row(f, "3", 2, "1 m")), 6, f.columns[2], "not a number: '1 m'");
+    expect_error(f, file_with(f, 1, row(f, "", 0, "x1")), 4, "t", "not a number: 'x1'");
+    expect_error(f, file_with(f, 1, row(f, "1", 1, "+1")), 4, f.columns[1], "not a number: '+1'");
+  }
+}
+
+TEST(InputFiles, NonFiniteOutOfRangeAndMissingValues) {
+  for (const Format& f : formats()) {
+    const std::size_t last = f.columns.size() - 1;
+    const std::string& name = f.columns[last];
+    expect_error(f, file_with(f, 1, row(f, "1", last, "nan")), 4, name,
+                 "not a finite number: 'nan'");
+    expect_error(f, file_with(f, 1, row(f, "1", last, "-inf")), 4, name,
+                 "not a finite number: '-inf'");
+    expect_error(f, file_with(f, 1, row(f, "1", last, "1e400")), 4, name,
+                 "number out of range: '1e400'");
+    expect_error(f, file_with(f, 1, row(f, "1", 1, "")), 4, f.columns[1], "missing value");
+    expect_error(f, file_with(f, 1, row(f, "", 0, "infinity")), 4, "t",
+                 "not a finite number: 'infinity'");
+  }
+}
+
+TEST(InputFiles, TimeRules) {
+  for (const Format& f : formats()) {
+    const std::string h = f.header() + "\n";
+    expect_error(f, h + row(f, "-0.5") + "\n", 2, "t", "negative time: '-0.5'");
+    expect_error(f, h + row(f, "0") + "\n" + row(f, "2") + "\n# c\n" + row(f, "1.5") + "\n", 5, "t",
+                 "time not strictly increasing: 1.5 s follows 2 s (line 3)");
+  }
+}
+
+TEST(InputFiles, FieldCountFollowsTheHeader) {
+  for (const Format& f : formats()) {
+    const std::string n = std::to_string(f.columns.size());
+    expect_error(f, file_with(f, 1, row(f, "1") + ",0"), 4, "",
+                 "expected " + n + " fields (" + f.header() + "), got " +
+                     std::to_string(f.columns.size() + 1));
+    expect_error(f, file_with(f, 1, "1,0"), 4, "",
+                 "expected " + n + " fields (" + f.header() + "), got 2");
+  }
+}
+
+TEST(InputFiles, RowLimit) {
+  for (const Format& f : formats()) {
+    // A replay's limit is 10 million rows by default: its configurable limit is tested in
+    // test_replay.cpp.
+    if (f.name == "replay") continue;
+    std::string text = f.header() + "\n";
+    text.reserve(f.max_rows * 2 * f.columns.size() + 16 * f.max_rows);
+    for (std::size_t i = 0; i <= f.max_rows; ++i) text += row(f, std::to_string(i)) + "\n";
+    expect_error(f, text, f.max_rows + 2, "",
+                 "too many data rows (limit " + std::to_string(f.max_rows) + " rows)");
+  }
+}
+
+TEST(InputFiles, CrlfByteOrderMarkCommentsAndSpacingAreAcceptedAlike) {
+  for (const Format& f : formats()) {
+    SCOPED_TRACE(f.name);
+    std::string text = "\xEF\xBB\xBF# comment\r\n\r\n  ";
+    text += f.header() + "\t\r\n";
+    for (int i = 0; i < 3; ++i)
+      text.append(" ").append(row(f, std::to_string(i))).append(" \r\n  # x\r\n");
+    EXPECT_NO_THROW(f.parse(text));
+  }
+}
+
+TEST(InputFiles, UnreadableFilesAreLineZero) {
+  const fs::path missing = fs::temp_directory_path() / "craneassist_no_such_input_file.csv";
+  for (const Format& f : formats()) {
+    SCOPED_TRACE(f.name);
+    try {
+      f.load(missing);
+      ADD_FAILURE() << "accepted";
+    } catch (const FileError& e) {
+      EXPECT_EQ(std::string(e.what()), missing.string() + ":0: file not found");
+      EXPECT_EQ(e.line(), 0u);
+      EXPECT_EQ(e.field(), "");
+    }
+    try {
+      f.load(fs::temp_directory_path());
+      ADD_FAILURE() << "accepted";
+    } catch (const FileError& e) {
+      EXPECT_EQ(e.reason(), "cannot read file: is a directory");
+    }
+  }
+}
+
+TEST(InputFiles, ErrorsInAFileNameThePath) {
+  const fs::path file =
+      fs::temp_directory_path() /
+      ("craneassist_test_input_" + std::to_string(std::random_device{}()) + ".csv");
+  for (const Format& f : formats()) {
+    SCOPED_TRACE(f.name);
+    {
+      std::ofstream out(file, std::ios::binary);
+      out << file_with(f, 2, row(f, "2", 1, "abc"));
+    }
+    try {
+      f.load(file);
+      ADD_FAILURE() << "accepted";
+    } catch (const FileError& e) {
+      EXPECT_EQ(std::string(e.what()),
+                file.string() + ":5: field '" + f.columns[1] + "': not a number: 'abc'");
+    }
+  }
+  fs::remove(file);
+}
+
+}  // namespace
+}  // namespace craneassist::input
