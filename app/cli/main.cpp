@@ -1,420 +1,44 @@
-// craneassist: boom-tip control for hydraulic cranes. The composition root: command line,
-// config loading, wiring of the pipeline and the backend, the summary.
+// craneassist: boom-tip control for hydraulic cranes. main() only dispatches: each subcommand
+// has its own file (add_*_command registers its options, run_*_command runs it), and every error
+// that leaves a subcommand takes the one path below: a usage error exits 2 with CLI11's message,
+// anything else is logged and exits 3 (docs: README.md#exit-codes).
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
-#include <filesystem>
-#include <optional>
-#include <sstream>
-#include <string>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <vector>
 
 #include "bound_command.hpp"
 #include "calibrate_command.hpp"
 #include "can_commands.hpp"
-#include "craneassist/config/crane_config.hpp"
-#include "craneassist/config/quantity.hpp"
-#include "craneassist/control/csv_log.hpp"
-#include "craneassist/control/replay_runner.hpp"
-#include "craneassist/control/trajectory_runner.hpp"
-#include "craneassist/dynamics/inverse_kinematics.hpp"
-#include "craneassist/dynamics/resolutions.hpp"
-#include "craneassist/input/replay.hpp"
-#include "craneassist/offline/sim_setup.hpp"
-#include "craneassist/offline/sine_path_experiment.hpp"
-#include "craneassist/sim_backend/sim_backend.hpp"
 #include "dds_commands.hpp"
-#include "embedded_replays.hpp"
+#include "energy_command.hpp"
 #include "exit_codes.hpp"
-#include "machine_setup.hpp"
+#include "experiment_command.hpp"
 #include "plan_command.hpp"
 #include "remote_command.hpp"
-#include "resolution_option.hpp"
+#include "replay_command.hpp"
 #include "sim_command.hpp"
 #include "suite_command.hpp"
-#include "telemetry_setup.hpp"
 
 namespace {
 
-using namespace craneassist;
+using namespace craneassist::cli;
 
-using cli::kExitOk;
-using cli::kExitRuntime;
-using cli::kExitUsage;
-
-struct ReplayArgs {
-  std::string replay_file;       // empty: the bundled demo
-  std::string trajectory_file;   // a planned joint trajectory instead of a replay
-  std::string config_file;       // empty: the embedded reference crane
-  cli::BackendArgs machine;      // the machine (empty values: the config's backend: and can:)
-  cli::TelemetryArgs telemetry;  // --telemetry: publish DDS telemetry during the replay
-  double freeze_at_s = -1.0;     // test hook: freeze the loop at this machine time
-  double freeze_for_s = 0.0;
-  std::string log_file = "craneassist-log.csv";
-  bool no_log = false;
-  bool no_scaling = false;
-  std::string scaling = control::to_string(control::ScalingMode::kFull);
-  std::string power_bound;  // empty: the config's
-  std::string resolution;   // empty: the config's
-  bool realtime = false;
-  double settle_s = 1.0;
-  std::optional<double> payload_kg;
-  std::string initial;            // start pose, "NAME=VALUE UNIT, ..."; empty: the config's
-  std::string pump_max_flow;      // quantity text, e.g. "120 L/min"
-  std::string prime_mover_power;  // quantity text, e.g. "60 kW"
-  std::string pump_mode;          // empty: the config's; ls or cp
-  std::string supply_pressure;    // quantity text, e.g. "20 MPa", or a bare number in MPa
+struct Subcommand {
+  CLI::App* app;
+  std::function<int()> run;
 };
 
-// Applies a quantity given on the command line ("120 L/min") or throws CLI-style.
-double cli_quantity(const std::string& option, const std::string& text, config::Dimension dim) {
-  std::string error;
-  const auto q = config::parse_quantity(text, dim, error);
-  if (!q || q->si_values.size() != 1 || q->si_values[0] <= 0.0) {
-    throw CLI::ValidationError(option, error.empty() ? "expected one positive value" : error);
-  }
-  return q->si_values[0];
-}
-
-// A pressure given on the command line: a quantity ("200 bar", "20 MPa") or a bare number in MPa.
-double cli_pressure(const std::string& option, const std::string& text) {
-  char* end = nullptr;
-  const double mpa = std::strtod(text.c_str(), &end);
-  if (end != text.c_str() && *end == '\0' && std::isfinite(mpa) && mpa > 0.0) return mpa * 1e6;
-  return cli_quantity(option, text, config::Dimension::kPressure);
-}
-
-const char* power_bound_name(dynamics::PowerBound b, dynamics::PumpMode mode) {
-  switch (b) {
-    case dynamics::PowerBound::kLoadSensing:
-      return mode == dynamics::PumpMode::kConstantPressure ? "constant-pressure, p_s Q"
-                                                           : "load-sensing";
-    case dynamics::PowerBound::kActuatorPowerSum:
-      return "actuator power sum (baseline)";
-    case dynamics::PowerBound::kNone:
-      return "none";
-  }
-  return "?";
-}
-
-// The pump line of a run summary: mode, energy, peaks.
-void print_pump_line(double energy_j, double peak_power_w, double peak_flow_m3_s,
-                     int saturated_cycles, const config::CraneConfig& cfg) {
-  const auto& pump = cfg.model.pump;
-  char pump_name[64];
-  if (pump.mode == dynamics::PumpMode::kConstantPressure) {
-    std::snprintf(pump_name, sizeof pump_name, "constant-pressure %.1f MPa",
-                  dynamics::supply_pressure_ceiling_pa(pump) * 1e-6);
-  } else {
-    std::snprintf(pump_name, sizeof pump_name, "load-sensing");
-  }
-  std::printf(
-      "  pump %s: energy %.1f kJ, peak power %.1f kW (limit %.1f kW), peak flow %.0f L/min, "
-      "saturated in %d cycles\n",
-      pump_name, energy_j / 1e3, peak_power_w / 1e3, pump.prime_mover_power_w / 1e3,
-      peak_flow_m3_s * 60e3, saturated_cycles);
-}
-
-// Stall events and, on a one-line replay, the lateral tip speed (docs/scaling.md#operator-feel).
-void print_feel_line(const control::MotionQualityResult& f) {
-  if (f.one_line) {
-    std::printf(
-        "  operator feel: %d stall events; tip speed across the command line: peak %.3f m/s over "
-        "50 ms at %.2f s (%.3f m/s in one cycle)\n",
-        f.stall_events, f.lateral_peak_m_s, f.lateral_peak_t_s, f.lateral_peak_cycle_m_s);
-  } else {
-    std::printf("  operator feel: %d stall events (commands not on one line: no lateral figure)\n",
-                f.stall_events);
-  }
-}
-
-void print_summary(const control::RunSummary& s, const config::CraneConfig& cfg,
-                   const std::string& replay_name, control::ScalingMode mode,
-                   const control::CsvLog* log, const char* backend) {
-  const double speedup = s.wall_time_s > 0.0 ? s.duration_s / s.wall_time_s : 0.0;
-  std::printf("craneassist replay: %s on %s\n", replay_name.c_str(), cfg.model.name.c_str());
-  std::printf("  backend %s, resolution %s, scaling %s, control %.0f Hz, payload %.0f kg\n",
-              backend, config::resolution_description(cfg).c_str(),
-              mode == control::ScalingMode::kFull
-                  ? (std::string("full (power bound: ") +
-                     power_bound_name(cfg.scaling.power_bound, cfg.model.pump.mode) + ")")
-                        .c_str()
-              : mode == control::ScalingMode::kFlowOnly ? "flow prescaling only"
-                                                        : "none",
-              cfg.control.rate_hz, cfg.model.bodies.back().mass_kg);
-  std::printf("  ran %.2f s of machine time in %.3f s (%.0fx real time), %d cycles\n", s.duration_s,
-              s.wall_time_s, speedup, s.cycles);
-  std::printf("  tip: path %.2f m, peak speed %.2f m/s\n", s.tip_path_m, s.peak_tip_speed_m_s);
-  std::printf(
-      "  tip direction error, commanded vs measured (steady, > 0.05 m/s): max %.2f deg, "
-      "rms %.2f deg over %d cycles\n",
-      s.max_direction_error_deg, s.rms_direction_error_deg, s.direction_samples);
-  print_pump_line(s.energy_j, s.peak_power_w, s.peak_flow_m3_s, s.pump_saturated_cycles, cfg);
-  if (s.stopped_cycles > 0) {
-    std::printf(
-        "  stopped: %d cycles stopping or stopped (%d in stop rows: input not valid), valves "
-        "neutral in %d\n",
-        s.stopped_cycles, s.input_stop_cycles, s.neutral_valve_cycles);
-  }
-  if (mode == control::ScalingMode::kFull) {
-    std::printf("  path jerk: peak %.2f m/s^3 (bound %.2f)\n", s.peak_path_jerk,
-                cfg.scaling.jerk_max_m_s3);
-  }
-  print_feel_line(s.feel);
-  std::printf("  active limit (cycles):");
-  for (std::size_t i = 0; i < s.limit_cycles.size(); ++i) {
-    if (s.limit_cycles[i] > 0) {
-      std::printf(" %s %d", scaling::to_string(static_cast<scaling::ActiveLimit>(i)),
-                  s.limit_cycles[i]);
-    }
-  }
-  std::printf("\n");
-  if (log != nullptr) {
-    std::printf("  log: %s (%zu rows%s)\n", log->path().c_str(), log->rows_written(),
-                s.log_rows_dropped > 0 ? ", SOME DROPPED" : "");
-  }
-}
-
-void print_trajectory_summary(const control::TrajectoryRunSummary& s,
-                              const config::CraneConfig& cfg, const input::JointTrajectory& traj,
-                              const std::string& name, const control::CsvLog* log) {
-  const double speedup = s.wall_time_s > 0.0 ? s.duration_s / s.wall_time_s : 0.0;
-  std::printf("craneassist replay --trajectory: %s on %s\n", name.c_str(), cfg.model.name.c_str());
-  for (const auto& c : traj.comments) std::printf("  | %s\n", c.c_str());
-  std::printf("  ran %.2f s of machine time in %.3f s (%.0fx real time), %d cycles\n", s.duration_s,
-              s.wall_time_s, speedup, s.cycles);
-  std::printf("  tip vs plan: max %.1f mm, rms %.1f mm (start %.1f mm)\n", s.max_tip_error_m * 1e3,
-              s.rms_tip_error_m * 1e3, s.start_error_m * 1e3);
-  print_pump_line(s.energy_j, s.peak_power_w, s.peak_flow_m3_s, s.pump_saturated_cycles, cfg);
-  if (s.invalid_state_cycles > 0) {
-    std::printf("  NO VALID MEASUREMENT in %d cycles (valves neutral)\n", s.invalid_state_cycles);
-  }
-  if (log != nullptr) {
-    std::printf("  log: %s (%zu rows%s)\n", log->path().c_str(), log->rows_written(),
-                s.log_rows_dropped > 0 ? ", SOME DROPPED" : "");
-  }
-}
-
-// replay --trajectory: execute a plan (craneassist plan) in the simulator, starting at its first
-// configuration.
-int run_trajectory_command(const ReplayArgs& args, const config::CraneConfig& cfg) {
-  std::optional<input::JointTrajectory> traj;
-  if (cli::uses_can_backend(args.machine, cfg)) {
-    spdlog::error("--trajectory runs on the simulated crane only (use --backend sim)");
-    return kExitUsage;
-  }
-  try {
-    traj = input::JointTrajectory::load_file(args.trajectory_file);
-    if (traj->joints() != cfg.model.dof()) {
-      spdlog::error("trajectory: {}: {} joints, but the crane {} has {}", args.trajectory_file,
-                    traj->joints(), cfg.model.name, cfg.model.dof());
-      return kExitUsage;
-    }
-  } catch (const input::FileError& e) {
-    spdlog::error("trajectory: {}", e.what());
-    return kExitUsage;
-  }
-  try {
-    sim_backend::SimBackend machine(cfg.model,
-                                    {cfg.simulation.step_s, dynamics::JointVector(traj->q(0))});
-    std::optional<control::CsvLog> log;
-    if (!args.no_log) log.emplace(args.log_file, cfg.model.dof());
-    control::TrajectoryRunOptions options;
-    options.settle_s = args.settle_s;
-    const auto summary =
-        control::run_trajectory(cfg, *traj, machine, options, log ? &*log : nullptr);
-    print_trajectory_summary(summary, cfg, *traj, args.trajectory_file, log ? &*log : nullptr);
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return kExitRuntime;
-  }
-  return kExitOk;
-}
-
-int run_replay_command(const ReplayArgs& args) {
-  config::CraneConfig cfg;
-  std::optional<input::Replay> loaded;
-  config::TelemetryConfig telemetry_settings;
-  try {
-    cfg = args.config_file.empty() ? config::default_crane_config()
-                                   : config::load_crane_config(args.config_file);
-    if (args.payload_kg) config::set_payload_mass(cfg.model, *args.payload_kg);
-    if (!args.initial.empty()) {
-      if (cli::uses_can_backend(args.machine, cfg)) {
-        throw CLI::ValidationError(
-            "--initial", "the can backend starts where the machine is (use --backend sim)");
-      }
-      try {
-        cfg.simulation.q_initial =
-            config::parse_joint_pose(cfg.model, args.initial, cfg.simulation.q_initial);
-      } catch (const std::invalid_argument& e) {
-        throw CLI::ValidationError("--initial", e.what());
-      }
-    }
-    if (!args.resolution.empty()) {
-      try {
-        config::set_resolution(cfg, args.resolution);
-      } catch (const std::invalid_argument& e) {
-        throw CLI::ValidationError("--resolution", e.what());
-      }
-    }
-    if (!args.power_bound.empty()) {
-      cfg.scaling.power_bound = dynamics::parse_power_bound(args.power_bound).value();
-    }
-    if (!args.pump_max_flow.empty()) {
-      cfg.model.pump.max_flow_m3_s =
-          cli_quantity("--pump-max-flow", args.pump_max_flow, config::Dimension::kFlow);
-    }
-    if (!args.prime_mover_power.empty()) {
-      cfg.model.pump.prime_mover_power_w =
-          cli_quantity("--prime-mover-power", args.prime_mover_power, config::Dimension::kPower);
-    }
-    auto& pump = cfg.model.pump;
-    if (args.pump_mode == "ls") pump.mode = dynamics::PumpMode::kLoadSensing;
-    if (args.pump_mode == "cp") pump.mode = dynamics::PumpMode::kConstantPressure;
-    if (!args.supply_pressure.empty()) {
-      pump.supply_pressure_pa = cli_pressure("--supply-pressure", args.supply_pressure);
-      if (pump.supply_pressure_pa > pump.max_pressure_pa) {
-        std::ostringstream why;
-        why << "must be at most max_pressure (the relief setting, " << pump.max_pressure_pa * 1e-6
-            << " MPa)";
-        throw CLI::ValidationError("--supply-pressure", why.str());
-      }
-    }
-    config::apply_energy_optimal(cfg);  // the pump mode may have changed
-    if (pump.mode == dynamics::PumpMode::kConstantPressure && !(pump.supply_pressure_pa > 0.0)) {
-      throw CLI::ValidationError("--pump-mode",
-                                 "constant-pressure needs a supply pressure "
-                                 "(hydraulics.pump.supply_pressure or "
-                                 "--supply-pressure)");
-    }
-    if (!args.trajectory_file.empty()) {
-      if (!args.replay_file.empty()) {
-        throw CLI::ValidationError("--trajectory", "give a replay file or --trajectory, not both");
-      }
-      return run_trajectory_command(args, cfg);
-    }
-    telemetry_settings = cli::load_telemetry_settings(args.telemetry);
-    if (args.replay_file.empty()) {
-      loaded = input::Replay::parse(cli::embedded::kDemoReplayCsv,
-                                    "<bundled examples/replays/demo.csv>");
-    } else {
-      loaded = input::Replay::load_file(args.replay_file);
-    }
-  } catch (const config::ConfigError& e) {
-    spdlog::error("config: {}", e.what());
-    return kExitUsage;
-  } catch (const input::FileError& e) {
-    spdlog::error("replay: {}", e.what());
-    return kExitUsage;
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return kExitUsage;
-  }
-
-  const input::Replay& replay = *loaded;
-  const std::string replay_name(replay.source_name());
-  try {
-    cli::Machine machines;
-    if (const int rc = machines.open(cfg, args.machine); rc != kExitOk) return rc;
-    valves::MachineInterface& machine = machines.get();
-    cli::Telemetry telemetry;
-    const bool telemetry_wanted = args.telemetry.on || !args.telemetry.config_file.empty();
-    if (const int rc = telemetry.open(telemetry_settings, telemetry_wanted, cfg, machine.name());
-        rc != kExitOk) {
-      return rc;
-    }
-    std::optional<control::CsvLog> log;
-    if (!args.no_log) log.emplace(args.log_file, cfg.model.dof());
-    control::RunOptions options;
-    if (control::CycleObserver* o = telemetry.observer()) options.observers.push_back(o);
-    options.controller.mode =
-        args.no_scaling ? control::ScalingMode::kNone : control::parse_scaling_mode(args.scaling).value();
-    options.realtime = args.realtime || machine.real_time();
-    options.settle_s = args.settle_s;
-    options.freeze_at_s = args.freeze_at_s;
-    options.freeze_for_s = args.freeze_for_s;
-    spdlog::info("running {} ({:.1f} s) on {} with the {} backend{}", replay_name,
-                 replay.end_time_s() + args.settle_s, cfg.model.name, machine.name(),
-                 options.realtime ? ", paced at real time" : "");
-    const control::RunSummary summary =
-        control::run_replay(cfg, replay, machine, options, log ? &*log : nullptr);
-    print_summary(summary, cfg, replay_name, options.controller.mode, log ? &*log : nullptr,
-                  machine.name());
-    telemetry.finish();
-    if (summary.log_rows_dropped > 0) {
-      spdlog::warn("the log writer fell behind: {} rows dropped", summary.log_rows_dropped);
-    }
-    if (summary.machine_fault) spdlog::error("the machine reported a fault: run stopped");
-    if (const int rc = machines.finish(); rc != kExitOk) return rc;
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return kExitRuntime;
-  }
-  return kExitOk;
-}
-
-struct ExperimentArgs {
-  std::string config_file;  // empty: the embedded planar 2R arm
-  std::string power_bound = dynamics::to_string(dynamics::PowerBound::kLoadSensing);
-  double speed = 2.0;
-  double duration_s = 8.0;
-  double jerk_max = 1000.0;
-  std::string log_file = "craneassist-2r.csv";
-  bool no_log = false;
-  bool pump_limiter = false;
-};
-
-int run_experiment_command(const ExperimentArgs& args) {
-  config::CraneConfig cfg;
-  try {
-    cfg = args.config_file.empty() ? config::planar_2r_config()
-                                   : config::load_crane_config(args.config_file);
-  } catch (const config::ConfigError& e) {
-    spdlog::error("config: {}", e.what());
-    return kExitUsage;
-  }
-  if (cfg.model.dof() != 2) {
-    spdlog::error("config: {}: the 2R experiment needs a two-joint model", cfg.source_name);
-    return kExitUsage;
-  }
-  try {
-    offline::SinePathOptions options;
-    options.sdot_request = args.speed;
-    options.duration_s = args.duration_s;
-    options.jerk_max = args.jerk_max;
-    options.power_bound = dynamics::parse_power_bound(args.power_bound).value();
-    dynamics::JointVector q0, f1, f2;
-    offline::sine_path(0.0, q0, f1, f2);
-    options.pump_power_limiter = args.pump_limiter;
-    sim_backend::SimBackend machine(offline::machine_model(cfg, options),
-                                    {cfg.simulation.step_s, q0});
-    std::optional<control::CsvLog> log;
-    if (!args.no_log) log.emplace(args.log_file, cfg.model.dof());
-    const auto s = offline::run_sine_path(cfg, options, machine, log ? &*log : nullptr);
-    if (log) log->close();
-    const double p_max = cfg.model.pump.prime_mover_power_w;
-    std::printf("craneassist experiment-2r: %s, f(s) = [pi/6 - sin s, -pi/6 - 0.5 sin s]\n",
-                cfg.model.name.c_str());
-    std::printf("  power bound %s, requested sdot %.2f 1/s, jerk bound %.0f, %d cycles\n",
-                dynamics::to_string(options.power_bound), args.speed, args.jerk_max, s.cycles);
-    std::printf("  path covered s = %.2f in %.1f s, peak path jerk %.1f\n", s.s_final,
-                args.duration_s, s.peak_path_jerk);
-    std::printf(
-        "  pump power: measured peak %.2f kW, model-predicted LS peak %.2f kW, limit %.2f kW"
-        " (%+.1f %%)\n",
-        s.peak_pump_power_w / 1e3, s.peak_planned_ls_power_w / 1e3, p_max / 1e3,
-        100.0 * (s.peak_pump_power_w / p_max - 1.0));
-    std::printf("  simulated pump power limiter %s, engaged in %d cycles; energy %.1f kJ\n",
-                args.pump_limiter ? "on" : "off", s.cycles_power_limited, s.energy_j / 1e3);
-    if (log) std::printf("  log: %s (%zu rows)\n", log->path().c_str(), log->rows_written());
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return kExitRuntime;
-  }
-  return kExitOk;
+// Registers a subcommand: its arguments live as long as the program, its options bind to them.
+template <class Args>
+void add(std::vector<Subcommand>& commands, CLI::App& cli,
+         CLI::App* (*add_command)(CLI::App&, Args&), int (*run_command)(const Args&)) {
+  auto args = std::make_shared<Args>();
+  CLI::App* app = add_command(cli, *args);
+  commands.push_back({app, [args, run_command] { return run_command(*args); }});
 }
 
 }  // namespace
@@ -425,113 +49,19 @@ int main(int argc, char** argv) {
   cli.require_subcommand(1);
   spdlog::set_pattern("craneassist: %^%l%$: %v");
 
-  ReplayArgs args;
-  auto* replay = cli.add_subcommand(
-      "replay", "Drive the crane from a replay file (default: the bundled demo) and log the run");
-  replay
-      ->add_option("file", args.replay_file,
-                   "Replay CSV (t,v_x,v_y,v_z); see docs/replay-format.md")
-      ->check(CLI::ExistingFile);
-  replay
-      ->add_option("--trajectory", args.trajectory_file,
-                   "Execute a planned joint trajectory (craneassist plan; "
-                   "docs/trajectory-format.md) instead of a replay, from its first configuration")
-      ->check(CLI::ExistingFile);
-  replay
-      ->add_option("--config", args.config_file,
-                   "Crane config YAML (default: the embedded K70M reference crane)")
-      ->check(CLI::ExistingFile);
-  cli::add_backend_options(*replay, args.machine);
-  cli::add_telemetry_options(*replay, args.telemetry, false);
-  replay->add_option("--test-freeze-at", args.freeze_at_s)->group("");
-  replay->add_option("--test-freeze-for", args.freeze_for_s)->group("");
-  replay->add_option("--log", args.log_file, "Per-cycle CSV log (docs/log-format.md)")
-      ->capture_default_str();
-  replay->add_flag("--no-log", args.no_log, "Do not write the log");
-  replay
-      ->add_option("--scaling", args.scaling,
-                   "full: power-limited, jerk-bounded path scaling; flow: flow and cylinder-speed "
-                   "prescaling only; none: the command unscaled")
-      ->check(CLI::IsMember(names_of(control::kScalingModes)))
-      ->capture_default_str();
-  replay->add_flag("--no-scaling", args.no_scaling,
-                   "Same as --scaling none (to see what scaling prevents)");
-  replay
-      ->add_option("--power-bound", args.power_bound,
-                   "Override the config's power bound: load_sensing, actuator_sum (the older "
-                   "baseline) or none")
-      ->check(CLI::IsMember(names_of(dynamics::kPowerBounds)));
-  cli::add_resolution_option(*replay, args.resolution, "for the run");
-  replay->add_flag("--realtime", args.realtime,
-                   "Pace the loop at real time (default: as fast as possible)");
-  replay->add_option("--settle", args.settle_s, "Seconds to keep running after the last replay row")
-      ->check(CLI::Range(0.0, 600.0))
-      ->capture_default_str();
-  replay->add_option("--payload", args.payload_kg, "Payload mass in the grapple, kg")
-      ->check(CLI::Range(0.0, 100000.0));
-  replay->add_option("--initial", args.initial,
-                     "Start pose of the simulated crane, e.g. \"lift=0 deg, tilt=-125 deg, "
-                     "extension=0.2 m\" (joints left out keep the config's simulation.initial)");
-  replay->add_option("--pump-max-flow", args.pump_max_flow,
-                     "Override the pump's maximum flow, e.g. \"120 L/min\"");
-  replay->add_option("--prime-mover-power", args.prime_mover_power,
-                     "Override the power available to the pump, e.g. \"60 kW\"");
-  replay
-      ->add_option("--pump-mode", args.pump_mode,
-                   "Override the config's pump mode: ls (load sensing) or cp (constant pressure "
-                   "at the supply pressure)")
-      ->check(CLI::IsMember({"ls", "cp"}));
-  replay->add_option("--supply-pressure", args.supply_pressure,
-                     "Override the constant-pressure setpoint, e.g. \"20 MPa\" (a bare number "
-                     "is MPa)");
-
-  ExperimentArgs exp;
-  auto* experiment = cli.add_subcommand(
-      "experiment-2r",
-      "Reproduce the 2R experiment of the power-limited scaling paper on the simulated arm");
-  experiment->add_option("--config", exp.config_file, "Two-joint arm config (default: embedded 2R)")
-      ->check(CLI::ExistingFile);
-  experiment
-      ->add_option("--power-bound", exp.power_bound,
-                   "load_sensing (the correct LS bound), actuator_sum (the older baseline) "
-                   "or none")
-      ->check(CLI::IsMember(names_of(dynamics::kPowerBounds)))
-      ->capture_default_str();
-  experiment->add_option("--speed", exp.speed, "Requested path speed, 1/s")
-      ->check(CLI::Range(0.01, 20.0))
-      ->capture_default_str();
-  experiment->add_option("--duration", exp.duration_s, "Seconds to run")
-      ->check(CLI::Range(0.1, 600.0))
-      ->capture_default_str();
-  experiment->add_option("--jerk", exp.jerk_max, "Path jerk bound, 1/s^3")
-      ->check(CLI::Range(1.0, 1e6))
-      ->capture_default_str();
-  experiment->add_option("--log", exp.log_file, "Per-cycle CSV log")->capture_default_str();
-  experiment->add_flag("--no-log", exp.no_log, "Do not write the log");
-  experiment->add_flag("--pump-limiter", exp.pump_limiter,
-                       "Keep the simulated pump's power limiter (default: off, so the measured "
-                       "power shows what the trajectory demands)");
-
-  cli::PlanArgs plan_args;
-  auto* plan = cli::add_plan_command(cli, plan_args);
-  cli::EmulateArgs emulate_args;
-  auto* emulate = cli::add_emulate_command(cli, emulate_args);
-  cli::EnergyArgs energy_args;
-  auto* energy = cli::add_energy_command(cli, energy_args);
-  cli::CalibrateArgs calibrate_args;
-  auto* calibrate = cli::add_calibrate_command(cli, calibrate_args);
-  cli::SimArgs sim_args;
-  auto* sim = cli::add_sim_command(cli, sim_args);
-  cli::RemoteArgs remote_args;
-  auto* remote = cli::add_remote_command(cli, remote_args);
-  cli::EchoArgs echo_args;
-  auto* echo = cli::add_echo_command(cli, echo_args);
-  cli::DashboardArgs dashboard_args;
-  auto* dashboard = cli::add_dashboard_command(cli, dashboard_args);
-  cli::SuiteArgs suite_args;
-  auto* suite = cli::add_suite_command(cli, suite_args);
-  cli::BoundArgs bound_args;
-  auto* bound = cli::add_bound_command(cli, bound_args);
+  std::vector<Subcommand> commands;
+  add(commands, cli, add_replay_command, run_replay_command);
+  add(commands, cli, add_experiment_command, run_experiment_command);
+  add(commands, cli, add_plan_command, run_plan_command);
+  add(commands, cli, add_emulate_command, run_emulate_command);
+  add(commands, cli, add_energy_command, run_energy_command);
+  add(commands, cli, add_calibrate_command, run_calibrate_command);
+  add(commands, cli, add_sim_command, run_sim_command);
+  add(commands, cli, add_remote_command, run_remote_command);
+  add(commands, cli, add_echo_command, run_echo_command);
+  add(commands, cli, add_dashboard_command, run_dashboard_command);
+  add(commands, cli, add_suite_command, run_suite_command);
+  add(commands, cli, add_bound_command, run_bound_command);
 
   try {
     cli.parse(argc, argv);
@@ -539,44 +69,16 @@ int main(int argc, char** argv) {
     // --help and --version exit 0; every usage error exits 2, like a bad config or replay.
     return cli.exit(e) == 0 ? kExitOk : kExitUsage;
   }
-  if (*experiment) return run_experiment_command(exp);
-  if (*emulate) return cli::run_emulate_command(emulate_args);
-  if (*energy) {
+  for (const Subcommand& c : commands) {
+    if (!*c.app) continue;
     try {
-      return cli::run_energy_command(energy_args);
-    } catch (const CLI::Error& e) {
+      return c.run();
+    } catch (const CLI::Error& e) {  // a value the parser could not check (a quantity, a pose)
       cli.exit(e);
       return kExitUsage;
-    }
-  }
-  if (*calibrate) {
-    try {
-      return cli::run_calibrate_command(calibrate_args);
-    } catch (const CLI::Error& e) {
-      cli.exit(e);
-      return kExitUsage;
-    }
-  }
-  if (*plan) {
-    try {
-      return cli::run_plan_command(plan_args);
-    } catch (const CLI::Error& e) {
-      cli.exit(e);
-      return kExitUsage;
-    }
-  }
-  if (*sim) return cli::run_sim_command(sim_args);
-  if (*suite) return cli::run_suite_command(suite_args);
-  if (*bound) return cli::run_bound_command(bound_args);
-  if (*remote) return cli::run_remote_command(remote_args);
-  if (*echo) return cli::run_echo_command(echo_args);
-  if (*dashboard) return cli::run_dashboard_command(dashboard_args);
-  if (*replay) {
-    try {
-      return run_replay_command(args);
-    } catch (const CLI::Error& e) {
-      cli.exit(e);
-      return kExitUsage;
+    } catch (const std::exception& e) {
+      spdlog::error("{}", e.what());
+      return kExitRuntime;
     }
   }
   return kExitUsage;

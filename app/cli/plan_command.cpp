@@ -8,14 +8,12 @@
 #include <fstream>
 
 #include "craneassist/config/crane_config.hpp"
-#include "craneassist/offline/energy_experiment.hpp"
 #include "craneassist/offline/planning.hpp"
 #include "exit_codes.hpp"
 
 namespace craneassist::cli {
-namespace {
 
-bool parse_grid(const std::string& text, planner::DpGrid& grid) {
+bool parse_dp_grid(const std::string& text, planner::DpGrid& grid) {
   int a = 0, b = 0, c = 0;
   char x1 = 0, x2 = 0, extra = 0;
   if (std::sscanf(text.c_str(), "%d%c%d%c%d%c", &a, &x1, &b, &x2, &c, &extra) != 5) return false;
@@ -25,6 +23,8 @@ bool parse_grid(const std::string& text, planner::DpGrid& grid) {
   grid = {a, b, c};
   return true;
 }
+
+namespace {
 
 double peak_memory_mb() {
   rusage usage{};
@@ -113,7 +113,7 @@ int run_plan_command(const PlanArgs& args) {
                                    : config::load_crane_config(args.config_file);
     if (args.payload_kg) config::set_payload_mass(cfg.model, *args.payload_kg);
     path = input::PrescribedPath::load_file(args.path_file);
-    if (!parse_grid(args.grid, dp.grid)) {
+    if (!parse_dp_grid(args.grid, dp.grid)) {
       throw CLI::ValidationError(
           "--grid", "expected three counts 2..5000 like 356x101x151, got '" + args.grid + "'");
     }
@@ -214,83 +214,6 @@ int run_plan_command(const PlanArgs& args) {
     }
     std::printf("\n  wrote %s (%zu samples); run it: craneassist replay --trajectory %s\n",
                 args.out_file.c_str(), traj.size(), args.out_file.c_str());
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return kExitRuntime;
-  }
-  return kExitOk;
-}
-
-CLI::App* add_energy_command(CLI::App& cli, EnergyArgs& args) {
-  auto* energy = cli.add_subcommand(
-      "energy",
-      "Paper 000's energy experiment in simulation: every resolution on every path, from both "
-      "start configurations, with a load-sensing and a constant-pressure pump (docs/energy.md)");
-  energy->add_option("--paths", args.path_files, "Tip path files")
-      ->check(CLI::ExistingFile)
-      ->capture_default_str();
-  energy->add_option("--out", args.out_file, "Results CSV (one row per run)")
-      ->capture_default_str();
-  energy->add_option("--grid", args.grid, "DP grid (see plan --grid)")->capture_default_str();
-  energy->add_option("--refine", args.refine, "DP refinement passes")
-      ->check(CLI::Range(0, 10))
-      ->capture_default_str();
-  energy->add_option("--threads", args.threads, "Worker threads (0: one per core)")
-      ->check(CLI::Range(0, 64))
-      ->capture_default_str();
-  energy
-      ->add_option("--config", args.config_file,
-                   "Crane config YAML (default: the embedded K70M reference crane)")
-      ->check(CLI::ExistingFile);
-  energy->add_flag("--quiet", args.quiet, "No progress output");
-  return energy;
-}
-
-int run_energy_command(const EnergyArgs& args) {
-  config::CraneConfig cfg;
-  offline::EnergyExperimentOptions options;
-  try {
-    cfg = args.config_file.empty() ? config::default_crane_config()
-                                   : config::load_crane_config(args.config_file);
-    if (!parse_grid(args.grid, options.dp.grid)) {
-      throw CLI::ValidationError(
-          "--grid", "expected three counts 2..5000 like 356x101x151, got '" + args.grid + "'");
-    }
-  } catch (const config::ConfigError& e) {
-    spdlog::error("config: {}", e.what());
-    return kExitUsage;
-  }
-  for (const auto& f : args.path_files) options.paths.emplace_back(f);
-  options.dp.refinement.passes = args.refine;
-  options.dp.threads = args.threads;
-  if (cfg.model.pump.supply_pressure_pa > 0.0) {
-    options.cp_supply_pressure_pa = cfg.model.pump.supply_pressure_pa;
-  }
-  if (!args.quiet) {
-    options.progress = [](const std::string& text) { spdlog::info("{}", text); };
-  }
-  try {
-    const auto runs = offline::run_energy_experiment(cfg, options);
-    std::ofstream out(args.out_file);
-    offline::write_energy_csv(out, runs);
-    out.close();
-    if (!out) {
-      spdlog::error("writing {} failed", args.out_file);
-      return kExitRuntime;
-    }
-    std::printf("craneassist energy: %zu runs on %s, results in %s\n", runs.size(),
-                cfg.model.name.c_str(), args.out_file.c_str());
-    std::printf("  %-11s %-9s %-19s %12s %12s\n", "path", "start", "method", "LS energy",
-                "CP energy");
-    for (std::size_t i = 0; i + 1 < runs.size(); i += 2) {
-      std::printf("  %-11s %-9s %-19s %9.1f kJ %9.1f kJ%s\n", runs[i].path.c_str(),
-                  runs[i].start.c_str(), runs[i].method.c_str(), runs[i].energy_j / 1e3,
-                  runs[i + 1].energy_j / 1e3,
-                  runs[i].penalised_stages > 0 ? "  (plan violates limits)" : "");
-    }
-  } catch (const input::FileError& e) {
-    spdlog::error("path: {}", e.what());
-    return kExitUsage;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return kExitRuntime;

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "craneassist/planner/dp_planner.hpp"
+
 namespace craneassist::cli {
 
 struct PlanArgs {
@@ -27,19 +29,7 @@ struct PlanArgs {
 CLI::App* add_plan_command(CLI::App& cli, PlanArgs& args);
 int run_plan_command(const PlanArgs& args);
 
-struct EnergyArgs {
-  std::vector<std::string> path_files = {"examples/paths/horizontal.csv",
-                                         "examples/paths/vertical.csv",
-                                         "examples/paths/half_cycle.csv"};
-  std::string config_file;
-  std::string out_file = "energy-results.csv";
-  std::string grid = "356x101x151";
-  int refine = 3;
-  int threads = 0;
-  bool quiet = false;
-};
-
-CLI::App* add_energy_command(CLI::App& cli, EnergyArgs& args);
-int run_energy_command(const EnergyArgs& args);
+// "NxMxK" (DP grid sizes, each 2..5000); false when malformed.
+bool parse_dp_grid(const std::string& text, planner::DpGrid& grid);
 
 }  // namespace craneassist::cli

@@ -1,0 +1,43 @@
+// `craneassist replay`: drive the crane from a replay file (default: the bundled demo) or execute
+// a planned joint trajectory (--trajectory), on the simulator or a machine on the CAN bus, log
+// the run and print its summary.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <optional>
+#include <string>
+
+#include "craneassist/control/controller.hpp"
+#include "machine_setup.hpp"
+#include "telemetry_setup.hpp"
+
+namespace craneassist::cli {
+
+struct ReplayArgs {
+  std::string replay_file;      // empty: the bundled demo
+  std::string trajectory_file;  // a planned joint trajectory instead of a replay
+  std::string config_file;      // empty: the embedded reference crane
+  BackendArgs machine;          // the machine (empty values: the config's backend: and can:)
+  TelemetryArgs telemetry;      // --telemetry: publish DDS telemetry during the replay
+  double freeze_at_s = -1.0;    // test hook: freeze the loop at this machine time
+  double freeze_for_s = 0.0;
+  std::string log_file = "craneassist-log.csv";
+  bool no_log = false;
+  bool no_scaling = false;
+  std::string scaling = control::to_string(control::ScalingMode::kFull);
+  std::string power_bound;  // empty: the config's
+  std::string resolution;   // empty: the config's
+  bool realtime = false;
+  double settle_s = 1.0;
+  std::optional<double> payload_kg;
+  std::string initial;            // start pose, "NAME=VALUE UNIT, ..."; empty: the config's
+  std::string pump_max_flow;      // quantity text, e.g. "120 L/min"
+  std::string prime_mover_power;  // quantity text, e.g. "60 kW"
+  std::string pump_mode;          // empty: the config's; ls or cp
+  std::string supply_pressure;    // quantity text, e.g. "20 MPa", or a bare number in MPa
+};
+
+CLI::App* add_replay_command(CLI::App& cli, ReplayArgs& args);
+int run_replay_command(const ReplayArgs& args);
+
+}  // namespace craneassist::cli
