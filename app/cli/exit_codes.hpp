@@ -1,4 +1,5 @@
-// Exit codes of the craneassist command line.
+// Exit codes of the craneassist command line, and the one way a subcommand reports an error in
+// its inputs.
 #pragma once
 
 namespace craneassist::cli {
@@ -6,5 +7,10 @@ namespace craneassist::cli {
 constexpr int kExitOk = 0;
 constexpr int kExitUsage = 2;    // bad command line, config, replay, path or trajectory file
 constexpr int kExitRuntime = 3;  // the run itself failed
+
+// Inside a catch block around reading a run's inputs (config, files, option values): logs the
+// error in flight, a config error as "config: ...", an input file's as "<file_kind>: FILE:LINE:
+// field ...: why", anything else as it is, and returns kExitUsage.
+int input_error_exit(const char* file_kind);
 
 }  // namespace craneassist::cli

@@ -125,17 +125,10 @@ int run_plan_command(const PlanArgs& args) {
     if (cfg.control.activation_speed_m_s > 0.0) {
       stage_options.at_rest_speed_m_s = cfg.control.activation_speed_m_s;
     }
-  } catch (const config::ConfigError& e) {
-    spdlog::error("config: {}", e.what());
-    return kExitUsage;
-  } catch (const input::FileError& e) {
-    spdlog::error("path: {}", e.what());
-    return kExitUsage;
   } catch (const CLI::Error&) {
     throw;
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return kExitUsage;
+  } catch (...) {
+    return input_error_exit("path");
   }
   dp.refinement.passes = args.refine;
   dp.threads = args.threads;

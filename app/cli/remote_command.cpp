@@ -112,15 +112,8 @@ int run_remote_command(const RemoteArgs& args) {
     jcfg = args.joystick_file.empty() ? config::default_joystick_config()
                                       : config::load_joystick_config(args.joystick_file);
     if (!args.replay_file.empty()) replay = input::Replay::load_file(args.replay_file);
-  } catch (const config::ConfigError& e) {
-    spdlog::error("config: {}", e.what());
-    return kExitUsage;
-  } catch (const input::FileError& e) {
-    spdlog::error("replay: {}", e.what());
-    return kExitUsage;
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return kExitUsage;
+  } catch (...) {
+    return input_error_exit("replay");
   }
   const config::SecurityFiles& sec = tcfg.commands.security;
   if (!args.insecure && !sec.complete()) {

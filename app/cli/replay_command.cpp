@@ -267,15 +267,8 @@ int run_replay_command(const ReplayArgs& args) {
     } else {
       loaded = input::Replay::load_file(args.replay_file);
     }
-  } catch (const config::ConfigError& e) {
-    spdlog::error("config: {}", e.what());
-    return kExitUsage;
-  } catch (const input::FileError& e) {
-    spdlog::error("replay: {}", e.what());
-    return kExitUsage;
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return kExitUsage;
+  } catch (...) {
+    return input_error_exit("replay");
   }
 
   const input::Replay& replay = *loaded;

@@ -226,15 +226,8 @@ int run_sim_command(const SimArgs& args) {
     if (kind == "replay") replay = input::Replay::load_file(args.input[1]);
     tcfg = load_telemetry_settings(args.telemetry);
     if (kind == "dds") dds::check_command_input_settings(tcfg);
-  } catch (const config::ConfigError& e) {
-    spdlog::error("config: {}", e.what());
-    return kExitUsage;
-  } catch (const input::FileError& e) {
-    spdlog::error("replay: {}", e.what());
-    return kExitUsage;
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return kExitUsage;
+  } catch (...) {
+    return input_error_exit("replay");
   }
 
   if (args.no_realtime && uses_can_backend(args.machine, cfg)) {
