@@ -11,13 +11,13 @@
 #include <string_view>
 #include <vector>
 
-#include "craneassist/control/controller.hpp"
-#include "craneassist/offline/planning.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/config/telemetry_config.hpp"
+#include "craneassist/control/controller.hpp"
 #include "craneassist/dynamics/enum_names.hpp"
 #include "craneassist/dynamics/model.hpp"
 #include "craneassist/dynamics/resolutions.hpp"
+#include "craneassist/offline/planning.hpp"
 #include "craneassist/planner/stage_model.hpp"
 #include "craneassist/scaling/path_constraints.hpp"
 
@@ -90,12 +90,14 @@ TEST(EnumNames, TelemetryQos) {
 
 TEST(EnumNames, CommandLineOnly) {
   expect_round_trip(control::kScalingModes, control::parse_scaling_mode, {"full", "flow", "none"});
-  expect_round_trip(offline::kStartExtensions, offline::parse_start_extension, {"shortest", "middle"});
+  expect_round_trip(offline::kStartExtensions, offline::parse_start_extension,
+                    {"shortest", "middle"});
   expect_round_trip(planner::kPlanCosts, planner::parse_plan_cost,
                     {"ls", "cp", "actuator-energy", "extension"});
   EXPECT_EQ(offline::plan_methods(), (std::vector<std::string>{"dp", "pinv-joint", "pinv-actuator",
-                                                           "min-flow", "min-ls-power"}));
-  for (const std::string& method : offline::plan_methods()) EXPECT_TRUE(offline::is_plan_method(method));
+                                                               "min-flow", "min-ls-power"}));
+  for (const std::string& method : offline::plan_methods())
+    EXPECT_TRUE(offline::is_plan_method(method));
   EXPECT_FALSE(offline::is_plan_method("energy-optimal"));
 }
 
