@@ -259,7 +259,7 @@ TEST(CycleTiming, APacedLoopMeasuresItsStartLatencyAndComputeTime) {
   EXPECT_EQ(s.timing.start_latency.count(), 50);
   EXPECT_EQ(s.timing.compute.count(), 50);
   EXPECT_GE(s.timing.start_latency.min_s(), 0.0);
-  EXPECT_DOUBLE_EQ(s.max_late_s, s.timing.start_latency.max_s());
+  EXPECT_DOUBLE_EQ(s.max_late_s(), s.timing.start_latency.max_s());
   EXPECT_GE(s.wall_time_s, 49 * 0.002) << "paced: 50 cycles take at least 49 periods";
   EXPECT_NE(control::describe(s.timing).find("overruns in 50 cycles"), std::string::npos);
 }

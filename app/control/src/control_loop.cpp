@@ -2,7 +2,6 @@
 
 #include <time.h>
 
-#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -75,13 +74,9 @@ LoopSummary run_control_loop(CycleTask& task, valves::MachineInterface& machine,
   long k = 0;
   for (; k < options.max_cycles; ++k) {
     const timespec woke = monotonic_now();
-    const double latency_s = seconds(woke) - seconds(next_tick);
     time.k = k;
     time.t_s = options.t0_s + static_cast<double>(k) * period;
-    if (options.realtime) {
-      summary.max_late_s = std::max(summary.max_late_s, latency_s);
-      summary.timing.start_latency.add(latency_s);
-    }
+    if (options.realtime) summary.timing.start_latency.add(seconds(woke) - seconds(next_tick));
     time.now_s = options.realtime ? input::steady_now_s() : time.t_s;
     const valves::BackendStatus machine_status = machine.read(state);
     if (machine_status == valves::BackendStatus::kFault && !summary.machine_fault) {
@@ -100,7 +95,7 @@ LoopSummary run_control_loop(CycleTask& task, valves::MachineInterface& machine,
     }
     const CycleStatus status = task.step(time, state, stop_cause, command, row);
     machine.write(command);
-    row.loop_latency_max_s = summary.max_late_s;
+    row.loop_latency_max_s = summary.max_late_s();
     row.loop_compute_s = last_compute_s;
     row.loop_overruns = summary.timing.overruns;
     if (options.log != nullptr) options.log->push(row);
@@ -130,8 +125,6 @@ LoopSummary run_control_loop(CycleTask& task, valves::MachineInterface& machine,
       add_ns(next_tick, period_ns);
       if (done_s > seconds(next_tick)) ++summary.timing.overruns;
       sleep_until(next_tick);
-    } else {
-      next_tick = monotonic_now();
     }
   }
   undo_realtime_setup(summary.realtime_result);

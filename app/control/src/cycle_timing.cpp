@@ -18,10 +18,6 @@ void add_reason(std::string& out, const std::string& reason) {
   out += reason;
 }
 
-// The thread's scheduling before the set-up, restored by undo_realtime_setup().
-thread_local int t_old_policy = SCHED_OTHER;
-thread_local sched_param t_old_param{};
-
 }  // namespace
 
 RealtimeResult apply_realtime_setup(const RealtimeSetup& setup) {
@@ -48,7 +44,9 @@ RealtimeResult apply_realtime_setup(const RealtimeSetup& setup) {
     }
   }
   if (setup.priority > 0) {
-    pthread_getschedparam(pthread_self(), &t_old_policy, &t_old_param);
+    sched_param previous{};
+    pthread_getschedparam(pthread_self(), &r.previous_policy, &previous);
+    r.previous_priority = previous.sched_priority;
     sched_param param{};
     param.sched_priority = std::clamp(setup.priority, sched_get_priority_min(SCHED_FIFO),
                                       sched_get_priority_max(SCHED_FIFO));
@@ -66,7 +64,11 @@ RealtimeResult apply_realtime_setup(const RealtimeSetup& setup) {
 }
 
 void undo_realtime_setup(const RealtimeResult& result) {
-  if (result.priority > 0) pthread_setschedparam(pthread_self(), t_old_policy, &t_old_param);
+  if (result.priority > 0) {
+    sched_param previous{};
+    previous.sched_priority = result.previous_priority;
+    pthread_setschedparam(pthread_self(), result.previous_policy, &previous);
+  }
   if (result.memory_locked) munlockall();
 }
 

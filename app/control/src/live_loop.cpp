@@ -113,7 +113,7 @@ LiveSummary run_live(const config::CraneConfig& config, input::CommandSource& so
   summary.cycles = static_cast<int>(ran.cycles);
   summary.duration_s = ran.duration_s;
   summary.wall_time_s = ran.wall_time_s;
-  summary.max_late_s = ran.max_late_s;
+  summary.max_late_s = ran.max_late_s();
   summary.peak_tip_speed_m_s = stats.peak_tip_speed_m_s;
   summary.tip_path_m = stats.tip_path_m;
   summary.enabled_cycles = stats.cycles - stats.input_stop_cycles;

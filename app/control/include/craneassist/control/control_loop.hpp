@@ -114,9 +114,10 @@ struct LoopSummary {
   long cycles = 0;
   double duration_s = 0.0;         // machine time
   double wall_time_s = 0.0;        // computer time
-  double max_late_s = 0.0;         // realtime: the latest a cycle started after its tick
   RealtimeResult realtime_result;  // what the system granted of LoopOptions::realtime_setup
   CycleTiming timing;              // start latency (paced runs), compute time, overruns
+  // Paced runs: the latest a cycle started after its tick.
+  double max_late_s() const noexcept { return timing.start_latency.max_s(); }
   // The machine reported a fault (BackendStatus::kFault, e.g. a latched CAN fault): the loop
   // stopped as for a stop request (stop reason "machine fault").
   bool machine_fault = false;

@@ -24,6 +24,8 @@ struct RealtimeResult {
   int priority = 0;     // the SCHED_FIFO priority granted (0: none)
   int cpu = -1;         // the core the thread is pinned to (-1: none)
   std::string refused;  // "; "-separated reasons, "" when everything asked for was granted
+  // The thread's scheduling before the set-up, restored by undo_realtime_setup().
+  int previous_policy = 0, previous_priority = 0;
 };
 
 // Applies the set-up to the calling thread (before the loop; may allocate).
