@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "craneassist/control/control_loop.hpp"
+#include "craneassist/control/log_row_builder.hpp"
 #include "craneassist/control/run_statistics.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
 #include "craneassist/valves/reference_follower.hpp"
@@ -22,6 +23,7 @@ class TrajectoryTask final : public CycleTask {
         preview_s_(preview_s),
         follower_(config.model, config.control.position_gain_1_s, 1.0 / config.control.rate_hz,
                   config.control.activation_speed_m_s, config.control.activation_error_m),
+        measured_(config.model),
         q_plan_(model_.dof()),
         qdot_plan_(model_.dof()),
         q_ref_(model_.dof()),
@@ -58,9 +60,9 @@ class TrajectoryTask final : public CycleTask {
     q_plan_j_ = q_plan_;
     const Eigen::Vector3d tip_plan = dynamics::tip_position(model_, kin_, q_plan_j_);
     if (state.valid) {
-      dynamics::tip_jacobian(model_, kin_, state.q, jac_);
-      tip = model_.task_from_base * kin_.frames[static_cast<std::size_t>(n)].translation();
-      tip_v = jac_ * state.qdot;
+      measured_.measure(state);
+      tip = measured_.tip();
+      tip_v = measured_.tip_velocity();
       const double error = (tip - tip_plan).norm();
       max_error_m_ = std::max(max_error_m_, error);
       sum_sq_error_ += error * error;
@@ -100,7 +102,7 @@ class TrajectoryTask final : public CycleTask {
   double preview_s_;
   valves::ReferenceFollower follower_;
   dynamics::KinematicsData kin_;
-  dynamics::TaskJacobian jac_;
+  LogRowBuilder measured_;  // the measured tip and its velocity
   Eigen::VectorXd q_plan_, qdot_plan_, q_ref_, qdot_ref_;
   dynamics::JointVector q_ref_j_, qdot_ref_j_, q_plan_j_;
   double start_error_m_ = 0.0, max_error_m_ = 0.0, sum_sq_error_ = 0.0;

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "craneassist/control/control_loop.hpp"
+#include "craneassist/control/log_row_builder.hpp"
 #include "craneassist/control/run_statistics.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
@@ -44,7 +45,8 @@ class SinePathTask final : public control::CycleTask {
                 {1.0 / config.control.rate_hz, options.jerk_max, options.acceleration_max,
                  config.control.flow_reserve, options.power_bound, config.scaling.power_reserve},
                 terms_),
-        follower_(model_, config.control.position_gain_1_s, 1.0 / config.control.rate_hz) {
+        follower_(model_, config.control.position_gain_1_s, 1.0 / config.control.rate_hz),
+        measured_(model_) {
     geometry_.d2c_dq2.resize(2);
   }
 
@@ -75,9 +77,9 @@ class SinePathTask final : public control::CycleTask {
     peak_planned_ls_power_w_ = std::max(peak_planned_ls_power_w_, planned);
     peak_path_jerk_ = std::max(peak_path_jerk_, std::abs(out_.state.sdddot));
     if (state.valid) {
-      dynamics::tip_jacobian(model_, kin_, state.q, jac_);
-      const Eigen::Vector3d tip = model_.task_from_base * kin_.frames[2].translation();
-      const Eigen::Vector3d tip_v = jac_ * state.qdot;
+      measured_.measure(state);
+      const Eigen::Vector3d& tip = measured_.tip();
+      const Eigen::Vector3d& tip_v = measured_.tip_velocity();
       dynamics::tip_jacobian(model_, kin_, q_ref_, jac_);
       const Eigen::Vector3d ref_v = jac_ * qdot_ref_;
       const Eigen::Vector3d cmd_v = jac_ * geometry_.f1 * options_.sdot_request;
@@ -127,6 +129,7 @@ class SinePathTask final : public control::CycleTask {
   scaling::PathGeometry geometry_;
   scaling::PathScalerOutput out_;
   dynamics::JointVector q_ref_, qdot_ref_;
+  control::LogRowBuilder measured_;  // the measured tip and its velocity
   dynamics::KinematicsData kin_;
   dynamics::TaskJacobian jac_;
   double peak_planned_ls_power_w_ = 0.0, peak_path_jerk_ = 0.0;
