@@ -84,7 +84,9 @@ void ensure_ode_initialized() {
   // dGetConfiguration() lacks ODE_EXT_ou) and then the call is a cheap no-op, but it costs
   // nothing to be correct for builds that are.
   static const bool process_ok = dInitODE2(0) != 0;
-  thread_local const bool thread_ok = dAllocateODEDataForThread(dAllocateMaskAll) != 0;
+  // dAllocateMaskAll is the enum value ~0 (an int, -1): all bits of the unsigned flag word.
+  thread_local const bool thread_ok =
+      dAllocateODEDataForThread(static_cast<unsigned>(dAllocateMaskAll)) != 0;
   if (!process_ok || !thread_ok) throw std::runtime_error("ODE initialisation failed");
 }
 

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 
 #include "craneassist/dynamics/rigid_body_terms.hpp"
@@ -10,7 +9,6 @@
 namespace craneassist::scaling {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kTopSpeedFallback = 50.0;  // m/s: when nothing caps the speed
 
 }  // namespace
