@@ -424,7 +424,7 @@ TEST(HeartbeatMonitor, AliveOnlyWhileTheCounterAdvancesInStateEnabled) {
   auto feed = [&](double t) {
     encode_heartbeat(spec, hb, f);
     EXPECT_TRUE(mon.on_frame(f, t));
-    ++hb.counter;
+    hb.counter = static_cast<std::uint8_t>(hb.counter + 1);  // 255 wraps to 0
   };
   EXPECT_FALSE(mon.alive(0.0));
   feed(0.00);  // the first message alone proves nothing

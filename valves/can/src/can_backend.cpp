@@ -485,7 +485,8 @@ void CanBackend::send_heartbeat(std::int64_t now_us, std::int64_t now_rt_us) {
                    m.heartbeat_frame, now_rt_us) == SendStatus::kOk) {
     m.counters.heartbeats_sent.fetch_add(1, std::memory_order_relaxed);
   }
-  ++hb.counter;  // the next one advances, whether or not this one went out
+  // The next one advances, whether or not this one went out; 255 wraps to 0.
+  hb.counter = static_cast<std::uint8_t>(hb.counter + 1);
 }
 
 bool CanBackend::activate(double timeout_s, std::string* why) {
