@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <limits>
 #include <sstream>
 
 #include "craneassist/config/crane_config.hpp"
@@ -97,6 +98,18 @@ TEST(JointTrajectory, SamplingReproducesAQuintic) {
   traj.sample(5.0, q, qd);  // held at the end, at rest
   EXPECT_NEAR(q[0], p(1.7), 1e-15);
   EXPECT_EQ(qd[0], 0.0);
+}
+
+// Found by fuzz_joint_trajectory: a NaN time passed every range check and the search for its
+// segment ran past the last sample (a heap read out of bounds). It holds the first sample.
+TEST(JointTrajectory, NanTimeHoldsTheFirstSample) {
+  const auto traj = input::JointTrajectory::parse(
+      "t,q_1,q_2,qdot_1,qdot_2,qddot_1,qddot_2\n0,0.1,0.2,0.5,0.5,0,0\n1,0.3,0.4,0,0,0,0\n",
+      "traj.csv");
+  Eigen::VectorXd q(2), qd(2);
+  traj.sample(std::numeric_limits<double>::quiet_NaN(), q, qd);
+  EXPECT_EQ(q, traj.q(0));
+  EXPECT_EQ(qd, Eigen::VectorXd::Zero(2));
 }
 
 TEST(TrajectoryRunner, SimulatedCraneFollowsAPlan) {

@@ -74,7 +74,9 @@ void JointTrajectory::append(double t_s, const Eigen::Ref<const Eigen::VectorXd>
 void JointTrajectory::sample(double t, Eigen::Ref<Eigen::VectorXd> q,
                              Eigen::Ref<Eigen::VectorXd> qdot) const {
   if (t_s_.empty()) return;
-  if (t <= t_s_.front() || t_s_.size() == 1) {
+  // A NaN time holds the first sample too (and must not reach the search below: no sample
+  // compares before NaN, so it would find none).
+  if (!(t > t_s_.front()) || t_s_.size() == 1) {
     q = this->q(0);
     qdot.setZero();
     if (t_s_.size() == 1 || t == t_s_.front()) qdot = this->qdot(0);

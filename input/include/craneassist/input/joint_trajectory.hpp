@@ -44,7 +44,8 @@ class JointTrajectory {
   Eigen::Map<const Eigen::VectorXd> qddot(std::size_t i) const { return column(2, i); }
 
   // Position and rate at time t: quintic Hermite interpolation between samples (position, rate
-  // and acceleration continuous); held at the first and last sample outside the time range.
+  // and acceleration continuous); held at the first and last sample outside the time range (a NaN
+  // time holds the first sample).
   // q and qdot must have joints() entries. No allocation.
   void sample(double t_s, Eigen::Ref<Eigen::VectorXd> q, Eigen::Ref<Eigen::VectorXd> qdot) const;
 
