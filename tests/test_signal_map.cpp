@@ -304,6 +304,29 @@ TEST(SignalMap, Validation) {
   EXPECT_STRNE(to_string(SpecError::kBadRange), "unknown");
 }
 
+// Found by fuzz_signal_map: a spec whose layout fits but which fails validate() (here a zero
+// scale, or an identifier above 11 bits) still got a dlc from required_dlc and was read and
+// written by extract_raw and insert_raw. Every function refuses a spec validate() refuses.
+TEST(SignalMap, AnInvalidSpecIsNeverReadOrWritten) {
+  for (int which = 0; which < 2; ++which) {
+    SignalSpec s = spec(0, 16, kIntel, false);
+    if (which == 0) s.scale = 0.0;
+    if (which == 1) s.id = 0x800;
+    ASSERT_NE(validate(s), SpecError::kNone);
+    EXPECT_EQ(required_dlc(s), 0);
+    CanFrame f;
+    f.id = s.id;
+    f.dlc = 8;
+    f.data = {1, 2, 3, 4, 5, 6, 7, 8};
+    std::uint64_t raw = 99;
+    EXPECT_FALSE(extract_raw(s, f, raw));
+    EXPECT_EQ(raw, 99u);
+    EXPECT_FALSE(insert_raw(s, 0xFFFF, f));
+    EXPECT_EQ(f.data[0], 1);
+    EXPECT_EQ(f.data[1], 2);
+  }
+}
+
 TEST(SignalMap, RandomRoundTripsEveryLayout) {
   // Every start bit, length and byte order that fits, signed and unsigned: encode a random raw
   // value, the other bits of the frame (random) stay, decode returns it.

@@ -111,13 +111,13 @@ SpecError validate(const SignalSpec& spec) {
 
 std::uint8_t required_dlc(const SignalSpec& spec) {
   Layout l;
-  if (!layout(spec, l)) return 0;
+  if (validate(spec) != SpecError::kNone || !layout(spec, l)) return 0;
   return static_cast<std::uint8_t>(l.last + 1);
 }
 
 bool extract_raw(const SignalSpec& spec, const CanFrame& frame, std::uint64_t& raw) {
   Layout l;
-  if (!layout(spec, l) || !covers(l, frame)) return false;
+  if (validate(spec) != SpecError::kNone || !layout(spec, l) || !covers(l, frame)) return false;
   std::uint64_t r = 0;
   for (int i = 0; i < spec.length; ++i) {
     const int p = bit_position(spec, l, i);
@@ -130,7 +130,7 @@ bool extract_raw(const SignalSpec& spec, const CanFrame& frame, std::uint64_t& r
 
 bool insert_raw(const SignalSpec& spec, std::uint64_t raw, CanFrame& frame) {
   Layout l;
-  if (!layout(spec, l) || !covers(l, frame)) return false;
+  if (validate(spec) != SpecError::kNone || !layout(spec, l) || !covers(l, frame)) return false;
   for (int i = 0; i < spec.length; ++i) {
     const int p = bit_position(spec, l, i);
     auto& byte = frame.data[static_cast<std::size_t>(p / 8)];
