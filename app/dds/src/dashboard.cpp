@@ -22,6 +22,7 @@
 #include "craneassist/dds/tools.hpp"
 #include "craneassist_msgs.h"
 #include "joint_units.hpp"
+#include "sample_views.hpp"
 #include "subscriber.hpp"
 
 namespace craneassist::dds {
@@ -382,6 +383,30 @@ int report_timeout(const Snapshot& s, const DashboardOptions& o) {
 }
 
 }  // namespace
+
+std::vector<std::string> dashboard_view(const msg::Status* status, const msg::JointState* joints,
+                                        const msg::Hydraulics* hydraulics,
+                                        const msg::CommandPath* command_path) {
+  Snapshot s;
+  const std::int64_t now_ns = monotonic_ns();
+  if (status != nullptr) {
+    s.status = *status;
+    s.received_ns[index_of(Topic::kStatus)] = now_ns;
+  }
+  if (joints != nullptr) {
+    s.joints = *joints;
+    s.received_ns[index_of(Topic::kJoints)] = now_ns;
+  }
+  if (hydraulics != nullptr) {
+    s.hydraulics = *hydraulics;
+    s.received_ns[index_of(Topic::kHydraulics)] = now_ns;
+  }
+  if (command_path != nullptr) {
+    s.command_path = *command_path;
+    s.received_ns[index_of(Topic::kCommandPath)] = now_ns;
+  }
+  return render(s, DashboardOptions{}, now_ns, false);
+}
 
 int run_dashboard(const DashboardOptions& o) {
   if (!(o.timeout_s >= 0.0) || !(o.refresh_s > 0.0)) {

@@ -12,6 +12,7 @@
 #include "craneassist/dds/tools.hpp"
 #include "craneassist_msgs.h"
 #include "joint_units.hpp"
+#include "sample_views.hpp"
 #include "subscriber.hpp"
 
 namespace craneassist::dds {
@@ -362,7 +363,32 @@ int echo_topic(const TopicInfo& topic, const EchoOptions& o) {
   return kToolOk;
 }
 
+template <typename T>
+void echo_one(const T& sample, EchoFormat format, std::FILE* out) {
+  if (format == EchoFormat::kCsv) {
+    CsvWriter(out).write(sample);
+  } else {
+    TextWriter(out).write(sample);
+  }
+}
+
 }  // namespace
+
+void echo_sample(const msg::Status& sample, EchoFormat format, std::FILE* out) {
+  echo_one(sample, format, out);
+}
+void echo_sample(const msg::JointState& sample, EchoFormat format, std::FILE* out) {
+  echo_one(sample, format, out);
+}
+void echo_sample(const msg::Hydraulics& sample, EchoFormat format, std::FILE* out) {
+  echo_one(sample, format, out);
+}
+void echo_sample(const msg::CommandPath& sample, EchoFormat format, std::FILE* out) {
+  echo_one(sample, format, out);
+}
+void echo_sample(const msg::OperatorCommand& sample, EchoFormat format, std::FILE* out) {
+  echo_one(sample, format, out);
+}
 
 int run_echo(const EchoOptions& o) {
   const TopicInfo* topic = find_topic(o.topic);
