@@ -178,6 +178,16 @@ TEST(AuxValveCommand, DecodeErrors) {
   g = f;
   g.data[2] = 0x35;
   EXPECT_EQ(decode(g, d, sa), CodecStatus::kBadField);
+  // Found by fuzz_can_frames: the 16-bit flow holds 64000 at 100 %; 64001..0xFAFF decoded to a
+  // flow above 1 (up to 100.4 %) with kOk instead of a bad field.
+  g = f;
+  g.data[3] = 0x00;  // 64000 = 0xFA00: full flow
+  g.data[4] = 0xFA;
+  ASSERT_EQ(decode(g, d, sa), CodecStatus::kOk);
+  EXPECT_DOUBLE_EQ(d.flow, 1.0);
+  g.data[3] = 0x01;  // 64001: beyond 100 %
+  EXPECT_EQ(decode(g, d, sa), CodecStatus::kBadField);
+  EXPECT_TRUE(std::isnan(d.flow));
 }
 
 TEST(AuxValveMeasuredFlow, KnownVectorAndRoundTrip) {

@@ -11,6 +11,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr std::uint32_t kMaxValid8 = 250;      // J1939-71: 0xFB..0xFF are special
 constexpr std::uint32_t kMaxValid16 = 0xFAFF;  // J1939-71: 0xFB00..0xFFFF are special
+constexpr std::uint32_t kFullFlow16 = 64000;   // the 16-bit port flow's 100 %
 
 // Raw value of a scaled field, rounded to nearest and clamped to [0, max_raw].
 std::uint32_t to_raw(double value, double per_bit, double offset, std::uint32_t max_raw,
@@ -175,8 +176,11 @@ CodecStatus decode(const CanFrame& frame, AuxValveCommand& command, std::uint8_t
   const std::uint8_t resolution_mode = frame.data[1] & 0x3u;
   const std::uint32_t extended = le16(frame, 3);
   command.extended_resolution = resolution_mode == 0x1 && extended <= kMaxValid16;
-  command.flow = command.extended_resolution ? extended * kExtendedFlowPerBit
-                                             : from_raw8(frame.data[0], kStandardFlowPerBit, 0.0);
+  // 64001..0xFAFF are valid J1939 values but beyond the parameter's 100 %: a bad field, like
+  // 251..255 of the 8-bit one.
+  command.flow = !command.extended_resolution ? from_raw8(frame.data[0], kStandardFlowPerBit, 0.0)
+                 : extended <= kFullFlow16    ? extended * kExtendedFlowPerBit
+                                              : kNaN;
   const std::uint8_t state = frame.data[2] & 0x0Fu;
   command.state = static_cast<ValveState>(state);
   command.fail_safe = static_cast<FailSafeMode>((frame.data[2] >> 6) & 0x3u);

@@ -118,9 +118,10 @@ CodecStatus encode(const AuxValveCommand& command, std::uint8_t source_address,
                    std::uint8_t priority, CanFrame& frame);
 
 // Decodes a command frame of any valve. The flow comes from the 16-bit field when the resolution
-// mode says it is valid and it holds 0..0xFAFF, else from the 8-bit field. kBadField: the 8-bit
-// flow is above 250 (flow is NaN) or the state is a reserved code; the other fields are still
-// filled. source_address receives the sender.
+// mode says it is valid and it holds 0..0xFAFF, else from the 8-bit field. kBadField: the flow
+// field used is above 100 % (the 8-bit one above 250, the 16-bit one above 64000; flow is NaN),
+// or the state is a reserved code; the other fields are still filled. source_address receives
+// the sender.
 CodecStatus decode(const CanFrame& frame, AuxValveCommand& command, std::uint8_t& source_address);
 
 struct AuxValveMeasuredFlow {
