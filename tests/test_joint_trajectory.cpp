@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <limits>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/control/trajectory_runner.hpp"
@@ -75,6 +77,18 @@ TEST(JointTrajectory, WriteThenReadIsExact) {
     EXPECT_EQ(back.qddot(i), t.qddot(i));
   }
   EXPECT_EQ(back.comments, t.comments);
+}
+
+// Found by fuzz_joint_trajectory: a comment line ending in "\r\r\n" kept one carriage return in
+// its text, which write_joint_trajectory wrote back as "...\r\n": read again, the comment had
+// lost it. Trailing carriage returns are not part of a comment.
+TEST(JointTrajectory, CommentsWithStrayCarriageReturnsRoundTrip) {
+  const auto t = input::JointTrajectory::parse(
+      "# planned\r\r\r\n#\r\r\nt,q_1,qdot_1,qddot_1\r\n0,0,0,0\r\n", "traj.csv");
+  ASSERT_EQ(t.comments, (std::vector<std::string>{"planned", ""}));
+  std::ostringstream out;
+  input::write_joint_trajectory(out, t);
+  EXPECT_EQ(input::JointTrajectory::parse(out.str(), "again.csv").comments, t.comments);
 }
 
 TEST(JointTrajectory, SamplingReproducesAQuintic) {

@@ -142,6 +142,9 @@ CsvFile Reader::read(std::string_view text, const std::function<void(const CsvRo
       if (!content.empty()) {
         std::string_view comment = raw.substr(raw.find('#') + 1);
         if (comment.starts_with(' ')) comment.remove_prefix(1);
+        // Carriage returns left at the end (a line ending "\r\r\n") are line-end debris, not
+        // text: kept, they would be read as a CRLF ending when the comment is written back.
+        while (comment.ends_with('\r')) comment.remove_suffix(1);
         file.comments.emplace_back(comment);
       }
       continue;
