@@ -132,7 +132,9 @@ TEST(LiveLoop, RecordedSessionReplaysToTheSameLog) {
     options.record = &record;
     live = control::run_live(cfg, source, machine, options, &log);
   }
-  EXPECT_EQ(live.cycles, 450);
+  // 4.5 s of session, then the end of the run's jerk-limited stop (the crane was moving).
+  EXPECT_GT(live.cycles, 470);
+  EXPECT_LT(live.cycles, 650);
   EXPECT_EQ(live.disconnects, 1);
   EXPECT_EQ(live.reconnects, 1);
   EXPECT_GT(live.enabled_cycles, 200);
@@ -163,7 +165,7 @@ TEST(LiveLoop, RecordedSessionReplaysToTheSameLog) {
     control::RunOptions options;
     options.settle_s = 0.0;
     const auto summary = control::run_replay(cfg, replay, machine, options, &log);
-    EXPECT_EQ(summary.cycles, 450);
+    EXPECT_EQ(summary.cycles, live.cycles) << "the replay ends with the same stop";
   }
   const std::string a = read_file(live_log), b = read_file(replay_log);
   EXPECT_GT(a.size(), 100000u);
@@ -214,7 +216,7 @@ TEST(LiveLoop, StaleInputStopsJerkLimitedAndMotionResumesOnlyAfterReArm) {
   sim_backend::SimBackend machine(cfg.model, offline::sim_settings(cfg));
   Probe probe(800);
   control::run_live(cfg, source, machine, scripted_options(7.0, &probe), nullptr);
-  ASSERT_EQ(probe.rows.size(), 700u);
+  ASSERT_GE(probe.rows.size(), 700u) << "7 s, then the end of the run's stop";
 
   // Moving before the freeze.
   const auto& before = probe.rows[195];

@@ -63,7 +63,7 @@ const char* power_bound_name(dynamics::PowerBound b, dynamics::PumpMode mode) {
 
 // The pump line of a run summary: mode, energy, peaks.
 void print_pump_line(double energy_j, double peak_power_w, double peak_flow_m3_s,
-                     int saturated_cycles, const config::CraneConfig& cfg) {
+                     long saturated_cycles, const config::CraneConfig& cfg) {
   const auto& pump = cfg.model.pump;
   char pump_name[64];
   if (pump.mode == dynamics::PumpMode::kConstantPressure) {
@@ -74,7 +74,7 @@ void print_pump_line(double energy_j, double peak_power_w, double peak_flow_m3_s
   }
   std::printf(
       "  pump %s: energy %.1f kJ, peak power %.1f kW (limit %.1f kW), peak flow %.0f L/min, "
-      "saturated in %d cycles\n",
+      "saturated in %ld cycles\n",
       pump_name, energy_j / 1e3, peak_power_w / 1e3, pump.prime_mover_power_w / 1e3,
       peak_flow_m3_s * 60e3, saturated_cycles);
 }
@@ -106,19 +106,25 @@ void print_summary(const control::RunSummary& s, const config::CraneConfig& cfg,
               : mode == control::ScalingMode::kFlowOnly ? "flow prescaling only"
                                                         : "none",
               cfg.control.rate_hz, cfg.model.bodies.back().mass_kg);
-  std::printf("  ran %.2f s of machine time in %.3f s (%.0fx real time), %d cycles\n", s.duration_s,
-              s.wall_time_s, speedup, s.cycles);
+  std::printf("  ran %.2f s of machine time in %.3f s (%.0fx real time), %ld cycles\n",
+              s.duration_s, s.wall_time_s, speedup, s.cycles);
   std::printf("  tip: path %.2f m, peak speed %.2f m/s\n", s.tip_path_m, s.peak_tip_speed_m_s);
   std::printf(
       "  tip direction error, commanded vs measured (steady, > 0.05 m/s): max %.2f deg, "
-      "rms %.2f deg over %d cycles\n",
+      "rms %.2f deg over %ld cycles\n",
       s.max_direction_error_deg, s.rms_direction_error_deg, s.direction_samples);
   print_pump_line(s.energy_j, s.peak_power_w, s.peak_flow_m3_s, s.pump_saturated_cycles, cfg);
   if (s.stopped_cycles > 0) {
     std::printf(
-        "  stopped: %d cycles stopping or stopped (%d in stop rows: input not valid), valves "
-        "neutral in %d\n",
+        "  stopped: %ld cycles stopping or stopped (%ld in stop rows: input not valid), valves "
+        "neutral in %ld\n",
         s.stopped_cycles, s.input_stop_cycles, s.neutral_valve_cycles);
+  }
+  if (s.end_stop && s.stop_cycles > 1) {
+    std::printf("  end of run: stopped jerk-limited in %.2f s, then valves neutral\n",
+                static_cast<double>(s.stop_cycles) / cfg.control.rate_hz);
+  } else if (s.end_stop) {
+    std::printf("  end of run: at rest, valves neutral\n");
   }
   if (mode == control::ScalingMode::kFull) {
     std::printf("  path jerk: peak %.2f m/s^3 (bound %.2f)\n", s.peak_path_jerk,
@@ -128,7 +134,7 @@ void print_summary(const control::RunSummary& s, const config::CraneConfig& cfg,
   std::printf("  active limit (cycles):");
   for (std::size_t i = 0; i < s.limit_cycles.size(); ++i) {
     if (s.limit_cycles[i] > 0) {
-      std::printf(" %s %d", scaling::to_string(static_cast<scaling::ActiveLimit>(i)),
+      std::printf(" %s %ld", scaling::to_string(static_cast<scaling::ActiveLimit>(i)),
                   s.limit_cycles[i]);
     }
   }
@@ -145,13 +151,13 @@ void print_trajectory_summary(const control::TrajectoryRunSummary& s,
   const double speedup = s.wall_time_s > 0.0 ? s.duration_s / s.wall_time_s : 0.0;
   std::printf("craneassist replay --trajectory: %s on %s\n", name.c_str(), cfg.model.name.c_str());
   for (const auto& c : traj.comments) std::printf("  | %s\n", c.c_str());
-  std::printf("  ran %.2f s of machine time in %.3f s (%.0fx real time), %d cycles\n", s.duration_s,
-              s.wall_time_s, speedup, s.cycles);
+  std::printf("  ran %.2f s of machine time in %.3f s (%.0fx real time), %ld cycles\n",
+              s.duration_s, s.wall_time_s, speedup, s.cycles);
   std::printf("  tip vs plan: max %.1f mm, rms %.1f mm (start %.1f mm)\n", s.max_tip_error_m * 1e3,
               s.rms_tip_error_m * 1e3, s.start_error_m * 1e3);
   print_pump_line(s.energy_j, s.peak_power_w, s.peak_flow_m3_s, s.pump_saturated_cycles, cfg);
   if (s.invalid_state_cycles > 0) {
-    std::printf("  NO VALID MEASUREMENT in %d cycles (valves neutral)\n", s.invalid_state_cycles);
+    std::printf("  NO VALID MEASUREMENT in %ld cycles (valves neutral)\n", s.invalid_state_cycles);
   }
   if (log != nullptr) {
     std::printf("  log: %s (%zu rows%s)\n", log->path().c_str(), log->rows_written(),

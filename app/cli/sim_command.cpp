@@ -319,11 +319,16 @@ int run_sim_command(const SimArgs& args) {
     }
     std::printf("craneassist sim: %s input on %s, %s backend\n", kind.c_str(),
                 cfg.model.name.c_str(), machine.name());
-    std::printf("  ran %.2f s of machine time in %.2f s, %d cycles, latest cycle start %.1f ms\n",
+    std::printf("  ran %.2f s of machine time in %.2f s, %ld cycles, latest cycle start %.1f ms\n",
                 s.duration_s, s.wall_time_s, s.cycles, s.max_late_s * 1e3);
-    std::printf("  tip: path %.2f m, peak speed %.2f m/s; operator command passed in %d cycles\n",
+    std::printf("  tip: path %.2f m, peak speed %.2f m/s; operator command passed in %ld cycles\n",
                 s.tip_path_m, s.peak_tip_speed_m_s, s.enabled_cycles);
     std::printf("  cycle timing: %s\n", control::describe(s.timing).c_str());
+    if (s.stop_cycles > 0) {
+      std::printf("  %s: stopped jerk-limited in %.2f s, then valves neutral\n",
+                  s.end_stop ? "end of run" : "stop",
+                  static_cast<double>(s.stop_cycles) / cfg.control.rate_hz);
+    }
     if (options.realtime_setup.lock_memory || options.realtime_setup.priority > 0 ||
         options.realtime_setup.cpu >= 0) {
       const control::RealtimeResult& r = s.realtime_result;
