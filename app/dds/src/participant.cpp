@@ -103,6 +103,7 @@ ParticipantPtr make_participant(const ParticipantOptions& options) {
                       "certificates, the key, and that governance and permissions are signed by "
                       "the permissions CA; Fast DDS logs the reason above)");
   }
+  if (!options.register_types) return p;
   register_type<craneassist::msg::StatusPubSubType>(*p);
   register_type<craneassist::msg::JointStatePubSubType>(*p);
   register_type<craneassist::msg::HydraulicsPubSubType>(*p);
