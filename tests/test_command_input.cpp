@@ -1,7 +1,8 @@
 // The DDS command input (docs/remote-commands.md): the settings reader's errors for the
 // command input's security files, and DdsCommandSource's states against a CommandWriter in the
-// same process, with certificates made by tools/dds-security/make-certs.sh. Each DDS test has
-// its own domain (181..184).
+// same process, with certificates made by tools/dds-security/make-certs.sh; what it does with
+// malformed samples, from a raw writer with the operator's identity (dds_raw_writer.hpp). Each
+// DDS test has its own domain (181..185).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -20,6 +21,8 @@
 #include "craneassist/config/telemetry_config.hpp"
 #include "craneassist/dds/command_source.hpp"
 #include "craneassist/dds/command_writer.hpp"
+#include "craneassist/input/input_monitor.hpp"
+#include "dds_raw_writer.hpp"
 
 // Under AddressSanitizer: Debian's Fast DDS 2.9 (not instrumented) deletes its statistics
 // listeners with a mismatched size at every participant's teardown, and leaks OpenSSL objects on
@@ -297,6 +300,108 @@ TEST(DdsCommandSource, OneOperatorAtATime) {
   EXPECT_DOUBLE_EQ(out.v_m_s.x(), -0.2);
   EXPECT_TRUE(out.deadman);
   EXPECT_EQ(source.stats().sender, "second");
+}
+
+// The operator's identity writing payloads of its own making to the crane's command input.
+class RawOperator {
+ public:
+  explicit RawOperator(int domain) : writer_(options(domain)) {}
+  // A well-formed sample with the next seq.
+  bool send(const std::array<double, 3>& v, bool deadman) {
+    return writer_.write(test::operator_command_payload(++seq_, "raw-operator", v, deadman));
+  }
+  bool send_raw(const test::Payload& payload) { return writer_.write(payload); }
+  std::uint64_t seq() const { return seq_; }
+
+ private:
+  static test::RawWriterOptions options(int domain) {
+    test::RawWriterOptions o;
+    o.domain_id = domain;
+    o.security = settings_of("operator", domain).commands.security;
+    return o;
+  }
+  test::RawWriter writer_;
+  std::uint64_t seq_ = 0;
+};
+
+// The crane's side of a test: the source behind the input monitor, one cycle every 10 ms.
+struct MonitoredSource {
+  explicit MonitoredSource(dds::DdsCommandSource& s) : source(s) {}
+  const input::MonitorOutput& cycle() {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    state = source.poll(sample);
+    monitor.update(state, sample, input::steady_now_s(), out);
+    return out;
+  }
+  dds::DdsCommandSource& source;
+  input::InputMonitor monitor{input::InputMonitorSettings{}};
+  input::OperatorCommand sample;
+  input::MonitorOutput out;
+  SourceState state = SourceState::kNoData;
+};
+
+// Sends released-deadman samples until the source has one (discovery and the DDS Security
+// handshake), then `released` more cycles of them, then `pressed` cycles moving at v.
+void arm_and_move(RawOperator& op, MonitoredSource& crane, const std::array<double, 3>& v,
+                  int released = 20, int pressed = 30) {
+  const double end = input::steady_now_s() + 10.0;
+  while (crane.state != SourceState::kOk && input::steady_now_s() < end) {
+    op.send({0.0, 0.0, 0.0}, false);
+    crane.cycle();
+  }
+  ASSERT_EQ(crane.state, SourceState::kOk) << "no sample from the raw operator within 10 s";
+  for (int i = 0; i < released; ++i) {
+    op.send({0.0, 0.0, 0.0}, false);
+    crane.cycle();
+  }
+  for (int i = 0; i < pressed; ++i) {
+    op.send(v, true);
+    crane.cycle();
+  }
+}
+
+// A malformed OperatorCommand (a bool byte of 2, a bad encapsulation: Fast CDR throws on Fast
+// DDS's thread; a cut-off body: Fast DDS 2.9 would hand over the part it read) is dropped and
+// counted, never passed on: while only such samples arrive, the input goes stale and the
+// monitor stops the crane. The source survives and takes the next good sample.
+TEST(DdsCommandSource, MalformedSamplesAreDroppedCountedAndGoStale) {
+  dds::DdsCommandSource source(settings_of("crane", 185));
+  RawOperator op(185);
+  MonitoredSource crane(source);
+  arm_and_move(op, crane, {0.3, 0.0, 0.0});
+  ASSERT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
+  const std::uint64_t good = source.stats().samples;
+
+  // Only malformed samples for 0.6 s, each kind in turn; each says "deadman held, 0.3 m/s".
+  const test::Malformation kinds[] = {test::Malformation::kTruncated, test::Malformation::kBadBool,
+                                      test::Malformation::kBadEncapsulation};
+  const double bad_start = input::steady_now_s();
+  int sent = 0;
+  double stopped_after = -1.0;
+  while (input::steady_now_s() - bad_start < 0.6) {
+    op.send_raw(test::malformed_payload(dds::Topic::kOperatorCommand, kinds[sent % 3]));
+    ++sent;
+    const input::MonitorOutput& o = crane.cycle();
+    if (!o.enabled && stopped_after < 0.0) stopped_after = input::steady_now_s() - bad_start;
+    if (stopped_after >= 0.0) {
+      EXPECT_FALSE(o.enabled) << "the command passed again after the stop";
+    }
+  }
+  EXPECT_EQ(crane.out.fault, input::InputFault::kStale) << input::to_string(crane.out.fault);
+  EXPECT_GE(stopped_after, 0.09);
+  EXPECT_LT(stopped_after, 0.3);
+  // The last good sample stays what the source reports (now stale): nothing of the bad ones.
+  EXPECT_DOUBLE_EQ(crane.sample.v_m_s.x(), 0.3);
+  const dds::CommandInputStats s = source.stats();
+  EXPECT_EQ(s.samples, good);
+  EXPECT_GE(s.malformed, static_cast<std::uint64_t>(sent) / 2) << sent << " sent";
+  EXPECT_LE(s.malformed, static_cast<std::uint64_t>(sent));
+
+  // Good samples again: taken (the monitor wants a release and press before motion).
+  arm_and_move(op, crane, {0.0, 0.0, 0.2}, 5, 5);
+  EXPECT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
+  EXPECT_DOUBLE_EQ(crane.sample.v_m_s.z(), 0.2);
+  EXPECT_GT(source.stats().samples, good);
 }
 
 }  // namespace

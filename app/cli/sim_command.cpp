@@ -82,11 +82,22 @@ class StatusReporter {
     }
     char sender[64] = "";
     if (remote_ != nullptr) {  // the remote operator (OperatorCommand.sender)
-      const std::string now_sender = remote_->stats().sender;
+      const dds::CommandInputStats stats = remote_->stats();
+      const std::string& now_sender = stats.sender;
       if (now_sender != sender_) {
         clear_line();
         spdlog::info("remote operator: '{}' (DDS)", now_sender);
         sender_ = now_sender;
+      }
+      // Dropped samples, at most one message a second.
+      if (stats.malformed > malformed_ && s.t - malformed_reported_t_ >= 1.0) {
+        clear_line();
+        spdlog::warn(
+            "t {:.2f} s: dds input: {} malformed samples dropped so far (they count as "
+            "missing)",
+            s.t, stats.malformed);
+        malformed_ = stats.malformed;
+        malformed_reported_t_ = s.t;
       }
       std::snprintf(sender, sizeof sender, " | from %.40s", sender_.c_str());
     }
@@ -114,6 +125,8 @@ class StatusReporter {
   std::string sender_;
   bool draw_;
   int disconnects_ = 0, reconnects_ = 0;
+  std::uint64_t malformed_ = 0;
+  double malformed_reported_t_ = -1e9;
   input::InputFault fault_ = input::InputFault::kNone;
 };
 
@@ -361,10 +374,11 @@ int run_sim_command(const SimArgs& args) {
         from = " from '" + d.sender + "' (first " + first + " s after start)";
       }
       std::printf(
-          "  dds input: %llu samples%s, %llu lost, %llu non-finite, %llu from other senders; "
-          "writers matched %d (peak %d)\n",
+          "  dds input: %llu samples%s, %llu lost, %llu non-finite, %llu malformed, %llu from "
+          "other senders; writers matched %d (peak %d)\n",
           static_cast<unsigned long long>(d.samples), from.c_str(),
           static_cast<unsigned long long>(d.lost), static_cast<unsigned long long>(d.non_finite),
+          static_cast<unsigned long long>(d.malformed),
           static_cast<unsigned long long>(d.other_senders), d.writer_matches,
           d.peak_matched_writers);
     }

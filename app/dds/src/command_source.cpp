@@ -10,6 +10,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "checked_types.hpp"
 #include "command_participant.hpp"
 #include "craneassist_msgs.h"
 #include "participant.hpp"
@@ -71,9 +72,10 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
   void on_data_available(fdds::DataReader* r) override {
     std::lock_guard<std::mutex> lock(listener_mutex);
     fdds::SampleInfo info;
-    while (r->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
-      if (info.valid_data) accept(info.publication_handle);
-    }
+    // A malformed sample is dropped and counted: it counts as missing (the input goes stale).
+    std::uint64_t bad = 0;
+    while (take_next_valid(*r, &sample, info, bad)) accept(info.publication_handle);
+    if (bad > 0) malformed.fetch_add(bad, std::memory_order_relaxed);
   }
 
   void on_subscription_matched(fdds::DataReader*,
@@ -170,6 +172,7 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
     CommandInputStats s;
     s.samples = samples.load();
     s.non_finite = non_finite.load();
+    s.malformed = malformed.load();
     s.lost = lost.load();
     s.other_senders = other_senders.load();
     s.matched_writers = matched.load();
@@ -191,7 +194,7 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
   std::atomic<int> matched{0};
   std::atomic<bool> ever_matched{false};
   // Counters.
-  std::atomic<std::uint64_t> samples{0}, non_finite{0}, lost{0}, other_senders{0};
+  std::atomic<std::uint64_t> samples{0}, non_finite{0}, lost{0}, other_senders{0}, malformed{0};
   std::atomic<int> peak_matched{0}, writer_matches{0};
   std::atomic<double> first_match_s{-1.0}, first_sample_s{-1.0};
   mutable std::mutex sender_mutex;

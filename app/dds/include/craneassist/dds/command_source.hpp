@@ -10,9 +10,10 @@
 // One operator at a time: the first writer whose sample arrives holds the command until its
 // writer is gone or it has been silent for 0.5 s; samples of other writers meanwhile are counted
 // and dropped. Samples with a non-finite component are passed on (the input monitor stops the
-// crane at once) and counted. The safety decisions stay with the input monitor: kNoData before
-// the first sample, kDisconnected when every matched writer has gone after one was matched (the
-// sample then goes stale too), kOk otherwise.
+// crane at once) and counted. A sample that cannot be deserialized is dropped and counted; it
+// counts as missing (no fresh stamp), so a stream of them makes the input stale. The safety
+// decisions stay with the input monitor: kNoData before the first sample, kDisconnected when every
+// matched writer has gone after one was matched (the sample then goes stale too), kOk otherwise.
 //
 // Plain C++17: no Fast DDS types (the C++20 command line includes it).
 #pragma once
@@ -31,7 +32,10 @@ struct CommandInputStats {
   std::uint64_t non_finite = 0;     // of those, with a NaN or infinite component
   std::uint64_t lost = 0;           // gaps in the operator's seq (best effort: dropped samples)
   std::uint64_t other_senders = 0;  // dropped: another writer held the command
-  int matched_writers = 0;          // authenticated, permitted writers matched now
+  // Dropped: not deserializable (a bool byte other than 0 or 1, a bad encapsulation, a cut-off
+  // body, ...), from any writer. Counted as missing: only such samples make the input stale.
+  std::uint64_t malformed = 0;
+  int matched_writers = 0;  // authenticated, permitted writers matched now
   int peak_matched_writers = 0;
   int writer_matches = 0;      // writers matched over the run
   double first_match_s = -1;   // first writer matched, s after the source started; -1: never
