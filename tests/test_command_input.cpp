@@ -1,11 +1,12 @@
 // The DDS command input (docs/remote-commands.md): the settings reader's errors for the
 // command input's security files, and DdsCommandSource's states against a CommandWriter in the
 // same process, with certificates made by tools/dds-security/make-certs.sh; what it does with
-// malformed samples, from a raw writer with the operator's identity (dds_raw_writer.hpp). Each
-// DDS test has its own domain (181..185).
+// malformed and replayed samples, from a raw writer with the operator's identity
+// (dds_raw_writer.hpp). Each DDS test has its own domain (181..186).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -311,6 +312,11 @@ class RawOperator {
     return writer_.write(test::operator_command_payload(++seq_, "raw-operator", v, deadman));
   }
   bool send_raw(const test::Payload& payload) { return writer_.write(payload); }
+  // A well-formed sample with this seq (the next send() continues after the highest so far).
+  bool send_seq(std::uint64_t seq, const std::array<double, 3>& v, bool deadman) {
+    seq_ = std::max(seq_, seq);
+    return writer_.write(test::operator_command_payload(seq, "raw-operator", v, deadman));
+  }
   std::uint64_t seq() const { return seq_; }
 
  private:
@@ -402,6 +408,64 @@ TEST(DdsCommandSource, MalformedSamplesAreDroppedCountedAndGoStale) {
   EXPECT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
   EXPECT_DOUBLE_EQ(crane.sample.v_m_s.z(), 0.2);
   EXPECT_GT(source.stats().samples, good);
+}
+
+// A sample whose seq is not above what its writer sent before (an old sample replayed, or the
+// latest repeated) is dropped and counted, per writer: another writer's seq starts afresh.
+TEST(DdsCommandSource, ReplayedSamplesAreDroppedPerWriter) {
+  dds::DdsCommandSource source(settings_of("crane", 186));
+  RawOperator op(186);
+  MonitoredSource crane(source);
+  arm_and_move(op, crane, {0.3, 0.0, 0.0});
+  ASSERT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
+  const std::uint64_t latest = op.seq();
+  ASSERT_GT(latest, 40u);
+  const std::uint64_t good = source.stats().samples;
+
+  // An old sample (seq 10, pressed, moving the other way), the latest once more, seq 0: dropped,
+  // the source still reports the latest good sample.
+  op.send_seq(10, {-0.5, 0.0, 0.0}, true);
+  crane.cycle();
+  op.send_seq(latest, {-0.5, 0.0, 0.0}, true);
+  crane.cycle();
+  op.send_seq(0, {-0.5, 0.0, 0.0}, true);
+  for (int i = 0; i < 5; ++i) crane.cycle();
+  EXPECT_DOUBLE_EQ(crane.sample.v_m_s.x(), 0.3);
+  dds::CommandInputStats s = source.stats();
+  EXPECT_EQ(s.replayed, 3u);
+  EXPECT_EQ(s.samples, good);
+  // Only replays: no fresh sample, the input goes stale.
+  for (int i = 0; i < 20; ++i) {
+    op.send_seq(20 + static_cast<std::uint64_t>(i), {-0.5, 0.0, 0.0}, true);
+    crane.cycle();
+  }
+  EXPECT_EQ(crane.out.fault, input::InputFault::kStale) << input::to_string(crane.out.fault);
+  EXPECT_EQ(source.stats().replayed, 23u);
+  // A higher seq is taken (the gap counts as lost).
+  const std::uint64_t lost_before = source.stats().lost;
+  op.send_seq(1000000, {0.0, 0.0, 0.1}, false);
+  for (int i = 0; i < 5; ++i) crane.cycle();
+  EXPECT_DOUBLE_EQ(crane.sample.v_m_s.z(), 0.1);
+  EXPECT_EQ(source.stats().samples, good + 1);
+  EXPECT_EQ(source.stats().lost, lost_before + 1000000 - latest - 1);
+
+  // Another writer, once the first has been silent for 1 s, counts from 1: its seq is its own,
+  // not held against the first's.
+  const std::uint64_t replayed_before = source.stats().replayed;
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  RawOperator second(186);
+  const double end = input::steady_now_s() + 10.0;
+  while (crane.sample.v_m_s.y() != 0.2 && input::steady_now_s() < end) {
+    second.send({0.0, 0.2, 0.0}, false);
+    crane.cycle();
+  }
+  EXPECT_DOUBLE_EQ(crane.sample.v_m_s.y(), 0.2);
+  EXPECT_LT(second.seq(), 1000000u);
+  EXPECT_EQ(source.stats().replayed, replayed_before);
+  second.send_seq(1, {0.0, -0.2, 0.0}, false);  // its own first seq again
+  for (int i = 0; i < 5; ++i) crane.cycle();
+  EXPECT_DOUBLE_EQ(crane.sample.v_m_s.y(), 0.2);
+  EXPECT_EQ(source.stats().replayed, replayed_before + 1);
 }
 
 }  // namespace

@@ -90,14 +90,16 @@ class StatusReporter {
         sender_ = now_sender;
       }
       // Dropped samples, at most one message a second.
-      if (stats.malformed > malformed_ && s.t - malformed_reported_t_ >= 1.0) {
+      if ((stats.malformed > malformed_ || stats.replayed > replayed_) &&
+          s.t - dropped_reported_t_ >= 1.0) {
         clear_line();
         spdlog::warn(
-            "t {:.2f} s: dds input: {} malformed samples dropped so far (they count as "
-            "missing)",
-            s.t, stats.malformed);
+            "t {:.2f} s: dds input: {} malformed, {} replayed samples dropped so far (they count "
+            "as missing)",
+            s.t, stats.malformed, stats.replayed);
         malformed_ = stats.malformed;
-        malformed_reported_t_ = s.t;
+        replayed_ = stats.replayed;
+        dropped_reported_t_ = s.t;
       }
       std::snprintf(sender, sizeof sender, " | from %.40s", sender_.c_str());
     }
@@ -125,8 +127,8 @@ class StatusReporter {
   std::string sender_;
   bool draw_;
   int disconnects_ = 0, reconnects_ = 0;
-  std::uint64_t malformed_ = 0;
-  double malformed_reported_t_ = -1e9;
+  std::uint64_t malformed_ = 0, replayed_ = 0;
+  double dropped_reported_t_ = -1e9;
   input::InputFault fault_ = input::InputFault::kNone;
 };
 
@@ -374,11 +376,11 @@ int run_sim_command(const SimArgs& args) {
         from = " from '" + d.sender + "' (first " + first + " s after start)";
       }
       std::printf(
-          "  dds input: %llu samples%s, %llu lost, %llu non-finite, %llu malformed, %llu from "
-          "other senders; writers matched %d (peak %d)\n",
+          "  dds input: %llu samples%s, %llu lost, %llu non-finite, %llu malformed, %llu "
+          "replayed, %llu from other senders; writers matched %d (peak %d)\n",
           static_cast<unsigned long long>(d.samples), from.c_str(),
           static_cast<unsigned long long>(d.lost), static_cast<unsigned long long>(d.non_finite),
-          static_cast<unsigned long long>(d.malformed),
+          static_cast<unsigned long long>(d.malformed), static_cast<unsigned long long>(d.replayed),
           static_cast<unsigned long long>(d.other_senders), d.writer_matches,
           d.peak_matched_writers);
     }

@@ -1,5 +1,6 @@
 #include "craneassist/dds/command_source.hpp"
 
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <fastdds/dds/subscriber/DataReader.hpp>
@@ -93,13 +94,57 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
       std::lock_guard<std::mutex> lock(listener_mutex);
       // The operator's writer is gone: another may take over.
       if (has_owner && s.last_publication_handle == owner) has_owner = false;
+      forget_writer(s.last_publication_handle);
     }
     if (s.current_count > 0) ever_matched.store(true, std::memory_order_release);
     matched.store(s.current_count, std::memory_order_release);
   }
 
+  // True when `seq` is above every seq `writer` sent before (and records it): a sample with an
+  // older or the same seq is a replay (or a repeat), whoever holds the command.
+  bool fresh_seq(const fdds::InstanceHandle_t& writer, std::uint64_t seq, double now) {
+    WriterSeq* slot = nullptr;
+    WriterSeq* free_slot = nullptr;
+    WriterSeq* oldest = nullptr;
+    for (WriterSeq& e : writer_seqs) {
+      if (e.used && e.writer == writer) {
+        slot = &e;
+        break;
+      }
+      if (!e.used) {
+        if (free_slot == nullptr) free_slot = &e;
+      } else if (!(has_owner && e.writer == owner) &&
+                 (oldest == nullptr || e.heard_s < oldest->heard_s)) {
+        oldest = &e;
+      }
+    }
+    if (slot != nullptr) {
+      if (seq <= slot->seq) return false;
+    } else {
+      // A writer not heard from before; when every entry is taken, the writer heard from
+      // longest ago (never the operator holding the command) makes room.
+      slot = free_slot != nullptr ? free_slot : oldest;
+      if (slot == nullptr) return true;
+      slot->used = true;
+      slot->writer = writer;
+    }
+    slot->seq = seq;
+    slot->heard_s = now;
+    return true;
+  }
+
+  void forget_writer(const fdds::InstanceHandle_t& writer) {
+    for (WriterSeq& e : writer_seqs) {
+      if (e.used && e.writer == writer) e.used = false;
+    }
+  }
+
   void accept(const fdds::InstanceHandle_t& writer) {
     const double now = input::steady_now_s();
+    if (!fresh_seq(writer, sample.seq(), now)) {
+      replayed.fetch_add(1, std::memory_order_relaxed);
+      return;
+    }
     if (has_owner && writer != owner && now - owner_last_s <= kOwnerSilence_s) {
       other_senders.fetch_add(1, std::memory_order_relaxed);
       return;
@@ -173,6 +218,7 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
     s.samples = samples.load();
     s.non_finite = non_finite.load();
     s.malformed = malformed.load();
+    s.replayed = replayed.load();
     s.lost = lost.load();
     s.other_senders = other_senders.load();
     s.matched_writers = matched.load();
@@ -194,7 +240,8 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
   std::atomic<int> matched{0};
   std::atomic<bool> ever_matched{false};
   // Counters.
-  std::atomic<std::uint64_t> samples{0}, non_finite{0}, lost{0}, other_senders{0}, malformed{0};
+  std::atomic<std::uint64_t> samples{0}, non_finite{0}, lost{0}, other_senders{0}, malformed{0},
+      replayed{0};
   std::atomic<int> peak_matched{0}, writer_matches{0};
   std::atomic<double> first_match_s{-1.0}, first_sample_s{-1.0};
   mutable std::mutex sender_mutex;
@@ -205,8 +252,17 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
   fdds::InstanceHandle_t owner;
   bool has_owner = false;
   double owner_last_s = 0.0;
-  std::uint64_t last_seq = 0;
+  std::uint64_t last_seq = 0;  // the operator's, for `lost`
   bool last_seq_valid = false;
+  // The highest seq of each writer heard from (fresh_seq); an entry goes when its writer is
+  // unmatched.
+  struct WriterSeq {
+    fdds::InstanceHandle_t writer;
+    std::uint64_t seq = 0;
+    double heard_s = 0.0;
+    bool used = false;
+  };
+  std::array<WriterSeq, 16> writer_seqs{};
   std::string sender_seen;
   // Loop thread only.
   input::OperatorCommand latest;

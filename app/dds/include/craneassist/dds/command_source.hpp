@@ -10,8 +10,9 @@
 // One operator at a time: the first writer whose sample arrives holds the command until its
 // writer is gone or it has been silent for 0.5 s; samples of other writers meanwhile are counted
 // and dropped. Samples with a non-finite component are passed on (the input monitor stops the
-// crane at once) and counted. A sample that cannot be deserialized is dropped and counted; it
-// counts as missing (no fresh stamp), so a stream of them makes the input stale. The safety
+// crane at once) and counted. A sample that cannot be deserialized, or whose seq is not above
+// every seq its writer sent before (a replay), is dropped and counted; it counts as missing (no
+// fresh stamp), so a stream of them makes the input stale. The safety
 // decisions stay with the input monitor: kNoData before the first sample, kDisconnected when every
 // matched writer has gone after one was matched (the sample then goes stale too), kOk otherwise.
 //
@@ -35,6 +36,9 @@ struct CommandInputStats {
   // Dropped: not deserializable (a bool byte other than 0 or 1, a bad encapsulation, a cut-off
   // body, ...), from any writer. Counted as missing: only such samples make the input stale.
   std::uint64_t malformed = 0;
+  // Dropped: a seq not above what the same writer sent before (a replayed or repeated sample),
+  // from any writer. Counted as missing, like malformed ones.
+  std::uint64_t replayed = 0;
   int matched_writers = 0;  // authenticated, permitted writers matched now
   int peak_matched_writers = 0;
   int writer_matches = 0;      // writers matched over the run
