@@ -2,7 +2,8 @@
 // command input's security files, and DdsCommandSource's states against a CommandWriter in the
 // same process, with certificates made by tools/dds-security/make-certs.sh; what it does with
 // malformed and replayed samples, from a raw writer with the operator's identity
-// (dds_raw_writer.hpp). Each DDS test has its own domain (181..186).
+// (dds_raw_writer.hpp), and who holds the command when two operators send. Each DDS test has its
+// own domain (181..188).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -292,30 +293,38 @@ TEST(DdsCommandSource, OneOperatorAtATime) {
   dds::CommandInputStats s = source.stats();
   EXPECT_EQ(s.sender, "first");
   EXPECT_GE(s.other_senders, 15u);
-  // The first falls silent for longer than 0.5 s: the second may take over.
+  // The first falls silent for longer than the stale timeout (0.1 s): the second may take over,
+  // its deadman read released until it has sent it released.
   for (int i = 0; i < 70; ++i) {
     second.write({-0.2, 0.0, 0.0}, true);
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   source.poll(out);
   EXPECT_DOUBLE_EQ(out.v_m_s.x(), -0.2);
-  EXPECT_TRUE(out.deadman);
+  EXPECT_FALSE(out.deadman);
   EXPECT_EQ(source.stats().sender, "second");
+  second.write({-0.2, 0.0, 0.0}, false);
+  second.write({-0.2, 0.0, 0.0}, true);
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  source.poll(out);
+  EXPECT_TRUE(out.deadman);
+  EXPECT_EQ(source.stats().owner_changes, 2);
 }
 
 // The operator's identity writing payloads of its own making to the crane's command input.
 class RawOperator {
  public:
-  explicit RawOperator(int domain) : writer_(options(domain)) {}
+  explicit RawOperator(int domain, std::string sender = "raw-operator")
+      : writer_(options(domain)), sender_(std::move(sender)) {}
   // A well-formed sample with the next seq.
   bool send(const std::array<double, 3>& v, bool deadman) {
-    return writer_.write(test::operator_command_payload(++seq_, "raw-operator", v, deadman));
+    return writer_.write(test::operator_command_payload(++seq_, sender_, v, deadman));
   }
   bool send_raw(const test::Payload& payload) { return writer_.write(payload); }
   // A well-formed sample with this seq (the next send() continues after the highest so far).
   bool send_seq(std::uint64_t seq, const std::array<double, 3>& v, bool deadman) {
     seq_ = std::max(seq_, seq);
-    return writer_.write(test::operator_command_payload(seq, "raw-operator", v, deadman));
+    return writer_.write(test::operator_command_payload(seq, sender_, v, deadman));
   }
   std::uint64_t seq() const { return seq_; }
 
@@ -327,12 +336,15 @@ class RawOperator {
     return o;
   }
   test::RawWriter writer_;
+  std::string sender_;
   std::uint64_t seq_ = 0;
 };
 
 // The crane's side of a test: the source behind the input monitor, one cycle every 10 ms.
 struct MonitoredSource {
-  explicit MonitoredSource(dds::DdsCommandSource& s) : source(s) {}
+  explicit MonitoredSource(dds::DdsCommandSource& s,
+                           const input::InputMonitorSettings& settings = {})
+      : source(s), monitor(settings) {}
   const input::MonitorOutput& cycle() {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
     state = source.poll(sample);
@@ -340,7 +352,7 @@ struct MonitoredSource {
     return out;
   }
   dds::DdsCommandSource& source;
-  input::InputMonitor monitor{input::InputMonitorSettings{}};
+  input::InputMonitor monitor;
   input::OperatorCommand sample;
   input::MonitorOutput out;
   SourceState state = SourceState::kNoData;
@@ -466,6 +478,101 @@ TEST(DdsCommandSource, ReplayedSamplesAreDroppedPerWriter) {
   for (int i = 0; i < 5; ++i) crane.cycle();
   EXPECT_DOUBLE_EQ(crane.sample.v_m_s.y(), 0.2);
   EXPECT_EQ(source.stats().replayed, replayed_before + 1);
+}
+
+// Waits (the first operator sending) until the source has matched two writers.
+void wait_for_two_writers(dds::DdsCommandSource& source, RawOperator& first, MonitoredSource& crane,
+                          const std::array<double, 3>& v) {
+  const double end = input::steady_now_s() + 10.0;
+  while (source.stats().peak_matched_writers < 2 && input::steady_now_s() < end) {
+    first.send(v, true);
+    crane.cycle();
+  }
+  ASSERT_EQ(source.stats().peak_matched_writers, 2);
+}
+
+// With a stale timeout longer than the old fixed 0.5 s: the second operator, sending with its
+// deadman held all along, takes the command over only after the first has been silent for longer
+// than the stale timeout, and its command passes only after it has released and pressed the
+// deadman.
+TEST(DdsCommandSource, TakeoverOnlyAfterTheStaleTimeoutAndWithReArm) {
+  input::InputMonitorSettings monitor;
+  monitor.stale_timeout_s = 1.0;
+  dds::DdsCommandSource source(settings_of("crane", 187), monitor.stale_timeout_s);
+  RawOperator first(187, "first");
+  MonitoredSource crane(source, monitor);
+  arm_and_move(first, crane, {0.3, 0.0, 0.0});
+  RawOperator second(187, "second");
+  wait_for_two_writers(source, first, crane, {0.3, 0.0, 0.0});
+  ASSERT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
+
+  // The first falls silent; the second sends, deadman held, moving the other way.
+  const double silent_from = input::steady_now_s();
+  double took_over_s = -1.0;
+  int second_passed = 0;
+  while (input::steady_now_s() - silent_from < 2.5) {
+    second.send({-0.2, 0.0, 0.0}, true);
+    const input::MonitorOutput& o = crane.cycle();
+    if (crane.sample.v_m_s.x() < 0.0 && took_over_s < 0.0) {
+      took_over_s = input::steady_now_s() - silent_from;
+    }
+    if (o.enabled && o.v_m_s.x() < 0.0) ++second_passed;
+  }
+  EXPECT_GT(took_over_s, 1.0);
+  EXPECT_LT(took_over_s, 1.3);
+  EXPECT_EQ(second_passed, 0) << "the second's command passed without a release and press";
+  EXPECT_FALSE(crane.out.enabled);
+  EXPECT_FALSE(crane.sample.deadman);  // read released until the second releases it
+  dds::CommandInputStats s = source.stats();
+  EXPECT_EQ(s.sender, "second");
+  EXPECT_EQ(s.owner_changes, 2);
+  EXPECT_GT(s.other_senders, 50u);  // its samples in the first second
+
+  // The second releases and presses: now its command passes.
+  for (int i = 0; i < 10; ++i) {
+    second.send({-0.2, 0.0, 0.0}, false);
+    crane.cycle();
+  }
+  EXPECT_FALSE(crane.out.enabled);
+  for (int i = 0; i < 10; ++i) {
+    second.send({-0.2, 0.0, 0.0}, true);
+    crane.cycle();
+  }
+  EXPECT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
+  EXPECT_DOUBLE_EQ(crane.out.v_m_s.x(), -0.2);
+}
+
+// Two operators both sending: the first keeps the command every cycle, the second's samples
+// are dropped; ownership never alternates.
+TEST(DdsCommandSource, FightingOperatorsNeverAlternate) {
+  input::InputMonitorSettings monitor;
+  monitor.stale_timeout_s = 0.3;  // margin for a test thread descheduled on a loaded machine
+  dds::DdsCommandSource source(settings_of("crane", 188), monitor.stale_timeout_s);
+  RawOperator first(188, "first");
+  MonitoredSource crane(source, monitor);
+  arm_and_move(first, crane, {0.1, 0.0, 0.0});
+  RawOperator second(188, "second");
+  wait_for_two_writers(source, first, crane, {0.1, 0.0, 0.0});
+  ASSERT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
+  int cycles = 0, first_held = 0;
+  for (int i = 0; i < 200; ++i) {
+    // Alternately first and second send first within a cycle; the second releases and presses.
+    if (i % 2 == 0) {
+      first.send({0.1, 0.0, 0.0}, true);
+      second.send({-0.2, 0.0, 0.0}, i % 10 < 5);
+    } else {
+      second.send({-0.2, 0.0, 0.0}, i % 10 < 5);
+      first.send({0.1, 0.0, 0.0}, true);
+    }
+    const input::MonitorOutput& o = crane.cycle();
+    ++cycles;
+    if (crane.sample.v_m_s.x() == 0.1 && o.enabled) ++first_held;
+  }
+  EXPECT_EQ(first_held, cycles);
+  const dds::CommandInputStats s = source.stats();
+  EXPECT_EQ(s.sender, "first");
+  EXPECT_EQ(s.owner_changes, 1);
+  EXPECT_GE(s.other_senders, 150u);
 }
 
 }  // namespace

@@ -89,6 +89,16 @@ class StatusReporter {
         spdlog::info("remote operator: '{}' (DDS)", now_sender);
         sender_ = now_sender;
       }
+      if (stats.owner_changes > owner_changes_) {
+        if (owner_changes_ > 0) {
+          clear_line();
+          spdlog::warn(
+              "t {:.2f} s: dds input: another writer took the command over ('{}'); its commands "
+              "pass once it has released and pressed the deadman",
+              s.t, now_sender);
+        }
+        owner_changes_ = stats.owner_changes;
+      }
       // Dropped samples, at most one message a second.
       if ((stats.malformed > malformed_ || stats.replayed > replayed_) &&
           s.t - dropped_reported_t_ >= 1.0) {
@@ -128,6 +138,7 @@ class StatusReporter {
   bool draw_;
   int disconnects_ = 0, reconnects_ = 0;
   std::uint64_t malformed_ = 0, replayed_ = 0;
+  int owner_changes_ = 0;
   double dropped_reported_t_ = -1e9;
   input::InputFault fault_ = input::InputFault::kNone;
 };
@@ -259,7 +270,7 @@ int run_sim_command(const SimArgs& args) {
     input::KeyboardSource* keyboard = nullptr;
     dds::DdsCommandSource* remote = nullptr;
     if (kind == "dds") {
-      auto d = std::make_unique<dds::DdsCommandSource>(tcfg);
+      auto d = std::make_unique<dds::DdsCommandSource>(tcfg, jcfg.monitor.stale_timeout_s);
       remote = d.get();
       source = std::move(d);
       spdlog::info(

@@ -7,10 +7,13 @@
 // reader. Fast DDS's listener thread stamps each sample on reception (steady_clock) and hands
 // the latest one to poll() through a seqlock: poll() never blocks, allocates or throws.
 //
-// One operator at a time: the first writer whose sample arrives holds the command until its
-// writer is gone or it has been silent for 0.5 s; samples of other writers meanwhile are counted
-// and dropped. Samples with a non-finite component are passed on (the input monitor stops the
-// crane at once) and counted. A sample that cannot be deserialized, or whose seq is not above
+// One operator at a time: the first writer whose sample arrives holds the command for as long as
+// it sends; samples of other writers meanwhile are counted and dropped. Another writer takes it
+// over only once the holder has been silent (or gone) for longer than the input monitor's stale
+// timeout, when the monitor has stopped the crane on stale input, and the new holder's deadman
+// reads released until it has sent it released (its own release and press re-arm the monitor).
+// Samples with a non-finite component are passed on (the input monitor stops the crane at once)
+// and counted. A sample that cannot be deserialized, or whose seq is not above
 // every seq its writer sent before (a replay), is dropped and counted; it counts as missing (no
 // fresh stamp), so a stream of them makes the input stale. The safety
 // decisions stay with the input monitor: kNoData before the first sample, kDisconnected when every
@@ -25,6 +28,7 @@
 
 #include "craneassist/config/telemetry_config.hpp"
 #include "craneassist/input/command_source.hpp"
+#include "craneassist/input/input_monitor.hpp"
 
 namespace craneassist::dds {
 
@@ -39,6 +43,7 @@ struct CommandInputStats {
   // Dropped: a seq not above what the same writer sent before (a replayed or repeated sample),
   // from any writer. Counted as missing, like malformed ones.
   std::uint64_t replayed = 0;
+  int owner_changes = 0;    // writers that took the command (the first one too)
   int matched_writers = 0;  // authenticated, permitted writers matched now
   int peak_matched_writers = 0;
   int writer_matches = 0;      // writers matched over the run
@@ -50,10 +55,13 @@ struct CommandInputStats {
 class DdsCommandSource : public input::CommandSource {
  public:
   // Creates the secure participant (settings.domain_id, settings.transport) and the reader of
-  // craneassist/operator_command with the settings.commands.topic QoS. Throws
-  // std::invalid_argument when settings.commands is not enabled or a security file is missing,
+  // craneassist/operator_command with the settings.commands.topic QoS. stale_timeout_s: the
+  // input monitor's (InputMonitorSettings::stale_timeout_s), the silence after which another
+  // writer may take the command over. Throws std::invalid_argument when settings.commands is
+  // not enabled, a security file is missing or stale_timeout_s is not positive,
   // std::runtime_error when DDS (or DDS Security: bad certificate, key, signature) fails.
-  explicit DdsCommandSource(const config::TelemetryConfig& settings);
+  explicit DdsCommandSource(const config::TelemetryConfig& settings,
+                            double stale_timeout_s = input::InputMonitorSettings{}.stale_timeout_s);
   ~DdsCommandSource() override;
   DdsCommandSource(const DdsCommandSource&) = delete;
   DdsCommandSource& operator=(const DdsCommandSource&) = delete;
