@@ -97,9 +97,9 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
     matched.store(s.current_count, std::memory_order_release);
   }
 
-  // True when `seq` is above every seq `writer` sent before (and records it): a sample with an
-  // older or the same seq is a replay (or a repeat), whoever holds the command.
-  bool fresh_seq(const fdds::InstanceHandle_t& writer, std::uint64_t seq, double now) {
+  // True when `sample_seq` is above every seq `writer` sent before (and records it): a sample
+  // with an older or the same seq is a replay (or a repeat), whoever holds the command.
+  bool fresh_seq(const fdds::InstanceHandle_t& writer, std::uint64_t sample_seq, double now) {
     WriterSeq* slot = nullptr;
     WriterSeq* free_slot = nullptr;
     WriterSeq* oldest = nullptr;
@@ -116,7 +116,7 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
       }
     }
     if (slot != nullptr) {
-      if (seq <= slot->seq) return false;
+      if (sample_seq <= slot->seq) return false;
     } else {
       // A writer not heard from before; when every entry is taken, the writer heard from
       // longest ago (never the operator holding the command) makes room.
@@ -125,7 +125,7 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
       slot->used = true;
       slot->writer = writer;
     }
-    slot->seq = seq;
+    slot->seq = sample_seq;
     slot->heard_s = now;
     return true;
   }
