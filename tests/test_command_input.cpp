@@ -359,9 +359,10 @@ struct MonitoredSource {
 };
 
 // Sends released-deadman samples until the source has one (discovery and the DDS Security
-// handshake), then `released` more cycles of them, then `pressed` cycles moving at v.
+// handshake), then `released` more cycles of them, then `pressed` cycles moving at v (the
+// monitor passes the command once the deadman has been held for 0.3 s).
 void arm_and_move(RawOperator& op, MonitoredSource& crane, const std::array<double, 3>& v,
-                  int released = 20, int pressed = 30) {
+                  int released = 20, int pressed = 50) {
   const double end = input::steady_now_s() + 10.0;
   while (crane.state != SourceState::kOk && input::steady_now_s() < end) {
     op.send({0.0, 0.0, 0.0}, false);
@@ -415,8 +416,9 @@ TEST(DdsCommandSource, MalformedSamplesAreDroppedCountedAndGoStale) {
   EXPECT_GE(s.malformed, static_cast<std::uint64_t>(sent) / 2) << sent << " sent";
   EXPECT_LE(s.malformed, static_cast<std::uint64_t>(sent));
 
-  // Good samples again: taken (the monitor wants a release and press before motion).
-  arm_and_move(op, crane, {0.0, 0.0, 0.2}, 5, 5);
+  // Good samples again: taken (the monitor wants a release and press, the deadman held 0.3 s
+  // and the stop latched 1 s before motion).
+  arm_and_move(op, crane, {0.0, 0.0, 0.2}, 5, 100);
   EXPECT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
   EXPECT_DOUBLE_EQ(crane.sample.v_m_s.z(), 0.2);
   EXPECT_GT(source.stats().samples, good);
@@ -528,13 +530,13 @@ TEST(DdsCommandSource, TakeoverOnlyAfterTheStaleTimeoutAndWithReArm) {
   EXPECT_EQ(s.owner_changes, 2);
   EXPECT_GT(s.other_senders, 50u);  // its samples in the first second
 
-  // The second releases and presses: now its command passes.
+  // The second releases and presses (and holds the deadman 0.3 s): now its command passes.
   for (int i = 0; i < 10; ++i) {
     second.send({-0.2, 0.0, 0.0}, false);
     crane.cycle();
   }
   EXPECT_FALSE(crane.out.enabled);
-  for (int i = 0; i < 10; ++i) {
+  for (int i = 0; i < 40; ++i) {
     second.send({-0.2, 0.0, 0.0}, true);
     crane.cycle();
   }
