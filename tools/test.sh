@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Set up (Debian packages, the SocketCAN test VM's kernel), build, and run the whole test suite
 # twice: a release build (with the SocketCAN tests in a qemu VM, label can_vm), then a build with
-# AddressSanitizer and UndefinedBehaviorSanitizer. Also checks the formatting.
+# AddressSanitizer and UndefinedBehaviorSanitizer. Also checks the formatting and that the
+# executable builds without DDS.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/install-deps.sh
@@ -17,6 +18,12 @@ echo "== release build and tests"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$jobs"
 ctest --test-dir build --output-on-failure -j"$jobs"
+
+echo "== build without DDS (CRANEASSIST_DDS=OFF): the executable alone, unoptimised, and its CLI checks"
+cmake -S . -B build-nodds -DCMAKE_BUILD_TYPE=Debug -DCRANEASSIST_DDS=OFF -DCRANEASSIST_BUILD_BENCH=OFF \
+  -DCRANEASSIST_CAN_VM_TESTS=OFF >/dev/null
+cmake --build build-nodds -j"$jobs" --target craneassist
+ctest --test-dir build-nodds --output-on-failure -R 'cli_sim_without_dds|cli_replay_initial|cli_sim_bad_input'
 
 echo "== AddressSanitizer + UndefinedBehaviorSanitizer build and tests"
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCRANEASSIST_SANITIZE=ON \

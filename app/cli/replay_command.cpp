@@ -11,6 +11,7 @@
 #include <sstream>
 #include <string>
 
+#include "crane_options.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/config/quantity.hpp"
 #include "craneassist/control/csv_log.hpp"
@@ -24,7 +25,6 @@
 #include "embedded_replays.hpp"
 #include "exit_codes.hpp"
 #include "machine_setup.hpp"
-#include "resolution_option.hpp"
 #include "telemetry_setup.hpp"
 
 namespace craneassist::cli {
@@ -202,28 +202,9 @@ int run_replay_command(const ReplayArgs& args) {
   std::optional<input::Replay> loaded;
   config::TelemetryConfig telemetry_settings;
   try {
-    cfg = args.config_file.empty() ? config::default_crane_config()
-                                   : config::load_crane_config(args.config_file);
-    if (args.payload_kg) config::set_payload_mass(cfg.model, *args.payload_kg);
-    if (!args.initial.empty()) {
-      if (uses_can_backend(args.machine, cfg)) {
-        throw CLI::ValidationError(
-            "--initial", "the can backend starts where the machine is (use --backend sim)");
-      }
-      try {
-        cfg.simulation.q_initial =
-            config::parse_joint_pose(cfg.model, args.initial, cfg.simulation.q_initial);
-      } catch (const std::invalid_argument& e) {
-        throw CLI::ValidationError("--initial", e.what());
-      }
-    }
-    if (!args.resolution.empty()) {
-      try {
-        config::set_resolution(cfg, args.resolution);
-      } catch (const std::invalid_argument& e) {
-        throw CLI::ValidationError("--resolution", e.what());
-      }
-    }
+    cfg = load_crane(args.config_file);
+    apply_crane_options(cfg, {args.payload_kg, args.initial, args.resolution,
+                              !uses_can_backend(args.machine, cfg)});
     if (!args.power_bound.empty()) {
       cfg.scaling.power_bound = dynamics::parse_power_bound(args.power_bound).value();
     }
@@ -325,10 +306,7 @@ CLI::App* add_replay_command(CLI::App& cli, ReplayArgs& args) {
                    "Execute a planned joint trajectory (craneassist plan; "
                    "docs/trajectory-format.md) instead of a replay, from its first configuration")
       ->check(CLI::ExistingFile);
-  replay
-      ->add_option("--config", args.config_file,
-                   "Crane config YAML (default: the embedded K70M reference crane)")
-      ->check(CLI::ExistingFile);
+  add_config_option(*replay, args.config_file);
   add_backend_options(*replay, args.machine);
   add_telemetry_options(*replay, args.telemetry, false);
   replay->add_option("--test-freeze-at", args.freeze_at_s)->group("");
@@ -355,11 +333,8 @@ CLI::App* add_replay_command(CLI::App& cli, ReplayArgs& args) {
   replay->add_option("--settle", args.settle_s, "Seconds to keep running after the last replay row")
       ->check(CLI::Range(0.0, 600.0))
       ->capture_default_str();
-  replay->add_option("--payload", args.payload_kg, "Payload mass in the grapple, kg")
-      ->check(CLI::Range(0.0, 100000.0));
-  replay->add_option("--initial", args.initial,
-                     "Start pose of the simulated crane, e.g. \"lift=0 deg, tilt=-125 deg, "
-                     "extension=0.2 m\" (joints left out keep the config's simulation.initial)");
+  add_payload_option(*replay, args.payload_kg);
+  add_initial_option(*replay, args.initial);
   replay->add_option("--pump-max-flow", args.pump_max_flow,
                      "Override the pump's maximum flow, e.g. \"120 L/min\"");
   replay->add_option("--prime-mover-power", args.prime_mover_power,
