@@ -13,12 +13,20 @@ void check_remote_input_settings(const config::TelemetryConfig& settings) {
   dds::check_command_input_settings(settings);
 }
 
-RemoteInput open_remote_input(const config::TelemetryConfig& settings) {
-  auto source = std::make_unique<dds::DdsCommandSource>(settings);
+RemoteInput open_remote_input(const config::TelemetryConfig& settings, double stale_timeout_s) {
+  auto source = std::make_unique<dds::DdsCommandSource>(settings, stale_timeout_s);
   const dds::DdsCommandSource* dds_source = source.get();
   RemoteInput remote;
   remote.source = std::move(source);
   remote.sender = [dds_source] { return dds_source->stats().sender; };
+  remote.events = [dds_source] {
+    const dds::CommandInputStats d = dds_source->stats();
+    RemoteInputEvents e;
+    e.malformed = d.malformed;
+    e.replayed = d.replayed;
+    e.operator_changes = d.owner_changes;
+    return e;
+  };
   remote.report = [dds_source] {
     const dds::CommandInputStats d = dds_source->stats();
     std::string from = " (no operator)";
@@ -30,10 +38,11 @@ RemoteInput open_remote_input(const config::TelemetryConfig& settings) {
     char line[512];
     std::snprintf(
         line, sizeof line,
-        "  dds input: %llu samples%s, %llu lost, %llu non-finite, %llu from other "
-        "senders; writers matched %d (peak %d)",
+        "  dds input: %llu samples%s, %llu lost, %llu non-finite, %llu malformed, %llu "
+        "replayed, %llu from other senders; writers matched %d (peak %d)",
         static_cast<unsigned long long>(d.samples), from.c_str(),
         static_cast<unsigned long long>(d.lost), static_cast<unsigned long long>(d.non_finite),
+        static_cast<unsigned long long>(d.malformed), static_cast<unsigned long long>(d.replayed),
         static_cast<unsigned long long>(d.other_senders), d.writer_matches, d.peak_matched_writers);
     return std::string(line);
   };

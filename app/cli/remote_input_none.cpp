@@ -18,7 +18,7 @@ void check_remote_input_settings(const config::TelemetryConfig&) {
   throw std::invalid_argument(kNotBuilt);
 }
 
-RemoteInput open_remote_input(const config::TelemetryConfig&) {
+RemoteInput open_remote_input(const config::TelemetryConfig&, double) {
   throw std::runtime_error(kNotBuilt);
 }
 

@@ -39,12 +39,10 @@ extern "C" void on_stop_signal(int) {
 // The status line and the device event messages, from the loop's status board (UI thread).
 class StatusReporter {
  public:
+  // remote: the DDS input's sender and events (empty functions: another input).
   StatusReporter(const control::LiveStatusBoard& board, const input::KeyboardSource* keyboard,
-                 std::function<std::string()> remote_sender)
-      : board_(board),
-        keyboard_(keyboard),
-        remote_sender_(std::move(remote_sender)),
-        draw_(isatty(1) != 0) {}
+                 const RemoteInput& remote)
+      : board_(board), keyboard_(keyboard), remote_(remote), draw_(isatty(1) != 0) {}
 
   void run(const std::atomic<bool>& done) {
     while (!done.load()) {
@@ -87,12 +85,35 @@ class StatusReporter {
       fault_ = s.fault;
     }
     char sender[64] = "";
-    if (remote_sender_) {  // the remote operator (OperatorCommand.sender)
-      const std::string now_sender = remote_sender_();
+    if (remote_.sender) {  // the remote operator (OperatorCommand.sender)
+      const std::string now_sender = remote_.sender();
+      const RemoteInputEvents events = remote_.events ? remote_.events() : RemoteInputEvents{};
       if (now_sender != sender_) {
         clear_line();
         spdlog::info("remote operator: '{}' (DDS)", now_sender);
         sender_ = now_sender;
+      }
+      if (events.operator_changes > operator_changes_) {
+        if (operator_changes_ > 0) {
+          clear_line();
+          spdlog::warn(
+              "t {:.2f} s: dds input: another writer took the command over ('{}'); its commands "
+              "pass once it has released and pressed the deadman",
+              s.t, now_sender);
+        }
+        operator_changes_ = events.operator_changes;
+      }
+      // Dropped samples, at most one message a second.
+      if ((events.malformed > malformed_ || events.replayed > replayed_) &&
+          s.t - dropped_reported_t_ >= 1.0) {
+        clear_line();
+        spdlog::warn(
+            "t {:.2f} s: dds input: {} malformed, {} replayed samples dropped so far (they count "
+            "as missing)",
+            s.t, events.malformed, events.replayed);
+        malformed_ = events.malformed;
+        replayed_ = events.replayed;
+        dropped_reported_t_ = s.t;
       }
       std::snprintf(sender, sizeof sender, " | from %.40s", sender_.c_str());
     }
@@ -116,10 +137,13 @@ class StatusReporter {
 
   const control::LiveStatusBoard& board_;
   const input::KeyboardSource* keyboard_;
-  std::function<std::string()> remote_sender_;
+  const RemoteInput& remote_;
   std::string sender_;
   bool draw_;
   int disconnects_ = 0, reconnects_ = 0;
+  std::uint64_t malformed_ = 0, replayed_ = 0;
+  int operator_changes_ = 0;
+  double dropped_reported_t_ = -1e9;
   input::InputFault fault_ = input::InputFault::kNone;
 };
 
@@ -228,7 +252,7 @@ int run_sim_command(const SimArgs& args) {
     input::KeyboardSource* keyboard = nullptr;
     RemoteInput remote;
     if (kind == "dds") {
-      remote = open_remote_input(tcfg);
+      remote = open_remote_input(tcfg, jcfg.monitor.stale_timeout_s);
       source = std::move(remote.source);
       spdlog::info(
           "dds input: craneassist/operator_command on DDS domain {} with DDS Security "
@@ -292,7 +316,7 @@ int run_sim_command(const SimArgs& args) {
     if (keyboard != nullptr) print_keys();
 
     std::atomic<bool> done{false};
-    StatusReporter reporter(board, keyboard, remote.sender);
+    StatusReporter reporter(board, keyboard, remote);
     std::thread ui([&] { reporter.run(done); });
     control::LiveSummary s;
     try {
