@@ -2,6 +2,7 @@
 // frames, as two raw sockets on one vcan interface do (a sender does not receive its own frames).
 #pragma once
 
+#include <cstdint>
 #include <deque>
 #include <mutex>
 #include <vector>
@@ -49,7 +50,7 @@ class FakeCanBus {
     Received r;
     r.kind = ReceiveKind::kFrame;
     r.frame = frame;
-    r.timestamp_us = realtime_now_us();
+    r.timestamp_us = realtime_now_us() + wall_clock_step_us;
     for (auto* e : ends_) {
       if (e != from) e->deliver(r);
     }
@@ -60,6 +61,9 @@ class FakeCanBus {
     std::lock_guard<std::mutex> lock(mutex_);
     return log_;
   }
+  // Added to the receive timestamps (CLOCK_REALTIME, as the kernel stamps them): a test's wall
+  // clock step.
+  std::int64_t wall_clock_step_us = 0;
   void clear_log() {
     std::lock_guard<std::mutex> lock(mutex_);
     log_.clear();

@@ -220,6 +220,44 @@ TEST(CanBackend, LostFeedbackLatchesBlockUntilEnable) {
   EXPECT_EQ(backend.counters().faults, 1u);
 }
 
+// Lost feedback is timed on CLOCK_MONOTONIC, not on the frames' wall-clock stamps: frames stamped
+// an hour ahead (the wall clock stepped back an hour after they came) do not stay fresh for an
+// hour; frames stamped an hour behind (stepped forward) are fresh while they come.
+TEST(CanBackend, LostFeedbackIsTimedOnTheMonotonicClockThroughAWallClockStep) {
+  for (const std::int64_t step_us : {std::int64_t{3600000000}, std::int64_t{-3600000000}}) {
+    SCOPED_TRACE(step_us);
+    Rig r;
+    r.bus.wall_clock_step_us = step_us;
+    CanBackend backend(r.map, r.cfg.model, r.backend_end);
+    valves::MachineState state;
+    valves::ValveCommand cmd;
+    cmd.spool = dynamics::JointVector::Constant(4, 0.3);
+    send_feedback(r.sensors, r.map, r.q);
+    EXPECT_EQ(backend.read(state), valves::BackendStatus::kOk);
+    backend.enable();
+    const auto t0 = std::chrono::steady_clock::now();
+    auto last_feedback = t0;
+    std::chrono::steady_clock::time_point faulted_at{};
+    for (int k = 0; k < 30; ++k) {
+      if (k < 5) {
+        send_feedback(r.sensors, r.map, r.q);
+        last_feedback = std::chrono::steady_clock::now();
+        EXPECT_EQ(backend.read(state), valves::BackendStatus::kOk) << "fresh while frames come";
+      } else {
+        backend.read(state);
+      }
+      backend.write(cmd);
+      if (backend.faulted() && faulted_at == std::chrono::steady_clock::time_point{}) {
+        faulted_at = std::chrono::steady_clock::now();
+      }
+      std::this_thread::sleep_until(t0 + (k + 1) * 10ms);
+    }
+    ASSERT_TRUE(backend.faulted());
+    EXPECT_EQ(backend.fault_reason(), FaultReason::kFeedbackLost);
+    EXPECT_LT(faulted_at - last_feedback, 100ms);
+  }
+}
+
 TEST(CanBackend, WatchdogBlocksEverySectionWhenTheLoopFreezes) {
   Rig r;
   CanBackend backend(r.map, r.cfg.model, r.backend_end);

@@ -1,10 +1,13 @@
 // The DDS command input (docs/remote-commands.md): the settings reader's errors for the
 // command input's security files, and DdsCommandSource's states against a CommandWriter in the
-// same process, with certificates made by tools/dds-security/make-certs.sh. Each DDS test has
-// its own domain (181..184).
+// same process, with certificates made by tools/dds-security/make-certs.sh; what it does with
+// malformed and replayed samples, from a raw writer with the operator's identity
+// (dds_raw_writer.hpp), and who holds the command when two operators send. Each DDS test has its
+// own domain (181..188).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -20,6 +23,8 @@
 #include "craneassist/config/telemetry_config.hpp"
 #include "craneassist/dds/command_source.hpp"
 #include "craneassist/dds/command_writer.hpp"
+#include "craneassist/input/input_monitor.hpp"
+#include "dds_raw_writer.hpp"
 
 // Under AddressSanitizer: Debian's Fast DDS 2.9 (not instrumented) deletes its statistics
 // listeners with a mismatched size at every participant's teardown, and leaks OpenSSL objects on
@@ -288,15 +293,288 @@ TEST(DdsCommandSource, OneOperatorAtATime) {
   dds::CommandInputStats s = source.stats();
   EXPECT_EQ(s.sender, "first");
   EXPECT_GE(s.other_senders, 15u);
-  // The first falls silent for longer than 0.5 s: the second may take over.
+  // The first falls silent for longer than the stale timeout (0.1 s): the second may take over,
+  // its deadman read released until it has sent it released.
   for (int i = 0; i < 70; ++i) {
     second.write({-0.2, 0.0, 0.0}, true);
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   source.poll(out);
   EXPECT_DOUBLE_EQ(out.v_m_s.x(), -0.2);
-  EXPECT_TRUE(out.deadman);
+  EXPECT_FALSE(out.deadman);
   EXPECT_EQ(source.stats().sender, "second");
+  second.write({-0.2, 0.0, 0.0}, false);
+  second.write({-0.2, 0.0, 0.0}, true);
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  source.poll(out);
+  EXPECT_TRUE(out.deadman);
+  EXPECT_EQ(source.stats().owner_changes, 2);
+}
+
+// The operator's identity writing payloads of its own making to the crane's command input.
+class RawOperator {
+ public:
+  explicit RawOperator(int domain, std::string sender = "raw-operator")
+      : writer_(options(domain)), sender_(std::move(sender)) {}
+  // A well-formed sample with the next seq.
+  bool send(const std::array<double, 3>& v, bool deadman) {
+    return writer_.write(test::operator_command_payload(++seq_, sender_, v, deadman));
+  }
+  bool send_raw(const test::Payload& payload) { return writer_.write(payload); }
+  // A well-formed sample with this seq (the next send() continues after the highest so far).
+  bool send_seq(std::uint64_t seq, const std::array<double, 3>& v, bool deadman) {
+    seq_ = std::max(seq_, seq);
+    return writer_.write(test::operator_command_payload(seq, sender_, v, deadman));
+  }
+  std::uint64_t seq() const { return seq_; }
+
+ private:
+  static test::RawWriterOptions options(int domain) {
+    test::RawWriterOptions o;
+    o.domain_id = domain;
+    o.security = settings_of("operator", domain).commands.security;
+    return o;
+  }
+  test::RawWriter writer_;
+  std::string sender_;
+  std::uint64_t seq_ = 0;
+};
+
+// The crane's side of a test: the source behind the input monitor, one cycle every 10 ms.
+struct MonitoredSource {
+  explicit MonitoredSource(dds::DdsCommandSource& s,
+                           const input::InputMonitorSettings& settings = {})
+      : source(s), monitor(settings) {}
+  const input::MonitorOutput& cycle() {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    state = source.poll(sample);
+    monitor.update(state, sample, input::steady_now_s(), out);
+    return out;
+  }
+  dds::DdsCommandSource& source;
+  input::InputMonitor monitor;
+  input::OperatorCommand sample;
+  input::MonitorOutput out;
+  SourceState state = SourceState::kNoData;
+};
+
+// Sends released-deadman samples until the source has one (discovery and the DDS Security
+// handshake), then `released` more cycles of them, then `pressed` cycles moving at v (the
+// monitor passes the command once the deadman has been held for 0.3 s).
+void arm_and_move(RawOperator& op, MonitoredSource& crane, const std::array<double, 3>& v,
+                  int released = 20, int pressed = 50) {
+  const double end = input::steady_now_s() + 10.0;
+  while (crane.state != SourceState::kOk && input::steady_now_s() < end) {
+    op.send({0.0, 0.0, 0.0}, false);
+    crane.cycle();
+  }
+  ASSERT_EQ(crane.state, SourceState::kOk) << "no sample from the raw operator within 10 s";
+  for (int i = 0; i < released; ++i) {
+    op.send({0.0, 0.0, 0.0}, false);
+    crane.cycle();
+  }
+  for (int i = 0; i < pressed; ++i) {
+    op.send(v, true);
+    crane.cycle();
+  }
+}
+
+// A malformed OperatorCommand (a bool byte of 2, a bad encapsulation: Fast CDR throws on Fast
+// DDS's thread; a cut-off body: Fast DDS 2.9 would hand over the part it read) is dropped and
+// counted, never passed on: while only such samples arrive, the input goes stale and the
+// monitor stops the crane. The source survives and takes the next good sample.
+TEST(DdsCommandSource, MalformedSamplesAreDroppedCountedAndGoStale) {
+  dds::DdsCommandSource source(settings_of("crane", 185));
+  RawOperator op(185);
+  MonitoredSource crane(source);
+  arm_and_move(op, crane, {0.3, 0.0, 0.0});
+  ASSERT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
+  const std::uint64_t good = source.stats().samples;
+
+  // Only malformed samples for 0.6 s, each kind in turn; each says "deadman held, 0.3 m/s".
+  const test::Malformation kinds[] = {test::Malformation::kTruncated, test::Malformation::kBadBool,
+                                      test::Malformation::kBadEncapsulation};
+  const double bad_start = input::steady_now_s();
+  int sent = 0;
+  double stopped_after = -1.0;
+  while (input::steady_now_s() - bad_start < 0.6) {
+    op.send_raw(test::malformed_payload(dds::Topic::kOperatorCommand, kinds[sent % 3]));
+    ++sent;
+    const input::MonitorOutput& o = crane.cycle();
+    if (!o.enabled && stopped_after < 0.0) stopped_after = input::steady_now_s() - bad_start;
+    if (stopped_after >= 0.0) {
+      EXPECT_FALSE(o.enabled) << "the command passed again after the stop";
+    }
+  }
+  EXPECT_EQ(crane.out.fault, input::InputFault::kStale) << input::to_string(crane.out.fault);
+  EXPECT_GE(stopped_after, 0.09);
+  EXPECT_LT(stopped_after, 0.3);
+  // The last good sample stays what the source reports (now stale): nothing of the bad ones.
+  EXPECT_DOUBLE_EQ(crane.sample.v_m_s.x(), 0.3);
+  const dds::CommandInputStats s = source.stats();
+  EXPECT_EQ(s.samples, good);
+  EXPECT_GE(s.malformed, static_cast<std::uint64_t>(sent) / 2) << sent << " sent";
+  EXPECT_LE(s.malformed, static_cast<std::uint64_t>(sent));
+
+  // Good samples again: taken (the monitor wants a release and press, the deadman held 0.3 s
+  // and the stop latched 1 s before motion).
+  arm_and_move(op, crane, {0.0, 0.0, 0.2}, 5, 100);
+  EXPECT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
+  EXPECT_DOUBLE_EQ(crane.sample.v_m_s.z(), 0.2);
+  EXPECT_GT(source.stats().samples, good);
+}
+
+// A sample whose seq is not above what its writer sent before (an old sample replayed, or the
+// latest repeated) is dropped and counted, per writer: another writer's seq starts afresh.
+TEST(DdsCommandSource, ReplayedSamplesAreDroppedPerWriter) {
+  dds::DdsCommandSource source(settings_of("crane", 186));
+  RawOperator op(186);
+  MonitoredSource crane(source);
+  arm_and_move(op, crane, {0.3, 0.0, 0.0});
+  ASSERT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
+  const std::uint64_t latest = op.seq();
+  ASSERT_GT(latest, 40u);
+  const std::uint64_t good = source.stats().samples;
+
+  // An old sample (seq 10, pressed, moving the other way), the latest once more, seq 0: dropped,
+  // the source still reports the latest good sample.
+  op.send_seq(10, {-0.5, 0.0, 0.0}, true);
+  crane.cycle();
+  op.send_seq(latest, {-0.5, 0.0, 0.0}, true);
+  crane.cycle();
+  op.send_seq(0, {-0.5, 0.0, 0.0}, true);
+  for (int i = 0; i < 5; ++i) crane.cycle();
+  EXPECT_DOUBLE_EQ(crane.sample.v_m_s.x(), 0.3);
+  dds::CommandInputStats s = source.stats();
+  EXPECT_EQ(s.replayed, 3u);
+  EXPECT_EQ(s.samples, good);
+  // Only replays: no fresh sample, the input goes stale.
+  for (int i = 0; i < 20; ++i) {
+    op.send_seq(20 + static_cast<std::uint64_t>(i), {-0.5, 0.0, 0.0}, true);
+    crane.cycle();
+  }
+  EXPECT_EQ(crane.out.fault, input::InputFault::kStale) << input::to_string(crane.out.fault);
+  EXPECT_EQ(source.stats().replayed, 23u);
+  // A higher seq is taken (the gap counts as lost).
+  const std::uint64_t lost_before = source.stats().lost;
+  op.send_seq(1000000, {0.0, 0.0, 0.1}, false);
+  for (int i = 0; i < 5; ++i) crane.cycle();
+  EXPECT_DOUBLE_EQ(crane.sample.v_m_s.z(), 0.1);
+  EXPECT_EQ(source.stats().samples, good + 1);
+  EXPECT_EQ(source.stats().lost, lost_before + 1000000 - latest - 1);
+
+  // Another writer, once the first has been silent for 1 s, counts from 1: its seq is its own,
+  // not held against the first's.
+  const std::uint64_t replayed_before = source.stats().replayed;
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  RawOperator second(186);
+  const double end = input::steady_now_s() + 10.0;
+  while (crane.sample.v_m_s.y() != 0.2 && input::steady_now_s() < end) {
+    second.send({0.0, 0.2, 0.0}, false);
+    crane.cycle();
+  }
+  EXPECT_DOUBLE_EQ(crane.sample.v_m_s.y(), 0.2);
+  EXPECT_LT(second.seq(), 1000000u);
+  EXPECT_EQ(source.stats().replayed, replayed_before);
+  second.send_seq(1, {0.0, -0.2, 0.0}, false);  // its own first seq again
+  for (int i = 0; i < 5; ++i) crane.cycle();
+  EXPECT_DOUBLE_EQ(crane.sample.v_m_s.y(), 0.2);
+  EXPECT_EQ(source.stats().replayed, replayed_before + 1);
+}
+
+// Waits (the first operator sending) until the source has matched two writers.
+void wait_for_two_writers(dds::DdsCommandSource& source, RawOperator& first, MonitoredSource& crane,
+                          const std::array<double, 3>& v) {
+  const double end = input::steady_now_s() + 10.0;
+  while (source.stats().peak_matched_writers < 2 && input::steady_now_s() < end) {
+    first.send(v, true);
+    crane.cycle();
+  }
+  ASSERT_EQ(source.stats().peak_matched_writers, 2);
+}
+
+// With a stale timeout longer than the old fixed 0.5 s: the second operator, sending with its
+// deadman held all along, takes the command over only after the first has been silent for longer
+// than the stale timeout, and its command passes only after it has released and pressed the
+// deadman.
+TEST(DdsCommandSource, TakeoverOnlyAfterTheStaleTimeoutAndWithReArm) {
+  input::InputMonitorSettings monitor;
+  monitor.stale_timeout_s = 1.0;
+  dds::DdsCommandSource source(settings_of("crane", 187), monitor.stale_timeout_s);
+  RawOperator first(187, "first");
+  MonitoredSource crane(source, monitor);
+  arm_and_move(first, crane, {0.3, 0.0, 0.0});
+  RawOperator second(187, "second");
+  wait_for_two_writers(source, first, crane, {0.3, 0.0, 0.0});
+  ASSERT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
+
+  // The first falls silent; the second sends, deadman held, moving the other way.
+  const double silent_from = input::steady_now_s();
+  double took_over_s = -1.0;
+  int second_passed = 0;
+  while (input::steady_now_s() - silent_from < 2.5) {
+    second.send({-0.2, 0.0, 0.0}, true);
+    const input::MonitorOutput& o = crane.cycle();
+    if (crane.sample.v_m_s.x() < 0.0 && took_over_s < 0.0) {
+      took_over_s = input::steady_now_s() - silent_from;
+    }
+    if (o.enabled && o.v_m_s.x() < 0.0) ++second_passed;
+  }
+  EXPECT_GT(took_over_s, 1.0);
+  EXPECT_LT(took_over_s, 1.3);
+  EXPECT_EQ(second_passed, 0) << "the second's command passed without a release and press";
+  EXPECT_FALSE(crane.out.enabled);
+  EXPECT_FALSE(crane.sample.deadman);  // read released until the second releases it
+  dds::CommandInputStats s = source.stats();
+  EXPECT_EQ(s.sender, "second");
+  EXPECT_EQ(s.owner_changes, 2);
+  EXPECT_GT(s.other_senders, 50u);  // its samples in the first second
+
+  // The second releases and presses (and holds the deadman 0.3 s): now its command passes.
+  for (int i = 0; i < 10; ++i) {
+    second.send({-0.2, 0.0, 0.0}, false);
+    crane.cycle();
+  }
+  EXPECT_FALSE(crane.out.enabled);
+  for (int i = 0; i < 40; ++i) {
+    second.send({-0.2, 0.0, 0.0}, true);
+    crane.cycle();
+  }
+  EXPECT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
+  EXPECT_DOUBLE_EQ(crane.out.v_m_s.x(), -0.2);
+}
+
+// Two operators both sending: the first keeps the command every cycle, the second's samples
+// are dropped; ownership never alternates.
+TEST(DdsCommandSource, FightingOperatorsNeverAlternate) {
+  input::InputMonitorSettings monitor;
+  monitor.stale_timeout_s = 0.3;  // margin for a test thread descheduled on a loaded machine
+  dds::DdsCommandSource source(settings_of("crane", 188), monitor.stale_timeout_s);
+  RawOperator first(188, "first");
+  MonitoredSource crane(source, monitor);
+  arm_and_move(first, crane, {0.1, 0.0, 0.0});
+  RawOperator second(188, "second");
+  wait_for_two_writers(source, first, crane, {0.1, 0.0, 0.0});
+  ASSERT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
+  int cycles = 0, first_held = 0;
+  for (int i = 0; i < 200; ++i) {
+    // Alternately first and second send first within a cycle; the second releases and presses.
+    if (i % 2 == 0) {
+      first.send({0.1, 0.0, 0.0}, true);
+      second.send({-0.2, 0.0, 0.0}, i % 10 < 5);
+    } else {
+      second.send({-0.2, 0.0, 0.0}, i % 10 < 5);
+      first.send({0.1, 0.0, 0.0}, true);
+    }
+    const input::MonitorOutput& o = crane.cycle();
+    ++cycles;
+    if (crane.sample.v_m_s.x() == 0.1 && o.enabled) ++first_held;
+  }
+  EXPECT_EQ(first_held, cycles);
+  const dds::CommandInputStats s = source.stats();
+  EXPECT_EQ(s.sender, "first");
+  EXPECT_EQ(s.owner_changes, 1);
+  EXPECT_GE(s.other_senders, 150u);
 }
 
 }  // namespace

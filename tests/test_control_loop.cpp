@@ -8,6 +8,8 @@
 
 #include <atomic>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -79,13 +81,17 @@ class StoppingTask final : public control::CycleTask {
                             const char* stop_cause, valves::ValveCommand&,
                             control::LogRow& row) noexcept override {
     row.t = time.t_s;
-    if (stop_cause == nullptr) return control::CycleStatus::kRunning;
+    if (stop_cause == nullptr) {
+      return idle_from >= 0 && time.k >= idle_from ? control::CycleStatus::kStopped
+                                                   : control::CycleStatus::kRunning;
+    }
     cause = stop_cause;
     if (stop_seen_at < 0) stop_seen_at = time.k;
     return time.k - stop_seen_at >= stop_cycles_ ? control::CycleStatus::kStopped
                                                  : control::CycleStatus::kStopping;
   }
   int starts = 0;
+  long idle_from = -1;  // from this cycle on at rest without a stop request (a stale input)
   long stop_seen_at = -1;
   std::string cause;
 
@@ -134,21 +140,91 @@ TEST(ControlLoop, RunsEveryCycleOnMachineTimeAndTellsEveryObserverInOrder) {
   options.max_cycles = 50;
   options.observers = {&recorder};
   const auto s = control::run_control_loop(task, machine, options);
-  EXPECT_EQ(s.cycles, 50);
-  EXPECT_DOUBLE_EQ(s.duration_s, 0.5);
+  EXPECT_EQ(s.cycles, 51) << "50, then the end of the run's stop (at rest at once)";
+  EXPECT_DOUBLE_EQ(s.duration_s, 0.51);
   EXPECT_FALSE(s.stop_requested);
+  EXPECT_TRUE(s.end_stop);
+  EXPECT_EQ(s.stop_cycles, 1);
+  EXPECT_EQ(task.cause, "end of run");
   EXPECT_EQ(task.starts, 1);
-  EXPECT_EQ(machine.writes, 50);
-  EXPECT_EQ(machine.advances, 50);
-  EXPECT_EQ(machine.reads, 52) << "one before the start, one per cycle, one at the end";
-  ASSERT_EQ(recorder.ks.size(), 50u);
+  EXPECT_EQ(machine.writes, 51);
+  EXPECT_EQ(machine.advances, 51);
+  EXPECT_EQ(machine.reads, 53) << "one before the start, one per cycle, one at the end";
+  ASSERT_EQ(recorder.ks.size(), 51u);
   for (std::size_t k = 0; k < recorder.ks.size(); ++k) {
     EXPECT_EQ(recorder.ks[k], static_cast<long>(k));
     EXPECT_DOUBLE_EQ(recorder.ts[k], 2.0 + 0.01 * static_cast<double>(k));
   }
   EXPECT_EQ(recorder.finishes, 1);
-  EXPECT_EQ(recorder.last_k, 49);
+  EXPECT_EQ(recorder.last_k, 50);
   EXPECT_EQ(machine.safe_stops, 0);
+}
+
+// The end of a run is a stop like any other: the task brings the machine to rest (the
+// controller: jerk-limited, then neutral valves) before the run ends; too slow, safe_stop().
+TEST(ControlLoop, TheEndOfARunStopsTheMachineBeforeItEnds) {
+  CountingMachine machine;
+  StoppingTask task(30);  // 0.3 s to come to rest
+  control::LoopOptions options;
+  options.max_cycles = 100;
+  const auto s = control::run_control_loop(task, machine, options);
+  EXPECT_TRUE(s.end_stop);
+  EXPECT_FALSE(s.stop_requested);
+  EXPECT_EQ(task.cause, "end of run");
+  EXPECT_EQ(task.stop_seen_at, 100);
+  EXPECT_EQ(s.cycles, 131) << "cycles 100..130 stopping, 130 reports kStopped";
+  EXPECT_EQ(s.stop_cycles, 31);
+  EXPECT_FALSE(s.safe_stopped);
+
+  CountingMachine slow_machine;
+  StoppingTask never(100000);
+  options.stop_settle_max_s = 0.5;
+  const auto slow = control::run_control_loop(never, slow_machine, options);
+  EXPECT_TRUE(slow.safe_stopped);
+  EXPECT_EQ(slow_machine.safe_stops, 1);
+  EXPECT_EQ(slow.cycles, 151);
+}
+
+// A run whose machine is already stopped (e.g. by a stale input) just ends; a study segment
+// (stop_at_end false) ends where it is.
+TEST(ControlLoop, ARunAlreadyStoppedOrASegmentEndsAtItsLength) {
+  CountingMachine machine;
+  StoppingTask task(30);
+  task.idle_from = 5;
+  control::LoopOptions options;
+  options.max_cycles = 20;
+  const auto stopped = control::run_control_loop(task, machine, options);
+  EXPECT_EQ(stopped.cycles, 20);
+  EXPECT_FALSE(stopped.end_stop);
+  EXPECT_EQ(task.stop_seen_at, -1);
+
+  StoppingTask segment(30);
+  control::LoopOptions segment_options;
+  segment_options.max_cycles = 20;
+  segment_options.stop_at_end = false;
+  const auto s = control::run_control_loop(segment, machine, segment_options);
+  EXPECT_EQ(s.cycles, 20);
+  EXPECT_FALSE(s.end_stop);
+  EXPECT_EQ(segment.stop_seen_at, -1);
+}
+
+// A run length computed from outside numbers never converts out of range.
+TEST(ControlLoop, ARunLengthOutOfRangeIsAnErrorNotUndefinedBehaviour) {
+  EXPECT_EQ(control::run_cycles(1500.0, "x"), 1500);
+  EXPECT_EQ(control::run_cycles(0.0, "x"), 0);
+  EXPECT_THROW(control::run_cycles(1e30, "the replay"), std::invalid_argument);
+  EXPECT_THROW(control::run_cycles(std::nan(""), "the replay"), std::invalid_argument);
+  EXPECT_THROW(control::run_cycles(-1.0, "the replay"), std::invalid_argument);
+  EXPECT_THROW(control::run_cycles(std::numeric_limits<double>::infinity(), "x"),
+               std::invalid_argument);
+  const auto cfg = config::default_crane_config();
+  const auto replay = input::Replay::parse("t,v_x,v_y,v_z\n0,0,0,0\n1,0,0,0\n", "short.csv");
+  sim_backend::SimBackend sim(cfg.model, offline::sim_settings(cfg));
+  control::RunOptions options;
+  options.settle_s = std::nan("");
+  EXPECT_THROW(control::run_replay(cfg, replay, sim, options, nullptr), std::invalid_argument);
+  options.settle_s = 1e300;
+  EXPECT_THROW(control::run_replay(cfg, replay, sim, options, nullptr), std::invalid_argument);
 }
 
 TEST(ControlLoop, AStopRequestEndsTheRunOnlyOnceTheTaskIsAtRest) {
@@ -256,12 +332,12 @@ TEST(CycleTiming, APacedLoopMeasuresItsStartLatencyAndComputeTime) {
   options.max_cycles = 50;
   options.realtime = true;
   const auto s = control::run_control_loop(task, machine, options);
-  EXPECT_EQ(s.timing.start_latency.count(), 50);
-  EXPECT_EQ(s.timing.compute.count(), 50);
+  EXPECT_EQ(s.timing.start_latency.count(), 51) << "50 and the end's stop";
+  EXPECT_EQ(s.timing.compute.count(), 51);
   EXPECT_GE(s.timing.start_latency.min_s(), 0.0);
   EXPECT_DOUBLE_EQ(s.max_late_s(), s.timing.start_latency.max_s());
   EXPECT_GE(s.wall_time_s, 49 * 0.002) << "paced: 50 cycles take at least 49 periods";
-  EXPECT_NE(control::describe(s.timing).find("overruns in 50 cycles"), std::string::npos);
+  EXPECT_NE(control::describe(s.timing).find("overruns in 51 cycles"), std::string::npos);
 }
 
 // The system may refuse SCHED_FIFO or the memory lock (a container, no CAP_SYS_NICE): the loop
@@ -275,7 +351,7 @@ TEST(CycleTiming, RealTimeSetUpIsGrantedOrRefusedWithAReason) {
   options.realtime_setup.priority = 80;
   options.realtime_setup.cpu = 0;
   const auto s = control::run_control_loop(task, machine, options);
-  EXPECT_EQ(s.cycles, 5);
+  EXPECT_EQ(s.cycles, 6) << "5 and the end of the run's stop";
   const auto& r = s.realtime_result;
   if (!r.memory_locked) {
     EXPECT_NE(r.refused.find("memory lock refused"), std::string::npos);
@@ -291,4 +367,47 @@ TEST(CycleTiming, RealTimeSetUpIsGrantedOrRefusedWithAReason) {
   sched_param param{};
   pthread_getschedparam(pthread_self(), &policy, &param);
   EXPECT_EQ(policy, SCHED_OTHER) << "the priority is given back after the run";
+}
+
+namespace {
+
+// Keeps every log row of the run.
+class RowProbe final : public control::CycleObserver {
+ public:
+  void on_cycle(const control::CycleRecord& c) noexcept override { rows.push_back(c.row); }
+  std::vector<control::LogRow> rows;
+};
+
+}  // namespace
+
+// A replay that ends with the crane moving (no settle time): the run does not just stop, the
+// crane decelerates jerk-limited to rest, then every valve is neutral (issue: the valves used to
+// go from flow to blocked in one frame with the load moving).
+TEST(ControlLoop, AReplayEndingInMotionDeceleratesJerkLimitedThenNeutral) {
+  const auto cfg = config::default_crane_config();
+  const auto replay =
+      input::Replay::parse("t,v_x,v_y,v_z\n0,0.6,0,0.2\n3,0.6,0,0.2\n", "ends_moving.csv");
+  sim_backend::SimBackend sim(cfg.model, offline::sim_settings(cfg));
+  RowProbe probe;
+  control::RunOptions options;
+  options.settle_s = 0.0;
+  options.observers = {&probe};
+  const auto s = control::run_replay(cfg, replay, sim, options, nullptr);
+  EXPECT_TRUE(s.end_stop);
+  EXPECT_GT(s.stop_cycles, 20) << "a real deceleration, not one frame";
+  ASSERT_FALSE(probe.rows.empty());
+  const std::size_t end = probe.rows.size() - static_cast<std::size_t>(s.stop_cycles);
+  const control::LogRow& before = probe.rows[end - 1];
+  EXPECT_STREQ(before.status, "running");
+  EXPECT_GT(std::hypot(before.tip_v[0], before.tip_v[2]), 0.3) << "moving when the replay ends";
+  for (std::size_t i = end; i < probe.rows.size(); ++i) {
+    const control::LogRow& r = probe.rows[i];
+    EXPECT_STREQ(r.stop_reason, "end of run");
+    EXPECT_LE(std::abs(r.sdddot), cfg.scaling.jerk_max_m_s3 * 1.001) << "t " << r.t;
+  }
+  const control::LogRow& last = probe.rows.back();
+  EXPECT_STREQ(last.status, "stopped");
+  for (int j = 0; j < cfg.model.dof(); ++j) EXPECT_EQ(last.spool[j], 0.0) << "joint " << j;
+  EXPECT_LT(std::hypot(last.ref_v[0], last.ref_v[1], last.ref_v[2]), 1e-9);
+  EXPECT_FALSE(s.machine_fault);
 }

@@ -1,6 +1,7 @@
 // `craneassist echo` and `craneassist dashboard` (dds::run_echo, dds::run_dashboard) against a
-// TelemetryPublisher in the same process, over DDS. Each test has its own domain (150..157) so
-// parallel test runs never see each other's samples.
+// TelemetryPublisher in the same process, over DDS, and against raw writers of malformed samples
+// (dds_raw_writer.hpp). Each test has its own domain (150..159) so parallel test runs never see
+// each other's samples.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -17,6 +18,7 @@
 #include "craneassist/dds/command_writer.hpp"
 #include "craneassist/dds/telemetry_publisher.hpp"
 #include "craneassist/dds/tools.hpp"
+#include "dds_raw_writer.hpp"
 #include "dds_test_frames.hpp"
 
 // Under AddressSanitizer: Debian's Fast DDS 2.9 (libfastrtps, not instrumented) deletes the
@@ -409,6 +411,116 @@ TEST_F(DdsTools, DashboardOnceTimeoutWithoutPublisher) {
             std::string::npos)
       << io.err_text();
   EXPECT_EQ(io.out_text(), "");
+}
+
+// Writes samples of `topic` every 10 ms once a reader has matched: for `bad_only_s` only
+// malformed ones (every kind the type can have), then each round the malformed ones and one
+// well-formed sample (telemetry_payload: crane "Raw crane"; operator_command: sender
+// "raw-operator").
+class MalformedWriter {
+ public:
+  MalformedWriter(int domain, dds::Topic topic, double bad_only_s = 0.5)
+      : writer_(options(domain, topic)), topic_(topic), bad_only_s_(bad_only_s) {
+    thread_ = std::thread([this] { run(); });
+  }
+  ~MalformedWriter() {
+    stop_.store(true);
+    thread_.join();
+  }
+  MalformedWriter(const MalformedWriter&) = delete;
+  MalformedWriter& operator=(const MalformedWriter&) = delete;
+
+  std::uint64_t malformed_written() const { return malformed_.load(); }
+
+ private:
+  static test::RawWriterOptions options(int domain, dds::Topic topic) {
+    test::RawWriterOptions o;
+    o.domain_id = domain;
+    o.topic = topic;
+    return o;
+  }
+  void run() {
+    while (!stop_.load() && writer_.matched_readers() == 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    const auto start = std::chrono::steady_clock::now();
+    for (std::uint64_t n = 1; !stop_.load(); ++n) {
+      for (test::Malformation m : test::malformations_of(topic_)) {
+        writer_.write(test::malformed_payload(topic_, m));
+        malformed_.fetch_add(1);
+      }
+      if (std::chrono::steady_clock::now() - start > std::chrono::duration<double>(bad_only_s_)) {
+        writer_.write(topic_ == dds::Topic::kOperatorCommand
+                          ? test::operator_command_payload(n, "raw-operator", {0.1, 0.2, 0.3}, true)
+                          : test::telemetry_payload(topic_, n));
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  }
+
+  test::RawWriter writer_;
+  dds::Topic topic_;
+  double bad_only_s_;
+  std::atomic<std::uint64_t> malformed_{0};
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+// Malformed samples (a bool byte of 2, a bad encapsulation: Fast CDR throws while echo takes
+// them; a cut-off body; joints over their bound) are dropped and counted; echo prints only the
+// well-formed ones and says how many it dropped.
+TEST_F(DdsTools, EchoDropsMalformedSamplesOfEveryTopic) {
+  const std::map<dds::Topic, std::string> expected = {
+      {dds::Topic::kStatus, "crane: Raw crane\n"},
+      {dds::Topic::kJoints, "names: [j0, j1, j2, j3]\n"},
+      {dds::Topic::kHydraulics, "pump_mode: load-sensing\n"},
+      {dds::Topic::kCommandPath, "input_source: dds\n"},
+      {dds::Topic::kOperatorCommand, "sender: raw-operator\n"},
+  };
+  for (const auto& [topic, line] : expected) {
+    const std::string name(dds::topic_info(topic).short_name);
+    SCOPED_TRACE(name);
+    MalformedWriter writer(158, topic);
+    Captured io;
+    ASSERT_EQ(dds::run_echo(echo_options(name, 158, io)), dds::kToolOk) << io.err_text();
+    const std::string out = io.out_text();
+    EXPECT_EQ(count_of(out, "---\n"), 3u) << out;
+    EXPECT_EQ(count_of(out, line), 3u) << out;
+    const std::string err = io.err_text();
+    EXPECT_EQ(count_of(err, "dropped a malformed sample (cannot be deserialized); echo goes on"),
+              1u)
+        << err;
+    EXPECT_NE(err.find("malformed samples dropped"), std::string::npos) << err;
+    EXPECT_GT(writer.malformed_written(), 0u);
+  }
+}
+
+// The dashboard takes its samples on Fast DDS's threads: malformed ones there must neither end
+// the process nor show; the view counts them per topic.
+TEST_F(DdsTools, DashboardDropsMalformedSamplesAndCountsThem) {
+  std::vector<std::unique_ptr<MalformedWriter>> writers;
+  for (dds::Topic topic : {dds::Topic::kStatus, dds::Topic::kJoints, dds::Topic::kHydraulics,
+                           dds::Topic::kCommandPath}) {
+    writers.push_back(std::make_unique<MalformedWriter>(159, topic));
+  }
+  Captured io;
+  dds::DashboardOptions o;
+  o.domain_id = 159;
+  o.once = true;
+  o.timeout_s = 10.0;
+  o.out = io.out;
+  o.err = io.err;
+  ASSERT_EQ(dds::run_dashboard(o), dds::kToolOk) << io.err_text();
+  const std::string out = io.out_text();
+  EXPECT_NE(out.find("Raw crane   backend sim"), std::string::npos) << out;
+  EXPECT_NE(out.find("\nj3        "), std::string::npos) << out;
+  const auto line = out.find("dropped   ");
+  ASSERT_NE(line, std::string::npos) << out;
+  const std::string dropped = out.substr(line, out.find('\n', line) - line);
+  for (const char* topic : {"status", "joints", "hydraulics", "command_path"}) {
+    EXPECT_NE(dropped.find(std::string(topic) + " "), std::string::npos) << dropped;
+    EXPECT_EQ(dropped.find(std::string(topic) + " 0"), std::string::npos) << dropped;
+  }
 }
 
 }  // namespace

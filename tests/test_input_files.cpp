@@ -186,7 +186,8 @@ TEST(InputFiles, RowLimit) {
     if (f.name == "replay") continue;
     std::string text = f.header() + "\n";
     text.reserve(f.max_rows * 2 * f.columns.size() + 16 * f.max_rows);
-    for (std::size_t i = 0; i <= f.max_rows; ++i) text += row(f, std::to_string(i)) + "\n";
+    for (std::size_t i = 0; i <= f.max_rows; ++i)
+      text += row(f, std::to_string(static_cast<double>(i) / 100.0)) + "\n";
     expect_error(f, text, f.max_rows + 2, "",
                  "too many data rows (limit " + std::to_string(f.max_rows) + " rows)");
   }

@@ -1,5 +1,6 @@
 // The input monitor: every fault stops (zero command) and says why; motion resumes only after
-// the deadman is released and pressed again.
+// the deadman is released and pressed again, has been held for deadman_hold and the stop has
+// lasted stop_latch; a chattering deadman never lets the command through.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,8 +13,12 @@ using namespace craneassist::input;
 
 namespace {
 
+// The fault rules alone (deadman_hold and stop_latch 0: the press that arms passes at once);
+// TimedHarness has the shipped timing rules.
 struct Harness {
-  InputMonitor monitor{InputMonitorSettings{0.1, 2.0}};
+  explicit Harness(const InputMonitorSettings& settings = {0.1, 2.0, 0.0, 0.0})
+      : monitor(settings) {}
+  InputMonitor monitor;
   MonitorOutput out;
   double now = 10.0;
 
@@ -137,4 +142,113 @@ TEST(InputMonitor, UpdateAllocatesNothing) {
   const long before = craneassist::test::heap_allocations();
   for (int i = 0; i < 1000; ++i) h.step(kMove, i % 7 != 0, SourceState::kOk, (i % 13) * 0.01);
   EXPECT_EQ(craneassist::test::heap_allocations(), before);
+}
+
+// The defaults: the deadman held 0.3 s, the stop latched 1 s.
+struct TimedHarness : Harness {
+  TimedHarness() : Harness(InputMonitorSettings{}) {}
+  // `n` cycles of 10 ms with the deadman as given; how many passed the command.
+  int run(int n, bool deadman, const Eigen::Vector3d& v = kMove) {
+    int passed = 0;
+    for (int i = 0; i < n; ++i) passed += step(v, deadman).enabled ? 1 : 0;
+    return passed;
+  }
+};
+
+TEST(InputMonitor, TheDefaultsHoldTheDeadmanAndLatchTheStop) {
+  const InputMonitorSettings d;
+  EXPECT_DOUBLE_EQ(d.deadman_hold_s, 0.3);
+  EXPECT_DOUBLE_EQ(d.stop_latch_s, 1.0);
+}
+
+TEST(InputMonitor, TheCommandPassesOnlyAfterTheDeadmanIsHeldForTheHoldTime) {
+  TimedHarness h;
+  h.run(5, false);
+  // 0.29 s held: arming; from 0.30 s on it passes.
+  for (int i = 0; i < 30; ++i) {
+    const auto o = h.step(kMove, true);
+    EXPECT_FALSE(o.enabled) << i;
+    EXPECT_EQ(o.fault, InputFault::kArming) << i;
+    EXPECT_TRUE(o.v_m_s.isZero());
+  }
+  EXPECT_STREQ(to_string(InputFault::kArming), "arming: keep the deadman held");
+  const auto o = h.step(kMove, true);
+  EXPECT_TRUE(o.enabled);
+  EXPECT_EQ(o.v_m_s, kMove);
+  // A release during the hold starts it again.
+  TimedHarness g;
+  g.run(5, false);
+  EXPECT_EQ(g.run(20, true), 0);
+  g.run(1, false);
+  EXPECT_EQ(g.run(30, true), 0);
+  EXPECT_TRUE(g.step(kMove, true).enabled);
+}
+
+TEST(InputMonitor, AReleaseLatchesTheStop) {
+  TimedHarness h;
+  h.run(5, false);
+  h.run(31, true);
+  ASSERT_TRUE(h.out.enabled);
+  // Released for one cycle, pressed again at once: stopped for 1 s from the release.
+  EXPECT_EQ(h.run(1, false), 0);
+  int latched = 0;
+  for (int i = 0; i < 99; ++i) {
+    const auto o = h.step(kMove, true);
+    EXPECT_FALSE(o.enabled) << i;
+    latched += o.fault == InputFault::kStopLatched ? 1 : 0;
+  }
+  EXPECT_EQ(latched, 99);  // the latch (1 s) outlasts the hold (0.3 s) and is what is shown
+  EXPECT_STREQ(to_string(InputFault::kStopLatched), "stop latched");
+  EXPECT_TRUE(h.step(kMove, true).enabled);
+  // Released longer than the latch: only the hold delays the command.
+  h.run(150, false);
+  EXPECT_EQ(h.run(30, true), 0);
+  EXPECT_TRUE(h.step(kMove, true).enabled);
+}
+
+TEST(InputMonitor, AFaultLatchesTheStopToo) {
+  TimedHarness h;
+  h.run(5, false);
+  h.run(31, true);
+  ASSERT_TRUE(h.out.enabled);
+  EXPECT_EQ(h.step(kMove, true, SourceState::kOk, 0.2).fault, InputFault::kStale);
+  h.run(1, false);  // re-arm at once
+  int passed = 0;
+  for (int i = 0; i < 98; ++i) passed += h.step(kMove, true).enabled ? 1 : 0;
+  EXPECT_EQ(passed, 0);
+  EXPECT_EQ(h.out.fault, InputFault::kStopLatched);
+  EXPECT_TRUE(h.step(kMove, true).enabled);
+}
+
+// A deadman that chatters (pressed and released in turn, every cycle or every few cycles) never
+// lets the command through after the first release, however long it goes on.
+TEST(InputMonitor, AChatteringDeadmanKeepsTheCommandStopped) {
+  for (int period : {1, 2, 5, 29}) {
+    TimedHarness h;
+    h.run(5, false);
+    h.run(31, true);
+    ASSERT_TRUE(h.out.enabled);
+    int passed = 0;
+    for (int i = 0; i < 1000; ++i) {
+      passed += h.step(kMove, (i / period) % 2 == 1).enabled ? 1 : 0;
+    }
+    EXPECT_EQ(passed, 0) << "chatter every " << period << " cycles";
+    EXPECT_FALSE(h.monitor.armed() && h.out.enabled);
+  }
+  // Held for longer than the hold between releases: the latch keeps the stop 1 s after each,
+  // so the command passes in at most a few short bursts.
+  TimedHarness h;
+  h.run(5, false);
+  h.run(31, true);
+  int passed = 0;
+  for (int i = 0; i < 1000; ++i) passed += h.step(kMove, i % 40 != 0).enabled ? 1 : 0;
+  EXPECT_LT(passed, 1000 / 10);
+}
+
+TEST(InputMonitor, ZeroHoldAndLatchArmAtThePress) {
+  Harness h;  // 0 and 0: the monitor before the timing rules
+  h.step(kMove, false);
+  ASSERT_TRUE(h.step(kMove, true).enabled);
+  h.step(kMove, false);
+  EXPECT_TRUE(h.step(kMove, true).enabled);
 }

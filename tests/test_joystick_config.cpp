@@ -50,6 +50,8 @@ TEST(JoystickConfig, ShippedDefaultIsTheGamepadLayout) {
   }
   EXPECT_DOUBLE_EQ(c.monitor.stale_timeout_s, 0.1);
   EXPECT_DOUBLE_EQ(c.monitor.max_speed_m_s, 2.0);
+  EXPECT_DOUBLE_EQ(c.monitor.deadman_hold_s, 0.3);
+  EXPECT_DOUBLE_EQ(c.monitor.stop_latch_s, 1.0);
   EXPECT_DOUBLE_EQ(c.keyboard.first_hold_s, 0.55);
   EXPECT_DOUBLE_EQ(c.keyboard.repeat_hold_s, 0.15);
 }
@@ -65,16 +67,44 @@ TEST(JoystickConfig, AngularSlewAndCartesianFrame) {
   EXPECT_NEAR(c.mapping.axes[0].max, 20.0 * M_PI / 180.0, 1e-12);
 }
 
+// The deadman's timing rules: optional (a file without them gets the defaults), 0 turns them off,
+// out of range or in the wrong unit is an error naming the field.
+TEST(JoystickConfig, DeadmanHoldAndStopLatch) {
+  std::string text = default_text();
+  text.replace(text.find("deadman_hold: 300 ms"), 20, "deadman_hold: 0.5 s");
+  text.replace(text.find("stop_latch: 1 s"), 15, "stop_latch: 0 s");
+  auto c = config::parse_joystick_config(text, "pad.yaml");
+  EXPECT_DOUBLE_EQ(c.monitor.deadman_hold_s, 0.5);
+  EXPECT_DOUBLE_EQ(c.monitor.stop_latch_s, 0.0);
+
+  text = default_text();
+  for (const char* key : {"  deadman_hold:", "  stop_latch:"}) {
+    const auto at = text.find(key);
+    ASSERT_NE(at, std::string::npos) << key;
+    text.erase(at, text.find('\n', at) - at + 1);
+  }
+  c = config::parse_joystick_config(text, "pad.yaml");
+  EXPECT_DOUBLE_EQ(c.monitor.deadman_hold_s, input::InputMonitorSettings{}.deadman_hold_s);
+  EXPECT_DOUBLE_EQ(c.monitor.stop_latch_s, input::InputMonitorSettings{}.stop_latch_s);
+
+  auto e = error_after_edit("deadman_hold: 300 ms", "deadman_hold: 3 s");
+  EXPECT_EQ(e.field(), "input.deadman_hold");
+  EXPECT_EQ(e.reason(), "must be 0 to 2 s");
+  e = error_after_edit("stop_latch: 1 s", "stop_latch: 1 m");
+  EXPECT_EQ(e.field(), "input.stop_latch");
+  EXPECT_NE(e.reason().find("not a time unit"), std::string::npos) << e.what();
+}
+
 TEST(JoystickConfig, ErrorsNameFileLineAndField) {
   auto e = error_after_edit("axis: left_y", "axis: left_z");
   EXPECT_EQ(e.file(), "pad.yaml");
   EXPECT_EQ(e.field(), "joystick.axes.radial.axis");
-  EXPECT_EQ(e.line(), 26);
+  EXPECT_EQ(e.line(), 28);
   EXPECT_NE(e.reason().find("unknown axis 'left_z'"), std::string::npos) << e.what();
 
   e = error_after_edit("deadman: right_shoulder", "deadman: right_shoe");
   EXPECT_EQ(e.field(), "joystick.deadman");
-  EXPECT_EQ(e.line(), 14);
+  EXPECT_EQ(e.line(), 16);
 
   e = error_after_edit("stale_timeout: 100 ms", "stale_timeout: 100 m");
   EXPECT_EQ(e.field(), "input.stale_timeout");

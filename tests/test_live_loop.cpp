@@ -1,8 +1,9 @@
 // The live loop on the simulated crane with scripted operators: a recorded session replays to
 // the same log byte for byte (faults included, as stop rows), every input fault gives a
 // jerk-limited stop with its reason and then neutral valves, motion resumes in the commanded
-// direction only after a re-arm, and the loop allocates nothing per cycle. Also measures the
-// times from the last fresh input to the stop command, to the tip at rest and to neutral valves.
+// direction only after a re-arm, a chattering deadman keeps the crane stopped, and the loop
+// allocates nothing per cycle. Also measures the times from the last fresh input to the stop
+// command, to the tip at rest and to neutral valves.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -129,10 +130,16 @@ TEST(LiveLoop, RecordedSessionReplaysToTheSameLog) {
     sim_backend::SimBackend machine(cfg.model, offline::sim_settings(cfg));
     control::CsvLog log(live_log, cfg.model.dof());
     auto options = scripted_options(4.5, nullptr);
+    // The monitor's timing rules off (deadman hold, stop latch; tested below), so that each
+    // scripted interruption stays an interval of its own in the recording.
+    options.monitor.deadman_hold_s = 0.0;
+    options.monitor.stop_latch_s = 0.0;
     options.record = &record;
     live = control::run_live(cfg, source, machine, options, &log);
   }
-  EXPECT_EQ(live.cycles, 450);
+  // 4.5 s of session, then the end of the run's jerk-limited stop (the crane was moving).
+  EXPECT_GT(live.cycles, 470);
+  EXPECT_LT(live.cycles, 650);
   EXPECT_EQ(live.disconnects, 1);
   EXPECT_EQ(live.reconnects, 1);
   EXPECT_GT(live.enabled_cycles, 200);
@@ -163,7 +170,7 @@ TEST(LiveLoop, RecordedSessionReplaysToTheSameLog) {
     control::RunOptions options;
     options.settle_s = 0.0;
     const auto summary = control::run_replay(cfg, replay, machine, options, &log);
-    EXPECT_EQ(summary.cycles, 450);
+    EXPECT_EQ(summary.cycles, live.cycles) << "the replay ends with the same stop";
   }
   const std::string a = read_file(live_log), b = read_file(replay_log);
   EXPECT_GT(a.size(), 100000u);
@@ -214,7 +221,7 @@ TEST(LiveLoop, StaleInputStopsJerkLimitedAndMotionResumesOnlyAfterReArm) {
   sim_backend::SimBackend machine(cfg.model, offline::sim_settings(cfg));
   Probe probe(800);
   control::run_live(cfg, source, machine, scripted_options(7.0, &probe), nullptr);
-  ASSERT_EQ(probe.rows.size(), 700u);
+  ASSERT_GE(probe.rows.size(), 700u) << "7 s, then the end of the run's stop";
 
   // Moving before the freeze.
   const auto& before = probe.rows[195];
@@ -260,10 +267,11 @@ TEST(LiveLoop, StaleInputStopsJerkLimitedAndMotionResumesOnlyAfterReArm) {
   EXPECT_LT(neutral_ms, 1500.0);
   EXPECT_TRUE(saw_stopping);
   EXPECT_LE(peak_jerk, cfg.scaling.jerk_max_m_s3 + 1e-9);
-  // Stopped with every valve exactly neutral, from then on until the re-arm at 5.2 s: while
-  // stale, fresh again at 4 s but not re-armed, and with the deadman released.
+  // Stopped with every valve exactly neutral, from then on until the re-arm at 5.2 s and the
+  // deadman held 0.3 s: while stale, fresh again at 4 s but not re-armed, with the deadman
+  // released, and arming.
   const auto neutral_k = static_cast<std::size_t>(std::lround(t_neutral * 100.0));
-  for (std::size_t k = neutral_k; k < 520; ++k) {
+  for (std::size_t k = neutral_k; k < 550; ++k) {
     const auto& r = probe.rows[k];
     EXPECT_STREQ(r.status, "stopped") << "t " << r.t;
     EXPECT_TRUE(std::isnan(r.cmd[0])) << "t " << r.t;
@@ -277,15 +285,19 @@ TEST(LiveLoop, StaleInputStopsJerkLimitedAndMotionResumesOnlyAfterReArm) {
   EXPECT_STREQ(fresh_not_armed.stop_reason, "re-arm: release and press the deadman");
   EXPECT_LT(speed(fresh_not_armed), 1e-3);
   EXPECT_STREQ(probe.rows[510].stop_reason, "deadman released");
-  // Re-armed at 5.2 s: running again, and the tip moves out, in the commanded direction.
-  EXPECT_STREQ(probe.rows[521].status, "running");
-  EXPECT_EQ(probe.rows[521].cmd[0], kOut.x());
+  // Re-armed at 5.2 s; the command passes once the deadman has been held for 0.3 s (the stop
+  // latch, 1 s, ran out long ago): running again, and the tip moves out, in the commanded
+  // direction.
+  EXPECT_STREQ(probe.rows[521].stop_reason, "arming: keep the deadman held");
+  EXPECT_TRUE(std::isnan(probe.rows[549].cmd[0]));
+  EXPECT_STREQ(probe.rows[551].status, "running");
+  EXPECT_EQ(probe.rows[551].cmd[0], kOut.x());
   const auto& moving_again = probe.rows[650];
   EXPECT_STREQ(moving_again.status, "running");
   EXPECT_GT(speed(moving_again), 0.3);
   const Eigen::Vector3d v(moving_again.tip_v[0], moving_again.tip_v[1], moving_again.tip_v[2]);
   EXPECT_GT(v.normalized().dot(kOut.normalized()), 0.999);
-  EXPECT_GT(probe.rows[650].tip[0] - probe.rows[519].tip[0], 0.2);
+  EXPECT_GT(probe.rows[690].tip[0] - probe.rows[519].tip[0], 0.2);
 }
 
 TEST(LiveLoop, EveryFaultStopsWithItsReason) {
@@ -323,6 +335,43 @@ TEST(LiveLoop, EveryFaultStopsWithItsReason) {
     EXPECT_LT(speed(probe.rows.back()), 1e-3) << c.reason;
     for (int i = 0; i < 4; ++i) {
       EXPECT_EQ(probe.rows.back().spool[static_cast<std::size_t>(i)], 0.0) << c.reason;
+    }
+  }
+}
+
+// A deadman that chatters from 1.5 s on (pressed and released in turn every cycle, every 30 ms,
+// or every 0.25 s) while the tip moves out at 0.4 m/s: the operator's command never passes
+// again, the tip comes to a jerk-limited stop and stays at rest with every valve neutral.
+TEST(LiveLoop, AChatteringDeadmanStopsTheCraneAndKeepsItStopped) {
+  const auto cfg = config::default_crane_config();
+  for (const int period : {1, 3, 25}) {
+    SCOPED_TRACE("chatter every " + std::to_string(period) + " cycles");
+    ScriptedSource source([period](double t) {
+      Script s = moving(t);
+      const long k = std::lround(t * 100.0);
+      if (k >= 150) s.deadman = ((k - 150) / period) % 2 == 1;
+      return s;
+    });
+    sim_backend::SimBackend machine(cfg.model, offline::sim_settings(cfg));
+    Probe probe(600);
+    control::run_live(cfg, source, machine, scripted_options(5.0, &probe), nullptr);
+    ASSERT_EQ(probe.rows.size(), 500u);
+    EXPECT_GT(speed(probe.rows[149]), 0.3);
+    int passed = 0;
+    double peak_jerk = 0.0, late_peak_speed = 0.0;
+    for (std::size_t k = 150; k < probe.rows.size(); ++k) {
+      const auto& r = probe.rows[k];
+      passed += std::isnan(r.cmd[0]) ? 0 : 1;
+      peak_jerk = std::max(peak_jerk, std::abs(r.sdddot));
+      if (k >= 300) late_peak_speed = std::max(late_peak_speed, speed(r));
+    }
+    EXPECT_EQ(passed, 0) << "cycles the chattering deadman let the command through";
+    EXPECT_LE(peak_jerk, cfg.scaling.jerk_max_m_s3 + 1e-9);
+    // At rest 1.5 s after the chatter began (the stop from 0.4 m/s takes about 0.9 s).
+    EXPECT_LT(late_peak_speed, 1e-3);
+    EXPECT_STREQ(probe.rows.back().status, "stopped");
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_EQ(probe.rows.back().spool[static_cast<std::size_t>(i)], 0.0);
     }
   }
 }

@@ -193,7 +193,7 @@ TEST(ScalingEndToEnd, PaperTwoLinkExperimentOldBoundExceedsPowerLsBoundDoesNot) 
       100 * (old_bound.peak_pump_power_w / p_max - 1), ls_bound.peak_pump_power_w / 1e3,
       100 * (ls_bound.peak_pump_power_w / p_max - 1));
   std::printf(
-      "[ figures  ] 2R, pump with limiter: limiter engaged %d cycles (actuator-sum) vs %d "
+      "[ figures  ] 2R, pump with limiter: limiter engaged %ld cycles (actuator-sum) vs %ld "
       "(LS)\n",
       old_limited.cycles_power_limited, ls_limited.cycles_power_limited);
   EXPECT_GT(old_bound.peak_pump_power_w, 1.2 * p_max);

@@ -3,7 +3,7 @@
 # twice: a release build (with the SocketCAN tests in a qemu VM, label can_vm), then a clang build
 # with AddressSanitizer and UndefinedBehaviorSanitizer (with float-cast-overflow and implicit
 # integer conversion checks) that also runs each libFuzzer harness briefly (label fuzz_smoke;
-# docs/fuzzing.md). Also checks the formatting.
+# docs/fuzzing.md). Also checks the formatting and that the executable builds without DDS.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/install-deps.sh
@@ -19,6 +19,12 @@ echo "== release build and tests"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$jobs"
 ctest --test-dir build --output-on-failure -j"$jobs"
+
+echo "== build without DDS (CRANEASSIST_DDS=OFF): the executable alone, unoptimised, and its CLI checks"
+cmake -S . -B build-nodds -DCMAKE_BUILD_TYPE=Debug -DCRANEASSIST_DDS=OFF -DCRANEASSIST_BUILD_BENCH=OFF \
+  -DCRANEASSIST_CAN_VM_TESTS=OFF >/dev/null
+cmake --build build-nodds -j"$jobs" --target craneassist
+ctest --test-dir build-nodds --output-on-failure -R 'cli_sim_without_dds|cli_replay_initial|cli_sim_bad_input'
 
 echo "== clang AddressSanitizer + UndefinedBehaviorSanitizer build, tests and fuzz smoke runs"
 cmake -S . -B build-clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \

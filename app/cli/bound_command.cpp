@@ -7,11 +7,11 @@
 #include <map>
 #include <optional>
 
+#include "crane_options.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/config/yaml_reader.hpp"
 #include "craneassist/offline/path_bound.hpp"
 #include "exit_codes.hpp"
-#include "resolution_option.hpp"
 
 namespace craneassist::cli {
 namespace {
@@ -88,12 +88,8 @@ CLI::App* add_bound_command(CLI::App& cli, BoundArgs& args) {
                    "Tip path CSV (t,x,y,z; docs/path-format.md) or replay CSV (t,v_x,v_y,v_z)")
       ->required()
       ->check(CLI::ExistingFile);
-  bound
-      ->add_option("--config", args.config_file,
-                   "Crane config YAML (default: the embedded K70M reference crane)")
-      ->check(CLI::ExistingFile);
-  bound->add_option("--payload", args.payload_kg, "Payload mass in the grapple, kg")
-      ->check(CLI::Range(0.0, 100000.0));
+  add_config_option(*bound, args.config_file);
+  add_payload_option(*bound, args.payload_kg);
   add_resolution_option(*bound, args.resolution, "of the controller that drives the path");
   bound
       ->add_option("--start", args.start,
@@ -116,10 +112,8 @@ int run_bound_command(const BoundArgs& args) {
   std::optional<input::Replay> replay;
   const char* format = "replay";  // the file's format, for its errors
   try {
-    cfg = args.config_file.empty() ? config::default_crane_config()
-                                   : config::load_crane_config(args.config_file);
-    if (args.payload_kg) config::set_payload_mass(cfg.model, *args.payload_kg);
-    if (!args.resolution.empty()) config::set_resolution(cfg, args.resolution);
+    cfg = load_crane(args.config_file);
+    apply_crane_options(cfg, {.payload_kg = args.payload_kg, .resolution = args.resolution});
     header = header_of(config::read_text_file(args.file));
     if (header == "t,x,y,z") {
       format = "path";

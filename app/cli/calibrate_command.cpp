@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "crane_options.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/dynamics/valve_table.hpp"
 #include "craneassist/offline/calibration.hpp"
@@ -18,9 +19,7 @@ CLI::App* add_calibrate_command(CLI::App& cli, CalibrateArgs& args) {
       "Sweep the valve command of each section on the simulator (both directions, from "
       "mid-stroke), measure the steady cylinder velocities and write the fitted monotone "
       "velocity-vs-command tables as a YAML block for hydraulics.valves (docs/valves.md)");
-  cmd->add_option("--config", args.config_file,
-                  "Crane config YAML (default: the embedded K70M reference crane)")
-      ->check(CLI::ExistingFile);
+  add_config_option(*cmd, args.config_file);
   cmd->add_option("--section", args.section,
                   "Section to calibrate: a joint index 0..n-1, a joint name, or all")
       ->capture_default_str();
@@ -35,8 +34,7 @@ CLI::App* add_calibrate_command(CLI::App& cli, CalibrateArgs& args) {
 int run_calibrate_command(const CalibrateArgs& args) {
   config::CraneConfig cfg;
   try {
-    cfg = args.config_file.empty() ? config::default_crane_config()
-                                   : config::load_crane_config(args.config_file);
+    cfg = load_crane(args.config_file);
   } catch (const config::ConfigError& e) {
     spdlog::error("config: {}", e.what());
     return kExitUsage;

@@ -11,6 +11,7 @@
 #include <optional>
 #include <vector>
 
+#include "crane_options.hpp"
 #include "craneassist/can/heartbeat.hpp"
 #include "craneassist/can/valve_frames.hpp"
 #include "craneassist/config/crane_config.hpp"
@@ -96,8 +97,7 @@ CLI::App* add_emulate_command(CLI::App& cli, EmulateArgs& args) {
       "Run the simulated crane behind the CAN protocol: decode valve command frames, step the "
       "simulator in real time, send joint position and pressure frames");
   cmd->add_option("--can", args.iface, "CAN interface, e.g. vcan0 or can0")->required();
-  cmd->add_option("--config", args.config_file, "Crane config YAML (default: the embedded K70M)")
-      ->check(CLI::ExistingFile);
+  add_config_option(*cmd, args.config_file);
   cmd->add_option("--mapping", args.mapping_file,
                   "CAN mapping YAML (default: the embedded config/can/k70m_can.yaml)")
       ->check(CLI::ExistingFile);
@@ -113,8 +113,7 @@ int run_emulate_command(const EmulateArgs& args) {
   config::CraneConfig cfg;
   can::CanMapping mapping;
   try {
-    cfg = args.config_file.empty() ? config::default_crane_config()
-                                   : config::load_crane_config(args.config_file);
+    cfg = load_crane(args.config_file);
     mapping = load_mapping_or_default(args.mapping_file);
   } catch (const std::exception& e) {
     spdlog::error("config: {}", e.what());

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "crane_options.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/offline/energy_experiment.hpp"
 #include "exit_codes.hpp"
@@ -29,10 +30,7 @@ CLI::App* add_energy_command(CLI::App& cli, EnergyArgs& args) {
   energy->add_option("--threads", args.threads, "Worker threads (0: one per core)")
       ->check(CLI::Range(0, 64))
       ->capture_default_str();
-  energy
-      ->add_option("--config", args.config_file,
-                   "Crane config YAML (default: the embedded K70M reference crane)")
-      ->check(CLI::ExistingFile);
+  add_config_option(*energy, args.config_file);
   energy->add_flag("--quiet", args.quiet, "No progress output");
   return energy;
 }
@@ -41,8 +39,7 @@ int run_energy_command(const EnergyArgs& args) {
   config::CraneConfig cfg;
   offline::EnergyExperimentOptions options;
   try {
-    cfg = args.config_file.empty() ? config::default_crane_config()
-                                   : config::load_crane_config(args.config_file);
+    cfg = load_crane(args.config_file);
     if (!parse_dp_grid(args.grid, options.dp.grid)) {
       throw CLI::ValidationError(
           "--grid", "expected three counts 2..5000 like 356x101x151, got '" + args.grid + "'");

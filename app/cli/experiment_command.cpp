@@ -44,7 +44,7 @@ int run_experiment_command(const ExperimentArgs& args) {
     const double p_max = cfg.model.pump.prime_mover_power_w;
     std::printf("craneassist experiment-2r: %s, f(s) = [pi/6 - sin s, -pi/6 - 0.5 sin s]\n",
                 cfg.model.name.c_str());
-    std::printf("  power bound %s, requested sdot %.2f 1/s, jerk bound %.0f, %d cycles\n",
+    std::printf("  power bound %s, requested sdot %.2f 1/s, jerk bound %.0f, %ld cycles\n",
                 dynamics::to_string(options.power_bound), args.speed, args.jerk_max, s.cycles);
     std::printf("  path covered s = %.2f in %.1f s, peak path jerk %.1f\n", s.s_final,
                 args.duration_s, s.peak_path_jerk);
@@ -53,7 +53,7 @@ int run_experiment_command(const ExperimentArgs& args) {
         " (%+.1f %%)\n",
         s.peak_pump_power_w / 1e3, s.peak_planned_ls_power_w / 1e3, p_max / 1e3,
         100.0 * (s.peak_pump_power_w / p_max - 1.0));
-    std::printf("  simulated pump power limiter %s, engaged in %d cycles; energy %.1f kJ\n",
+    std::printf("  simulated pump power limiter %s, engaged in %ld cycles; energy %.1f kJ\n",
                 args.pump_limiter ? "on" : "off", s.cycles_power_limited, s.energy_j / 1e3);
     if (log) std::printf("  log: %s (%zu rows)\n", log->path().c_str(), log->rows_written());
   } catch (const std::exception& e) {

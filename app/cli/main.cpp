@@ -13,15 +13,17 @@
 #include "bound_command.hpp"
 #include "calibrate_command.hpp"
 #include "can_commands.hpp"
-#include "dds_commands.hpp"
 #include "energy_command.hpp"
 #include "exit_codes.hpp"
 #include "experiment_command.hpp"
 #include "plan_command.hpp"
-#include "remote_command.hpp"
 #include "replay_command.hpp"
 #include "sim_command.hpp"
 #include "suite_command.hpp"
+#if CRANEASSIST_WITH_DDS
+#include "dds_commands.hpp"
+#include "remote_command.hpp"
+#endif
 
 namespace {
 
@@ -57,11 +59,13 @@ int main(int argc, char** argv) {
   add(commands, cli, add_energy_command, run_energy_command);
   add(commands, cli, add_calibrate_command, run_calibrate_command);
   add(commands, cli, add_sim_command, run_sim_command);
+  add(commands, cli, add_suite_command, run_suite_command);
+  add(commands, cli, add_bound_command, run_bound_command);
+#if CRANEASSIST_WITH_DDS  // a build without DDS (CRANEASSIST_DDS=OFF) has none of these
   add(commands, cli, add_remote_command, run_remote_command);
   add(commands, cli, add_echo_command, run_echo_command);
   add(commands, cli, add_dashboard_command, run_dashboard_command);
-  add(commands, cli, add_suite_command, run_suite_command);
-  add(commands, cli, add_bound_command, run_bound_command);
+#endif
 
   try {
     cli.parse(argc, argv);

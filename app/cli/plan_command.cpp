@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "crane_options.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/offline/planning.hpp"
 #include "exit_codes.hpp"
@@ -93,11 +94,8 @@ CLI::App* add_plan_command(CLI::App& cli, PlanArgs& args) {
   plan->add_option("--dt", args.dt_s, "Stage length, s")
       ->check(CLI::Range(0.005, 1.0))
       ->capture_default_str();
-  plan->add_option("--config", args.config_file,
-                   "Crane config YAML (default: the embedded K70M reference crane)")
-      ->check(CLI::ExistingFile);
-  plan->add_option("--payload", args.payload_kg, "Payload mass in the grapple, kg")
-      ->check(CLI::Range(0.0, 100000.0));
+  add_config_option(*plan, args.config_file);
+  add_payload_option(*plan, args.payload_kg);
   plan->add_flag("--quiet", args.quiet, "No progress output");
   return plan;
 }
@@ -109,9 +107,8 @@ int run_plan_command(const PlanArgs& args) {
   planner::StageModelOptions stage_options;
   offline::StartExtension start = offline::StartExtension::kShortest;
   try {
-    cfg = args.config_file.empty() ? config::default_crane_config()
-                                   : config::load_crane_config(args.config_file);
-    if (args.payload_kg) config::set_payload_mass(cfg.model, *args.payload_kg);
+    cfg = load_crane(args.config_file);
+    apply_crane_options(cfg, {.payload_kg = args.payload_kg});
     path = input::PrescribedPath::load_file(args.path_file);
     if (!parse_dp_grid(args.grid, dp.grid)) {
       throw CLI::ValidationError(

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <string>
 
+#include "crane_options.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/config/quantity.hpp"
 #include "craneassist/control/csv_log.hpp"
@@ -24,7 +25,6 @@
 #include "embedded_replays.hpp"
 #include "exit_codes.hpp"
 #include "machine_setup.hpp"
-#include "resolution_option.hpp"
 #include "telemetry_setup.hpp"
 
 namespace craneassist::cli {
@@ -63,7 +63,7 @@ const char* power_bound_name(dynamics::PowerBound b, dynamics::PumpMode mode) {
 
 // The pump line of a run summary: mode, energy, peaks.
 void print_pump_line(double energy_j, double peak_power_w, double peak_flow_m3_s,
-                     int saturated_cycles, const config::CraneConfig& cfg) {
+                     long saturated_cycles, const config::CraneConfig& cfg) {
   const auto& pump = cfg.model.pump;
   char pump_name[64];
   if (pump.mode == dynamics::PumpMode::kConstantPressure) {
@@ -74,7 +74,7 @@ void print_pump_line(double energy_j, double peak_power_w, double peak_flow_m3_s
   }
   std::printf(
       "  pump %s: energy %.1f kJ, peak power %.1f kW (limit %.1f kW), peak flow %.0f L/min, "
-      "saturated in %d cycles\n",
+      "saturated in %ld cycles\n",
       pump_name, energy_j / 1e3, peak_power_w / 1e3, pump.prime_mover_power_w / 1e3,
       peak_flow_m3_s * 60e3, saturated_cycles);
 }
@@ -106,19 +106,25 @@ void print_summary(const control::RunSummary& s, const config::CraneConfig& cfg,
               : mode == control::ScalingMode::kFlowOnly ? "flow prescaling only"
                                                         : "none",
               cfg.control.rate_hz, cfg.model.bodies.back().mass_kg);
-  std::printf("  ran %.2f s of machine time in %.3f s (%.0fx real time), %d cycles\n", s.duration_s,
-              s.wall_time_s, speedup, s.cycles);
+  std::printf("  ran %.2f s of machine time in %.3f s (%.0fx real time), %ld cycles\n",
+              s.duration_s, s.wall_time_s, speedup, s.cycles);
   std::printf("  tip: path %.2f m, peak speed %.2f m/s\n", s.tip_path_m, s.peak_tip_speed_m_s);
   std::printf(
       "  tip direction error, commanded vs measured (steady, > 0.05 m/s): max %.2f deg, "
-      "rms %.2f deg over %d cycles\n",
+      "rms %.2f deg over %ld cycles\n",
       s.max_direction_error_deg, s.rms_direction_error_deg, s.direction_samples);
   print_pump_line(s.energy_j, s.peak_power_w, s.peak_flow_m3_s, s.pump_saturated_cycles, cfg);
   if (s.stopped_cycles > 0) {
     std::printf(
-        "  stopped: %d cycles stopping or stopped (%d in stop rows: input not valid), valves "
-        "neutral in %d\n",
+        "  stopped: %ld cycles stopping or stopped (%ld in stop rows: input not valid), valves "
+        "neutral in %ld\n",
         s.stopped_cycles, s.input_stop_cycles, s.neutral_valve_cycles);
+  }
+  if (s.end_stop && s.stop_cycles > 1) {
+    std::printf("  end of run: stopped jerk-limited in %.2f s, then valves neutral\n",
+                static_cast<double>(s.stop_cycles) / cfg.control.rate_hz);
+  } else if (s.end_stop) {
+    std::printf("  end of run: at rest, valves neutral\n");
   }
   if (mode == control::ScalingMode::kFull) {
     std::printf("  path jerk: peak %.2f m/s^3 (bound %.2f)\n", s.peak_path_jerk,
@@ -128,7 +134,7 @@ void print_summary(const control::RunSummary& s, const config::CraneConfig& cfg,
   std::printf("  active limit (cycles):");
   for (std::size_t i = 0; i < s.limit_cycles.size(); ++i) {
     if (s.limit_cycles[i] > 0) {
-      std::printf(" %s %d", scaling::to_string(static_cast<scaling::ActiveLimit>(i)),
+      std::printf(" %s %ld", scaling::to_string(static_cast<scaling::ActiveLimit>(i)),
                   s.limit_cycles[i]);
     }
   }
@@ -145,13 +151,13 @@ void print_trajectory_summary(const control::TrajectoryRunSummary& s,
   const double speedup = s.wall_time_s > 0.0 ? s.duration_s / s.wall_time_s : 0.0;
   std::printf("craneassist replay --trajectory: %s on %s\n", name.c_str(), cfg.model.name.c_str());
   for (const auto& c : traj.comments) std::printf("  | %s\n", c.c_str());
-  std::printf("  ran %.2f s of machine time in %.3f s (%.0fx real time), %d cycles\n", s.duration_s,
-              s.wall_time_s, speedup, s.cycles);
+  std::printf("  ran %.2f s of machine time in %.3f s (%.0fx real time), %ld cycles\n",
+              s.duration_s, s.wall_time_s, speedup, s.cycles);
   std::printf("  tip vs plan: max %.1f mm, rms %.1f mm (start %.1f mm)\n", s.max_tip_error_m * 1e3,
               s.rms_tip_error_m * 1e3, s.start_error_m * 1e3);
   print_pump_line(s.energy_j, s.peak_power_w, s.peak_flow_m3_s, s.pump_saturated_cycles, cfg);
   if (s.invalid_state_cycles > 0) {
-    std::printf("  NO VALID MEASUREMENT in %d cycles (valves neutral)\n", s.invalid_state_cycles);
+    std::printf("  NO VALID MEASUREMENT in %ld cycles (valves neutral)\n", s.invalid_state_cycles);
   }
   if (log != nullptr) {
     std::printf("  log: %s (%zu rows%s)\n", log->path().c_str(), log->rows_written(),
@@ -202,28 +208,9 @@ int run_replay_command(const ReplayArgs& args) {
   std::optional<input::Replay> loaded;
   config::TelemetryConfig telemetry_settings;
   try {
-    cfg = args.config_file.empty() ? config::default_crane_config()
-                                   : config::load_crane_config(args.config_file);
-    if (args.payload_kg) config::set_payload_mass(cfg.model, *args.payload_kg);
-    if (!args.initial.empty()) {
-      if (uses_can_backend(args.machine, cfg)) {
-        throw CLI::ValidationError(
-            "--initial", "the can backend starts where the machine is (use --backend sim)");
-      }
-      try {
-        cfg.simulation.q_initial =
-            config::parse_joint_pose(cfg.model, args.initial, cfg.simulation.q_initial);
-      } catch (const std::invalid_argument& e) {
-        throw CLI::ValidationError("--initial", e.what());
-      }
-    }
-    if (!args.resolution.empty()) {
-      try {
-        config::set_resolution(cfg, args.resolution);
-      } catch (const std::invalid_argument& e) {
-        throw CLI::ValidationError("--resolution", e.what());
-      }
-    }
+    cfg = load_crane(args.config_file);
+    apply_crane_options(cfg, {args.payload_kg, args.initial, args.resolution,
+                              !uses_can_backend(args.machine, cfg)});
     if (!args.power_bound.empty()) {
       cfg.scaling.power_bound = dynamics::parse_power_bound(args.power_bound).value();
     }
@@ -325,10 +312,7 @@ CLI::App* add_replay_command(CLI::App& cli, ReplayArgs& args) {
                    "Execute a planned joint trajectory (craneassist plan; "
                    "docs/trajectory-format.md) instead of a replay, from its first configuration")
       ->check(CLI::ExistingFile);
-  replay
-      ->add_option("--config", args.config_file,
-                   "Crane config YAML (default: the embedded K70M reference crane)")
-      ->check(CLI::ExistingFile);
+  add_config_option(*replay, args.config_file);
   add_backend_options(*replay, args.machine);
   add_telemetry_options(*replay, args.telemetry, false);
   replay->add_option("--test-freeze-at", args.freeze_at_s)->group("");
@@ -355,11 +339,8 @@ CLI::App* add_replay_command(CLI::App& cli, ReplayArgs& args) {
   replay->add_option("--settle", args.settle_s, "Seconds to keep running after the last replay row")
       ->check(CLI::Range(0.0, 600.0))
       ->capture_default_str();
-  replay->add_option("--payload", args.payload_kg, "Payload mass in the grapple, kg")
-      ->check(CLI::Range(0.0, 100000.0));
-  replay->add_option("--initial", args.initial,
-                     "Start pose of the simulated crane, e.g. \"lift=0 deg, tilt=-125 deg, "
-                     "extension=0.2 m\" (joints left out keep the config's simulation.initial)");
+  add_payload_option(*replay, args.payload_kg);
+  add_initial_option(*replay, args.initial);
   replay->add_option("--pump-max-flow", args.pump_max_flow,
                      "Override the pump's maximum flow, e.g. \"120 L/min\"");
   replay->add_option("--prime-mover-power", args.prime_mover_power,

@@ -8,20 +8,23 @@
 #include <cstdio>
 #include <exception>
 #include <fstream>
+#include <functional>
 #include <memory>
+#include <string>
 #include <thread>
+#include <utility>
 
+#include "crane_options.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/config/joystick_config.hpp"
 #include "craneassist/control/live_loop.hpp"
-#include "craneassist/dds/command_source.hpp"
 #include "craneassist/input/evdev_source.hpp"
 #include "craneassist/input/keyboard_source.hpp"
 #include "craneassist/input/replay_source.hpp"
 #include "craneassist/input/sdl_source.hpp"
 #include "craneassist/offline/sim_setup.hpp"
 #include "exit_codes.hpp"
-#include "resolution_option.hpp"
+#include "remote_input.hpp"
 
 namespace craneassist::cli {
 namespace {
@@ -36,8 +39,9 @@ extern "C" void on_stop_signal(int) {
 // The status line and the device event messages, from the loop's status board (UI thread).
 class StatusReporter {
  public:
+  // remote: the DDS input's sender and events (empty functions: another input).
   StatusReporter(const control::LiveStatusBoard& board, const input::KeyboardSource* keyboard,
-                 const dds::DdsCommandSource* remote = nullptr)
+                 const RemoteInput& remote)
       : board_(board), keyboard_(keyboard), remote_(remote), draw_(isatty(1) != 0) {}
 
   void run(const std::atomic<bool>& done) {
@@ -81,12 +85,35 @@ class StatusReporter {
       fault_ = s.fault;
     }
     char sender[64] = "";
-    if (remote_ != nullptr) {  // the remote operator (OperatorCommand.sender)
-      const std::string now_sender = remote_->stats().sender;
+    if (remote_.sender) {  // the remote operator (OperatorCommand.sender)
+      const std::string now_sender = remote_.sender();
+      const RemoteInputEvents events = remote_.events ? remote_.events() : RemoteInputEvents{};
       if (now_sender != sender_) {
         clear_line();
         spdlog::info("remote operator: '{}' (DDS)", now_sender);
         sender_ = now_sender;
+      }
+      if (events.operator_changes > operator_changes_) {
+        if (operator_changes_ > 0) {
+          clear_line();
+          spdlog::warn(
+              "t {:.2f} s: dds input: another writer took the command over ('{}'); its commands "
+              "pass once it has released and pressed the deadman",
+              s.t, now_sender);
+        }
+        operator_changes_ = events.operator_changes;
+      }
+      // Dropped samples, at most one message a second.
+      if ((events.malformed > malformed_ || events.replayed > replayed_) &&
+          s.t - dropped_reported_t_ >= 1.0) {
+        clear_line();
+        spdlog::warn(
+            "t {:.2f} s: dds input: {} malformed, {} replayed samples dropped so far (they count "
+            "as missing)",
+            s.t, events.malformed, events.replayed);
+        malformed_ = events.malformed;
+        replayed_ = events.replayed;
+        dropped_reported_t_ = s.t;
       }
       std::snprintf(sender, sizeof sender, " | from %.40s", sender_.c_str());
     }
@@ -110,10 +137,13 @@ class StatusReporter {
 
   const control::LiveStatusBoard& board_;
   const input::KeyboardSource* keyboard_;
-  const dds::DdsCommandSource* remote_;
+  const RemoteInput& remote_;
   std::string sender_;
   bool draw_;
   int disconnects_ = 0, reconnects_ = 0;
+  std::uint64_t malformed_ = 0, replayed_ = 0;
+  int operator_changes_ = 0;
+  double dropped_reported_t_ = -1e9;
   input::InputFault fault_ = input::InputFault::kNone;
 };
 
@@ -131,9 +161,7 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
       "Drive the crane live: keyboard, joystick (evdev, SDL), a remote operator over DDS "
       "Security or a replay file; the simulated crane, or with --backend can the machine on the "
       "CAN bus");
-  sim->add_option("--config", args.config_file,
-                  "Crane config YAML (default: the embedded K70M reference crane)")
-      ->check(CLI::ExistingFile);
+  add_config_option(*sim, args.config_file);
   sim->add_option("--input", args.input,
                   "keyboard (default on a terminal), evdev, sdl, dds (a remote operator, "
                   "docs/remote-commands.md), or replay FILE")
@@ -160,11 +188,8 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
       ->check(CLI::Range(0, 99));
   sim->add_option("--cpu", args.cpu, "Pin the loop thread to this core")
       ->check(CLI::Range(0, 1023));
-  sim->add_option("--payload", args.payload_kg, "Payload mass in the grapple, kg")
-      ->check(CLI::Range(0.0, 100000.0));
-  sim->add_option("--initial", args.initial,
-                  "Start pose of the simulated crane, e.g. \"lift=0 deg, tilt=-125 deg, "
-                  "extension=0.2 m\" (joints left out keep the config's simulation.initial)");
+  add_payload_option(*sim, args.payload_kg);
+  add_initial_option(*sim, args.initial);
   add_resolution_option(*sim, args.resolution, "for the run");
   add_backend_options(*sim, args.machine);
   add_telemetry_options(*sim, args.telemetry, true);
@@ -176,6 +201,10 @@ int run_sim_command(const SimArgs& args) {
   if (kind != "keyboard" && kind != "evdev" && kind != "sdl" && kind != "dds" && kind != "replay") {
     spdlog::error("--input: unknown input '{}' (expected keyboard, evdev, sdl, dds or replay FILE)",
                   kind);
+    return kExitUsage;
+  }
+  if (kind == "dds" && !remote_input_available()) {
+    spdlog::error("--input dds: this craneassist was built without DDS (CRANEASSIST_DDS=OFF)");
     return kExitUsage;
   }
   if ((kind == "replay") != (args.input.size() == 2)) {
@@ -197,35 +226,14 @@ int run_sim_command(const SimArgs& args) {
   config::TelemetryConfig tcfg;
   std::optional<input::Replay> replay;
   try {
-    cfg = args.config_file.empty() ? config::default_crane_config()
-                                   : config::load_crane_config(args.config_file);
-    if (args.payload_kg) config::set_payload_mass(cfg.model, *args.payload_kg);
-    if (!args.resolution.empty()) {
-      try {
-        config::set_resolution(cfg, args.resolution);
-      } catch (const std::invalid_argument& e) {
-        spdlog::error("--resolution: {}", e.what());
-        return kExitUsage;
-      }
-    }
-    if (!args.initial.empty()) {
-      if (uses_can_backend(args.machine, cfg)) {
-        spdlog::error("--initial: the can backend starts where the machine is (use --backend sim)");
-        return kExitUsage;
-      }
-      try {
-        cfg.simulation.q_initial =
-            config::parse_joint_pose(cfg.model, args.initial, cfg.simulation.q_initial);
-      } catch (const std::invalid_argument& e) {
-        spdlog::error("--initial: {}", e.what());
-        return kExitUsage;
-      }
-    }
+    cfg = load_crane(args.config_file);
+    apply_crane_options(cfg, {args.payload_kg, args.initial, args.resolution,
+                              !uses_can_backend(args.machine, cfg)});
     jcfg = args.joystick_file.empty() ? config::default_joystick_config()
                                       : config::load_joystick_config(args.joystick_file);
     if (kind == "replay") replay = input::Replay::load_file(args.input[1]);
     tcfg = load_telemetry_settings(args.telemetry);
-    if (kind == "dds") dds::check_command_input_settings(tcfg);
+    if (kind == "dds") check_remote_input_settings(tcfg);
   } catch (...) {
     return input_error_exit("replay");
   }
@@ -242,11 +250,10 @@ int run_sim_command(const SimArgs& args) {
     g_stop.store(false);
     std::unique_ptr<input::CommandSource> source;
     input::KeyboardSource* keyboard = nullptr;
-    dds::DdsCommandSource* remote = nullptr;
+    RemoteInput remote;
     if (kind == "dds") {
-      auto d = std::make_unique<dds::DdsCommandSource>(tcfg);
-      remote = d.get();
-      source = std::move(d);
+      remote = open_remote_input(tcfg, jcfg.monitor.stale_timeout_s);
+      source = std::move(remote.source);
       spdlog::info(
           "dds input: craneassist/operator_command on DDS domain {} with DDS Security "
           "({}); waiting for an operator (craneassist remote)",
@@ -323,8 +330,7 @@ int run_sim_command(const SimArgs& args) {
     machine.safe_stop();
     done.store(true);
     ui.join();
-    std::optional<dds::CommandInputStats> remote_stats;
-    if (remote != nullptr) remote_stats = remote->stats();
+    const std::string remote_report = remote.report ? remote.report() : std::string();
     source.reset();  // restores the terminal; ends the DDS input
     signal(SIGINT, SIG_DFL);
     signal(SIGTERM, SIG_DFL);
@@ -337,11 +343,16 @@ int run_sim_command(const SimArgs& args) {
     }
     std::printf("craneassist sim: %s input on %s, %s backend\n", kind.c_str(),
                 cfg.model.name.c_str(), machine.name());
-    std::printf("  ran %.2f s of machine time in %.2f s, %d cycles, latest cycle start %.1f ms\n",
+    std::printf("  ran %.2f s of machine time in %.2f s, %ld cycles, latest cycle start %.1f ms\n",
                 s.duration_s, s.wall_time_s, s.cycles, s.max_late_s * 1e3);
-    std::printf("  tip: path %.2f m, peak speed %.2f m/s; operator command passed in %d cycles\n",
+    std::printf("  tip: path %.2f m, peak speed %.2f m/s; operator command passed in %ld cycles\n",
                 s.tip_path_m, s.peak_tip_speed_m_s, s.enabled_cycles);
     std::printf("  cycle timing: %s\n", control::describe(s.timing).c_str());
+    if (s.stop_cycles > 0) {
+      std::printf("  %s: stopped jerk-limited in %.2f s, then valves neutral\n",
+                  s.end_stop ? "end of run" : "stop",
+                  static_cast<double>(s.stop_cycles) / cfg.control.rate_hz);
+    }
     if (options.realtime_setup.lock_memory || options.realtime_setup.priority > 0 ||
         options.realtime_setup.cpu >= 0) {
       const control::RealtimeResult& r = s.realtime_result;
@@ -352,22 +363,7 @@ int run_sim_command(const SimArgs& args) {
       if (!r.refused.empty()) spdlog::warn("real time: {}", r.refused);
     }
     std::printf("  input device: %d disconnects, %d re-attaches\n", s.disconnects, s.reconnects);
-    if (remote_stats) {
-      const dds::CommandInputStats& d = *remote_stats;
-      std::string from = " (no operator)";
-      if (d.first_sample_s >= 0.0) {
-        char first[32];
-        std::snprintf(first, sizeof first, "%.2f", d.first_sample_s);
-        from = " from '" + d.sender + "' (first " + first + " s after start)";
-      }
-      std::printf(
-          "  dds input: %llu samples%s, %llu lost, %llu non-finite, %llu from other senders; "
-          "writers matched %d (peak %d)\n",
-          static_cast<unsigned long long>(d.samples), from.c_str(),
-          static_cast<unsigned long long>(d.lost), static_cast<unsigned long long>(d.non_finite),
-          static_cast<unsigned long long>(d.other_senders), d.writer_matches,
-          d.peak_matched_writers);
-    }
+    if (!remote_report.empty()) std::printf("%s\n", remote_report.c_str());
     if (log) std::printf("  log: %s (%zu rows)\n", log->path().c_str(), log->rows_written());
     if (!args.record_file.empty()) {
       std::printf("  record: %s (%zu rows%s)\n", args.record_file.c_str(), record.size(),

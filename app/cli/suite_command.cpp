@@ -8,10 +8,10 @@
 #include <filesystem>
 #include <vector>
 
+#include "crane_options.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/offline/scenario_suite.hpp"
 #include "exit_codes.hpp"
-#include "resolution_option.hpp"
 
 namespace craneassist::cli {
 namespace {
@@ -66,10 +66,7 @@ CLI::App* add_suite_command(CLI::App& cli, SuiteArgs& args) {
   suite->add_option("manifest", args.manifest, "Suite manifest YAML (docs/suite-format.md)")
       ->required()
       ->check(CLI::ExistingFile);
-  suite
-      ->add_option("--config", args.config_file,
-                   "Crane config YAML (default: the embedded K70M reference crane)")
-      ->check(CLI::ExistingFile);
+  add_config_option(*suite, args.config_file);
   add_resolution_option(*suite, args.resolution, "for every run (all: the pump energy of each)",
                         true);
   suite->add_option("--log-dir", args.log_dir, "Write each run's per-cycle log into this folder");
@@ -81,8 +78,7 @@ int run_suite_command(const SuiteArgs& args) {
   config::CraneConfig cfg;
   offline::Suite suite;
   try {
-    cfg = args.config_file.empty() ? config::default_crane_config()
-                                   : config::load_crane_config(args.config_file);
+    cfg = load_crane(args.config_file);
     suite = offline::load_suite(args.manifest);
     offline::check_suite(suite, cfg);
   } catch (const config::ConfigError& e) {

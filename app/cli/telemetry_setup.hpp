@@ -1,6 +1,8 @@
 // DDS telemetry of `craneassist sim` and `craneassist replay`: the options, the settings file
 // (config/telemetry/default.yaml or --telemetry-config), and the publisher with its loop
-// observer. One place for both commands.
+// observer. One place for both commands. The options and settings are always there
+// (telemetry_setup.cpp); the publisher is built from app/dds (telemetry_dds.cpp), or in a build
+// without DDS (CRANEASSIST_DDS=OFF) runs without telemetry and says so (telemetry_none.cpp).
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -10,8 +12,7 @@
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/config/telemetry_config.hpp"
-#include "craneassist/dds/telemetry_publisher.hpp"
-#include "telemetry_observer.hpp"
+#include "craneassist/control/control_loop.hpp"
 
 namespace craneassist::cli {
 
@@ -32,19 +33,23 @@ config::TelemetryConfig load_telemetry_settings(const TelemetryArgs& args);
 
 class Telemetry {
  public:
+  Telemetry();
+  ~Telemetry();
+  Telemetry(const Telemetry&) = delete;
+  Telemetry& operator=(const Telemetry&) = delete;
+
   // Starts publishing when `wanted` (and the settings enable it); returns kExitOk, or logs why
-  // DDS could not start and returns kExitRuntime.
+  // DDS could not start and returns kExitRuntime. Without DDS: warns and returns kExitOk.
   int open(const config::TelemetryConfig& settings, bool wanted, const config::CraneConfig& cfg,
            const char* backend);
   // The loop observer, or nullptr when not publishing.
-  control::CycleObserver* observer() { return observer_ ? &*observer_ : nullptr; }
+  control::CycleObserver* observer();
   // Publishes the last frames, prints the counters line.
   void finish();
 
  private:
-  std::unique_ptr<dds::TelemetryPublisher> publisher_;
-  std::optional<cli::TelemetryObserver> observer_;
-  int domain_ = 0;
+  struct Publishing;
+  std::unique_ptr<Publishing> publishing_;
 };
 
 }  // namespace craneassist::cli

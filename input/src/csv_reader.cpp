@@ -109,6 +109,11 @@ double Reader::field_value(const CsvColumn& column, std::string_view text, std::
   if (!parse_number(text, value, reason)) throw error(line, column.name, std::move(reason));
   if (column.kind == CsvKind::kTime) {
     if (value < 0.0) throw error(line, column.name, "negative time: " + quoted(text));
+    if (value > kMaxFileTime_s) {
+      throw error(line, column.name,
+                  "time " + number(value) + " s is beyond the longest run a file may describe, " +
+                      number(kMaxFileTime_s) + " s (24 h)");
+    }
     if (previous_line_ > 0) {
       std::string problem;
       if (!(value > previous_time_)) {

@@ -20,8 +20,12 @@
 
 namespace craneassist::input::detail {
 
+// The latest time a file may hold (a time column's bound): one day. A run is as long as its file;
+// this keeps a two-row file from running for months and filling the disk with its log.
+inline constexpr double kMaxFileTime_s = 86400.0;
+
 enum class CsvKind {
-  kTime,    // a finite number >= 0, strictly increasing from row to row
+  kTime,    // a finite number in [0, kMaxFileTime_s], strictly increasing from row to row
   kNumber,  // a finite number
   kFlag,    // 0 or 1
 };

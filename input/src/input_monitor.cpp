@@ -22,6 +22,10 @@ const char* to_string(InputFault fault) {
       return "deadman released";
     case InputFault::kNotArmed:
       return "re-arm: release and press the deadman";
+    case InputFault::kStopLatched:
+      return "stop latched";
+    case InputFault::kArming:
+      return "arming: keep the deadman held";
   }
   return "unknown";
 }
@@ -60,16 +64,34 @@ void InputMonitor::update(SourceState state, const OperatorCommand& sample, doub
   } else if (fault != InputFault::kNone) {
     armed_ = false;
     released_seen_ = false;  // after the fault is gone the deadman must be released again
-  } else if (!armed_) {
-    if (released_seen_) {
-      armed_ = true;
-    } else {
-      fault = InputFault::kNotArmed;
+  } else {
+    if (!armed_) {
+      if (released_seen_) {
+        armed_ = true;
+        armed_at_s_ = now_s;
+      } else {
+        fault = InputFault::kNotArmed;
+      }
+    }
+    // Armed and pressed, no fault: the stop latch, then the continuous hold. (Negated
+    // comparisons: a clock that is not finite keeps the command stopped. The tolerance keeps a
+    // time that is a whole number of cycles from missing its cycle by rounding.)
+    constexpr double kTolerance_s = 1e-9;
+    if (armed_) {
+      if (ever_enabled_ && !enabled_ &&
+          !(now_s - stopped_at_s_ + kTolerance_s >= settings_.stop_latch_s)) {
+        fault = InputFault::kStopLatched;
+      } else if (!(now_s - armed_at_s_ + kTolerance_s >= settings_.deadman_hold_s)) {
+        fault = InputFault::kArming;
+      }
     }
   }
 
   out.fault = fault;
   out.enabled = armed_ && fault == InputFault::kNone;
+  if (enabled_ && !out.enabled) stopped_at_s_ = now_s;
+  enabled_ = out.enabled;
+  ever_enabled_ = ever_enabled_ || out.enabled;
   if (out.enabled) {
     out.v_m_s = sample.v_m_s;
   } else {

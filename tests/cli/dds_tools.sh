@@ -39,7 +39,8 @@ case $case_name in
 echo)
   start_publisher
   # Every telemetry topic (the test frame's values in each; the DDS name works too) and a CSV,
-  # all at once: each echo's discovery can take a few seconds.
+  # all at once: each echo's discovery can take a few seconds (more under the sanitizers with
+  # other DDS tests running: 15 s each, well inside the publisher's 20 s).
   n=0
   pids=
   for topic in status craneassist/joints hydraulics command_path csv; do
@@ -49,7 +50,7 @@ echo)
     else
       set -- echo "$topic" --count 3
     fi
-    (rc=0; "$bin" "$@" --domain "$domain" --timeout 8 > "$work/out$n" 2> "$work/err$n" || rc=$?
+    (rc=0; "$bin" "$@" --domain "$domain" --timeout 15 > "$work/out$n" 2> "$work/err$n" || rc=$?
      echo "$rc" > "$work/rc$n") &
     pids="$pids $!"
   done

@@ -12,13 +12,17 @@
 #             create its writer (exit 3, says why), never a command
 #   loss      the operator's process is killed in mid-motion: the input goes stale, the crane
 #             stops (jerk-limited) and its valves go neutral
+#   malformed the operator's samples turn malformed in mid-motion (a bool byte of 2, a bad
+#             encapsulation, a cut-off body; dds_malformed_operator): the crane survives, counts
+#             them, the input goes stale and the crane stops as on loss
 #   usage     sim --input dds without commands.enabled or without the security files: exit 2
 #             with the message; remote without an identity: exit 2
 #
-# Usage: remote_commands.sh CASE CRANEASSIST MAKE_CERTS REPLAY_CSV DOMAIN WORKDIR
+# Usage: remote_commands.sh CASE CRANEASSIST MAKE_CERTS REPLAY_CSV DOMAIN WORKDIR [HELPER]
+#   HELPER: malformed: the dds_malformed_operator program
 # Prints "CASE OK" on success.
 set -eu
-case_name=$1 bin=$2 make_certs=$3 replay=$4 domain=$5 work=$6
+case_name=$1 bin=$2 make_certs=$3 replay=$4 domain=$5 work=$6 helper=${7:-}
 # Under AddressSanitizer (CRANEASSIST_SANITIZE): Debian's Fast DDS 2.9 deletes its statistics
 # listeners with a mismatched size (new-delete-type-mismatch at every participant's teardown) and
 # leaks OpenSSL objects on a failed handshake (tests/lsan-fastdds.supp). Both are in the library,
@@ -66,6 +70,30 @@ sim_remote() {
                    END { printf "%.3f", sqrt(dx * dx + dy * dy + dz * dz) }' "$work/log.csv")
   commanded=$(awk -F, 'NR > 1 && $2 != "nan" && ($2 != 0 || $3 != 0 || $4 != 0) { n++ }
                        END { print n + 0 }' "$work/log.csv")
+}
+
+# From the log (t: column 1, cmd_vx: 2, tip_vx..tip_vz: 11..13, spool*): the last cycle the
+# command passed, the first cycle after it with every valve neutral, the peak tip speed and the tip
+# speed at the end; checks that the crane moved, then stopped with every valve neutral.
+expect_moved_then_stopped() {
+  result=$(awk -F, '
+    NR == 1 { for (i = 1; i <= NF; i++) if ($i ~ /^spool/) spool[++n] = i; next }
+    {
+      neutral = 1
+      for (k = 1; k <= n; k++) if ($spool[k] != 0) neutral = 0
+      v = sqrt($11 * $11 + $12 * $12 + $13 * $13)
+      if ($2 != "nan") { last = $1; rest = -1; if (v > peak) peak = v }
+      else if (neutral && rest < 0 && last != "") rest = $1
+      end_v = v
+    }
+    END { printf "%s %s %.3f %.4f", last, rest, peak, end_v }' "$work/log.csv")
+  # shellcheck disable=SC2086 # four words
+  set -- $result
+  [ -n "${1:-}" ] || fail "the command never passed"
+  awk -v p="$3" 'BEGIN { exit !(p > 0.1) }' || fail "the tip never moved (peak $3 m/s)"
+  awk -v r="$2" 'BEGIN { exit !(r > 0) }' || fail "the valves never went neutral"
+  awk -v v="$4" 'BEGIN { exit !(v < 0.01) }' || fail "the tip still moves at the end ($4 m/s)"
+  stop_summary="last command at t $1 s, every valve neutral at t $2 s, peak tip speed $3 m/s, at the end $4 m/s"
 }
 
 expect_no_command() {
@@ -151,27 +179,28 @@ EOF
     wait "$remote_pid" || true
     wait "$sim_pid" || fail "sim exited $?"
     grep -q "input stale" "$work/sim.out" || fail "no stale input reported"
-    # From the log (t: column 1, cmd_vx: 2, tip_vx..tip_vz: 11..13, spool*): the last cycle the
-    # command passed, the first cycle after it with every valve neutral, the tip speed at the end.
-    result=$(awk -F, '
-      NR == 1 { for (i = 1; i <= NF; i++) if ($i ~ /^spool/) spool[++n] = i; next }
-      {
-        neutral = 1
-        for (k = 1; k <= n; k++) if ($spool[k] != 0) neutral = 0
-        v = sqrt($11 * $11 + $12 * $12 + $13 * $13)
-        if ($2 != "nan") { last = $1; rest = -1; if (v > peak) peak = v }
-        else if (neutral && rest < 0 && last != "") rest = $1
-        end_v = v
-      }
-      END { printf "%s %s %.3f %.4f", last, rest, peak, end_v }' "$work/log.csv")
-    # shellcheck disable=SC2086 # four words
-    set -- $result
-    [ -n "${1:-}" ] || fail "the command never passed"
-    awk -v p="$3" 'BEGIN { exit !(p > 0.1) }' || fail "the tip never moved (peak $3 m/s)"
-    awk -v r="$2" 'BEGIN { exit !(r > 0) }' || fail "the valves never went neutral"
-    awk -v v="$4" 'BEGIN { exit !(v < 0.01) }' || fail "the tip still moves at the end ($4 m/s)"
-    echo "loss: last command at t $1 s, every valve neutral at t $2 s, peak tip speed $3 m/s," \
-      "at the end $4 m/s"
+    expect_moved_then_stopped
+    echo "loss: $stop_summary"
+    ;;
+  malformed)
+    [ -x "$helper" ] || fail "no dds_malformed_operator given"
+    "$make_certs" "$work/certs" >/dev/null
+    "$bin" sim --input dds --telemetry-config "$work/certs/crane.yaml" --domain "$domain" \
+      --duration 6 --log "$work/log.csv" >"$work/sim.out" 2>&1 &
+    sim_pid=$!
+    rc=0
+    "$helper" "$domain" "$work/certs/operator.yaml" >"$work/operator.out" 2>&1 || rc=$?
+    sim_rc=0
+    wait "$sim_pid" || sim_rc=$?
+    [ "$rc" -eq 0 ] || fail "dds_malformed_operator exited $rc"
+    [ "$sim_rc" -eq 0 ] || fail "sim exited $sim_rc (killed by a malformed sample?)"
+    grep -q "input stale" "$work/sim.out" || fail "no stale input reported"
+    grep -q "malformed, 0 replayed samples dropped so far" "$work/sim.out" ||
+      fail "no malformed samples reported"
+    bad=$(sed -n 's/.*dds input: .* \([0-9]*\) malformed,.*/\1/p' "$work/sim.out")
+    [ -n "$bad" ] && [ "$bad" -gt 50 ] || fail "malformed samples counted: '$bad' (sent 100)"
+    expect_moved_then_stopped
+    echo "malformed: $bad malformed samples counted; $stop_summary"
     ;;
   usage)
     "$make_certs" "$work/certs" >/dev/null

@@ -5,6 +5,8 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 #include "craneassist/input/command_source.hpp"
@@ -50,11 +52,21 @@ const char* status_word(CycleStatus status) {
   return "unknown";
 }
 
+long run_cycles(double cycles, const char* what) {
+  if (!(cycles >= 0.0 && cycles <= static_cast<double>(kMaxRunCycles))) {
+    throw std::invalid_argument(std::string(what) + ": a run of " + std::to_string(cycles) +
+                                " cycles is not possible (at most " +
+                                std::to_string(kMaxRunCycles) + ")");
+  }
+  return static_cast<long>(cycles);
+}
+
 LoopSummary run_control_loop(CycleTask& task, valves::MachineInterface& machine,
                              const LoopOptions& options) {
   const double period = options.period_s;
   const long period_ns = std::lround(period * 1e9);
-  const long settle_cycles = static_cast<long>(std::ceil(options.stop_settle_max_s / period));
+  const long settle_cycles =
+      run_cycles(std::ceil(options.stop_settle_max_s / period), "the stop's settle time");
 
   valves::MachineState state;
   valves::ValveCommand command;
@@ -72,7 +84,15 @@ LoopSummary run_control_loop(CycleTask& task, valves::MachineInterface& machine,
   bool frozen_once = false;
   double last_compute_s = 0.0;
   long k = 0;
-  for (; k < options.max_cycles; ++k) {
+  CycleStatus last_status = CycleStatus::kRunning;
+  for (;; ++k) {
+    if (stop_cause == nullptr && k >= options.max_cycles) {
+      // The end of the run: stop the machine, never leave it moving (unless it already is).
+      if (k == 0 || !options.stop_at_end || last_status == CycleStatus::kStopped) break;
+      stop_requested_at = k;
+      stop_cause = "end of run";
+      summary.end_stop = true;
+    }
     const timespec woke = monotonic_now();
     time.k = k;
     time.t_s = options.t0_s + static_cast<double>(k) * period;
@@ -94,12 +114,14 @@ LoopSummary run_control_loop(CycleTask& task, valves::MachineInterface& machine,
       stop_cause = options.stop_cause;
     }
     const CycleStatus status = task.step(time, state, stop_cause, command, row);
+    last_status = status;
     machine.write(command);
     row.loop_latency_max_s = summary.max_late_s();
     row.loop_compute_s = last_compute_s;
     row.loop_overruns = summary.timing.overruns;
     if (options.log != nullptr) options.log->push(row);
-    const CycleRecord record{time, state, command, row, status, task.controller_output()};
+    const CycleRecord record{time,      state, command, row, status, task.controller_output(),
+                             stop_cause};
     for (CycleObserver* o : options.observers) o->on_cycle(record);
 
     machine.advance(period);
@@ -132,7 +154,8 @@ LoopSummary run_control_loop(CycleTask& task, valves::MachineInterface& machine,
   for (CycleObserver* o : options.observers) o->on_finish(time, state);
   summary.cycles = k;
   summary.duration_s = static_cast<double>(k) * period;
-  summary.stop_requested = stop_cause != nullptr;
+  summary.stop_requested = stop_cause != nullptr && !summary.end_stop;
+  summary.stop_cycles = stop_requested_at >= 0 ? k - stop_requested_at : 0;
   summary.wall_time_s = seconds(monotonic_now()) - seconds(wall_start);
   if (options.log != nullptr) summary.log_rows_dropped = options.log->close();
   return summary;

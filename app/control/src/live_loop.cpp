@@ -11,8 +11,10 @@ namespace craneassist::control {
 namespace {
 
 // Records the command the controller got, in the replay format: a row where it changes, a stop
-// row for no command (the replay format holds no NaN), and a last row at the final cycle so a
-// replay of it runs as long as the session. Preallocated; rows beyond the capacity are counted.
+// row for no command (the replay format holds no NaN), and a last row at the session's final
+// cycle so a replay of it runs as long as the session. The session ends where the loop's stop
+// begins (quit, fault, end of run): a replay of the record ends with the same stop.
+// Preallocated; rows beyond the capacity are counted.
 class RecordingObserver final : public CycleObserver {
  public:
   RecordingObserver(std::vector<input::ReplayRow>& record, std::size_t capacity)
@@ -21,6 +23,8 @@ class RecordingObserver final : public CycleObserver {
     record_.reserve(capacity);
   }
   void on_cycle(const CycleRecord& c) noexcept override {
+    if (c.stop_cause != nullptr) return;
+    last_t_s_ = c.time.t_s;
     const Eigen::Vector3d cmd(c.row.cmd[0], c.row.cmd[1], c.row.cmd[2]);
     const bool stop = !cmd.allFinite();
     const input::ReplayRow row{c.time.t_s, stop ? Eigen::Vector3d::Zero() : cmd, stop};
@@ -33,9 +37,9 @@ class RecordingObserver final : public CycleObserver {
       last_ = row;
     }
   }
-  void on_finish(const CycleTime& last, const valves::MachineState&) override {
-    if (!record_.empty() && record_.back().t_s < last.t_s) {
-      record_.push_back({last.t_s, last_.v_m_s, last_.stop});
+  void on_finish(const CycleTime&, const valves::MachineState&) override {
+    if (!record_.empty() && record_.back().t_s < last_t_s_) {
+      record_.push_back({last_t_s_, last_.v_m_s, last_.stop});
     }
   }
   std::size_t dropped() const { return dropped_; }
@@ -44,6 +48,7 @@ class RecordingObserver final : public CycleObserver {
   std::vector<input::ReplayRow>& record_;
   std::size_t capacity_;
   input::ReplayRow last_{0.0, Eigen::Vector3d::Zero(), false};
+  double last_t_s_ = 0.0;
   std::size_t dropped_ = 0;
 };
 
@@ -87,7 +92,7 @@ LiveSummary run_live(const config::CraneConfig& config, input::CommandSource& so
   LoopOptions loop;
   loop.period_s = period;
   loop.max_cycles = options.duration_s > 0.0
-                        ? static_cast<long>(std::ceil(options.duration_s / period - 1e-9))
+                        ? run_cycles(std::ceil(options.duration_s / period - 1e-9), "--duration")
                         : std::numeric_limits<long>::max();
   loop.realtime = options.realtime;
   loop.realtime_setup = options.realtime_setup;
@@ -110,18 +115,20 @@ LiveSummary run_live(const config::CraneConfig& config, input::CommandSource& so
   const LoopSummary ran = run_control_loop(task, machine, loop);
   const RunSummary stats = statistics.summary(ran);
   LiveSummary summary;
-  summary.cycles = static_cast<int>(ran.cycles);
+  summary.cycles = ran.cycles;
   summary.duration_s = ran.duration_s;
   summary.wall_time_s = ran.wall_time_s;
   summary.max_late_s = ran.max_late_s();
   summary.peak_tip_speed_m_s = stats.peak_tip_speed_m_s;
   summary.tip_path_m = stats.tip_path_m;
-  summary.enabled_cycles = stats.cycles - stats.input_stop_cycles;
+  summary.enabled_cycles = stats.cycles - stats.input_stop_cycles - ran.stop_cycles;
   summary.disconnects = input.monitor().disconnects();
   summary.reconnects = input.monitor().reconnects();
   summary.log_rows_dropped = ran.log_rows_dropped;
   summary.record_rows_dropped = recording ? recording->dropped() : 0;
   summary.machine_fault = ran.machine_fault;
+  summary.end_stop = ran.end_stop;
+  summary.stop_cycles = ran.stop_cycles;
   summary.realtime_result = ran.realtime_result;
   summary.timing = ran.timing;
   return summary;

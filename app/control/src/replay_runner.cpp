@@ -16,7 +16,8 @@ RunSummary run_replay(const config::CraneConfig& config, const input::Replay& re
   LoopOptions loop;
   loop.period_s = period;
   loop.max_cycles =
-      static_cast<long>(std::ceil((replay.end_time_s() + options.settle_s) / period - 1e-9)) + 1;
+      run_cycles(std::ceil((replay.end_time_s() + options.settle_s) / period - 1e-9) + 1.0,
+                 "the replay and its settle time");
   loop.realtime = options.realtime;
   loop.log = log;
   loop.freeze_at_s = options.freeze_at_s;

@@ -23,7 +23,7 @@ void RunStatistics::on_cycle(const CycleRecord& c) noexcept {
   const Eigen::Vector3d cmd(row.cmd[0], row.cmd[1], row.cmd[2]);
   const Eigen::Vector3d tip(row.tip[0], row.tip[1], row.tip[2]);
   const Eigen::Vector3d tip_v(row.tip_v[0], row.tip_v[1], row.tip_v[2]);
-  const bool input_stop = !cmd.allFinite();
+  const bool input_stop = !cmd.allFinite() && c.stop_cause == nullptr;  // not the loop's stop
 
   if (c.status != CycleStatus::kRunning) ++s_.stopped_cycles;
   s_.neutral_valve_cycles += c.status == CycleStatus::kStopped;
@@ -72,13 +72,17 @@ void RunStatistics::on_finish(const CycleTime&, const valves::MachineState& stat
 RunSummary RunStatistics::summary(const LoopSummary& loop) const {
   RunSummary s = s_;
   s.feel = quality_.result();
-  s.cycles = static_cast<int>(loop.cycles);
+  s.cycles = loop.cycles;
   s.duration_s = loop.duration_s;
   s.wall_time_s = loop.wall_time_s;
   s.machine_fault = loop.machine_fault;
+  s.end_stop = loop.end_stop;
+  s.stop_cycles = loop.stop_cycles;
   s.log_rows_dropped = loop.log_rows_dropped;
   s.rms_direction_error_deg =
-      s.direction_samples > 0 ? std::sqrt(sum_sq_direction_ / s.direction_samples) : 0.0;
+      s.direction_samples > 0
+          ? std::sqrt(sum_sq_direction_ / static_cast<double>(s.direction_samples))
+          : 0.0;
   return s;
 }
 

@@ -130,9 +130,9 @@ TrajectoryRunSummary run_trajectory(const config::CraneConfig& config,
   LoopOptions loop;
   loop.period_s = period;
   loop.t0_s = trajectory.start_time_s();
-  loop.max_cycles = static_cast<long>(std::ceil(
-                        (trajectory.end_time_s() - loop.t0_s + options.settle_s) / period)) +
-                    1;
+  loop.max_cycles =
+      run_cycles(std::ceil((trajectory.end_time_s() - loop.t0_s + options.settle_s) / period) + 1.0,
+                 "the trajectory and its settle time");
   loop.log = log;
   loop.observers.push_back(&statistics);
   const RunSummary s = statistics.summary(run_control_loop(task, machine, loop));

@@ -1,5 +1,6 @@
 #include "craneassist/dds/command_source.hpp"
 
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <fastdds/dds/subscriber/DataReader.hpp>
@@ -10,6 +11,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "checked_types.hpp"
 #include "command_participant.hpp"
 #include "craneassist_msgs.h"
 #include "participant.hpp"
@@ -33,15 +35,12 @@ void check_command_input_settings(const config::TelemetryConfig& settings) {
   }
 }
 
-namespace {
-
-// The operator holds the command until its writer is gone or it is silent this long.
-constexpr double kOwnerSilence_s = 0.5;
-
-}  // namespace
-
 struct DdsCommandSource::Impl : public fdds::DataReaderListener {
-  explicit Impl(const config::TelemetryConfig& settings) : start_s(input::steady_now_s()) {
+  Impl(const config::TelemetryConfig& settings, double stale_timeout_s)
+      : start_s(input::steady_now_s()), takeover_silence_s(stale_timeout_s) {
+    if (!(stale_timeout_s > 0.0)) {
+      throw std::invalid_argument("DdsCommandSource: the stale timeout must be positive");
+    }
     check_command_input_settings(settings);
     ParticipantOptions options = participant_options(settings);
     options.name = settings.participant_name + "-commands";
@@ -71,9 +70,10 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
   void on_data_available(fdds::DataReader* r) override {
     std::lock_guard<std::mutex> lock(listener_mutex);
     fdds::SampleInfo info;
-    while (r->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
-      if (info.valid_data) accept(info.publication_handle);
-    }
+    // A malformed sample is dropped and counted: it counts as missing (the input goes stale).
+    std::uint64_t bad = 0;
+    while (take_next_valid(*r, &sample, info, bad)) accept(info.publication_handle);
+    if (bad > 0) malformed.fetch_add(bad, std::memory_order_relaxed);
   }
 
   void on_subscription_matched(fdds::DataReader*,
@@ -88,26 +88,80 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
       }
     }
     if (s.current_count_change < 0) {
+      // A writer gone, the operator's too: it is silent from now on, and another writer takes the
+      // command over by the same rule as from a silent one (accept()).
       std::lock_guard<std::mutex> lock(listener_mutex);
-      // The operator's writer is gone: another may take over.
-      if (has_owner && s.last_publication_handle == owner) has_owner = false;
+      forget_writer(s.last_publication_handle);
     }
     if (s.current_count > 0) ever_matched.store(true, std::memory_order_release);
     matched.store(s.current_count, std::memory_order_release);
   }
 
+  // True when `sample_seq` is above every seq `writer` sent before (and records it): a sample
+  // with an older or the same seq is a replay (or a repeat), whoever holds the command.
+  bool fresh_seq(const fdds::InstanceHandle_t& writer, std::uint64_t sample_seq, double now) {
+    WriterSeq* slot = nullptr;
+    WriterSeq* free_slot = nullptr;
+    WriterSeq* oldest = nullptr;
+    for (WriterSeq& e : writer_seqs) {
+      if (e.used && e.writer == writer) {
+        slot = &e;
+        break;
+      }
+      if (!e.used) {
+        if (free_slot == nullptr) free_slot = &e;
+      } else if (!(has_owner && e.writer == owner) &&
+                 (oldest == nullptr || e.heard_s < oldest->heard_s)) {
+        oldest = &e;
+      }
+    }
+    if (slot != nullptr) {
+      if (sample_seq <= slot->seq) return false;
+    } else {
+      // A writer not heard from before; when every entry is taken, the writer heard from
+      // longest ago (never the operator holding the command) makes room.
+      slot = free_slot != nullptr ? free_slot : oldest;
+      if (slot == nullptr) return true;
+      slot->used = true;
+      slot->writer = writer;
+    }
+    slot->seq = sample_seq;
+    slot->heard_s = now;
+    return true;
+  }
+
+  void forget_writer(const fdds::InstanceHandle_t& writer) {
+    for (WriterSeq& e : writer_seqs) {
+      if (e.used && e.writer == writer) e.used = false;
+    }
+  }
+
   void accept(const fdds::InstanceHandle_t& writer) {
     const double now = input::steady_now_s();
-    if (has_owner && writer != owner && now - owner_last_s <= kOwnerSilence_s) {
+    if (!fresh_seq(writer, sample.seq(), now)) {
+      replayed.fetch_add(1, std::memory_order_relaxed);
+      return;
+    }
+    // One operator at a time: another writer takes the command over only once the operator
+    // holding it has been silent for longer than the stale timeout (the monitor has stopped the
+    // crane on stale input by then), never while it sends.
+    if (has_owner && writer != owner && !(now - owner_last_s > takeover_silence_s)) {
       other_senders.fetch_add(1, std::memory_order_relaxed);
       return;
     }
     if (!has_owner || writer != owner) {
       owner = writer;
       has_owner = true;
+      owner_released = false;
       last_seq_valid = false;
+      owner_changes.fetch_add(1, std::memory_order_relaxed);
     }
     owner_last_s = now;
+    // A new operator's deadman counts only after it has sent it released: until then the
+    // deadman reads released, so the monitor sees a release and then its press (re-arm), even
+    // when it never saw the old operator's samples go stale.
+    if (!sample.deadman()) owner_released = true;
+    const bool deadman_held = sample.deadman() && owner_released;
     if (last_seq_valid && sample.seq() > last_seq + 1) {
       lost.fetch_add(sample.seq() - last_seq - 1, std::memory_order_relaxed);
     }
@@ -125,7 +179,7 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
     vx.store(v[0], std::memory_order_relaxed);
     vy.store(v[1], std::memory_order_relaxed);
     vz.store(v[2], std::memory_order_relaxed);
-    deadman.store(sample.deadman(), std::memory_order_relaxed);
+    deadman.store(deadman_held, std::memory_order_relaxed);
     seq.store(s + 2, std::memory_order_release);
     have_sample.store(true, std::memory_order_release);
     if (samples.fetch_add(1, std::memory_order_relaxed) == 0) {
@@ -170,6 +224,9 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
     CommandInputStats s;
     s.samples = samples.load();
     s.non_finite = non_finite.load();
+    s.malformed = malformed.load();
+    s.replayed = replayed.load();
+    s.owner_changes = owner_changes.load();
     s.lost = lost.load();
     s.other_senders = other_senders.load();
     s.matched_writers = matched.load();
@@ -183,6 +240,7 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
   }
 
   const double start_s;
+  const double takeover_silence_s;  // the monitor's stale timeout
   // The latest sample (seqlock: the listener writes, poll() reads).
   std::atomic<std::uint32_t> seq{0};
   std::atomic<double> stamp{0.0}, vx{0.0}, vy{0.0}, vz{0.0};
@@ -191,8 +249,9 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
   std::atomic<int> matched{0};
   std::atomic<bool> ever_matched{false};
   // Counters.
-  std::atomic<std::uint64_t> samples{0}, non_finite{0}, lost{0}, other_senders{0};
-  std::atomic<int> peak_matched{0}, writer_matches{0};
+  std::atomic<std::uint64_t> samples{0}, non_finite{0}, lost{0}, other_senders{0}, malformed{0},
+      replayed{0};
+  std::atomic<int> peak_matched{0}, writer_matches{0}, owner_changes{0};
   std::atomic<double> first_match_s{-1.0}, first_sample_s{-1.0};
   mutable std::mutex sender_mutex;
   std::string sender;
@@ -202,8 +261,18 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
   fdds::InstanceHandle_t owner;
   bool has_owner = false;
   double owner_last_s = 0.0;
-  std::uint64_t last_seq = 0;
+  bool owner_released = false;  // the operator holding the command has sent its deadman released
+  std::uint64_t last_seq = 0;   // the operator's, for `lost`
   bool last_seq_valid = false;
+  // The highest seq of each writer heard from (fresh_seq); an entry goes when its writer is
+  // unmatched.
+  struct WriterSeq {
+    fdds::InstanceHandle_t writer;
+    std::uint64_t seq = 0;
+    double heard_s = 0.0;
+    bool used = false;
+  };
+  std::array<WriterSeq, 16> writer_seqs{};
   std::string sender_seen;
   // Loop thread only.
   input::OperatorCommand latest;
@@ -212,8 +281,8 @@ struct DdsCommandSource::Impl : public fdds::DataReaderListener {
   fdds::DataReader* reader = nullptr;
 };
 
-DdsCommandSource::DdsCommandSource(const config::TelemetryConfig& settings)
-    : impl_(std::make_unique<Impl>(settings)) {}
+DdsCommandSource::DdsCommandSource(const config::TelemetryConfig& settings, double stale_timeout_s)
+    : impl_(std::make_unique<Impl>(settings, stale_timeout_s)) {}
 
 DdsCommandSource::~DdsCommandSource() = default;
 

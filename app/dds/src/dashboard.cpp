@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "checked_types.hpp"
 #include "craneassist/dds/telemetry_publisher.hpp"
 #include "craneassist/dds/tools.hpp"
 #include "craneassist_msgs.h"
@@ -53,6 +54,7 @@ struct Snapshot {
   msg::CommandPath command_path;
   std::int64_t received_ns[kTelemetryTopics] = {};  // CLOCK_MONOTONIC; 0: nothing yet
   int matched[kTelemetryTopics] = {};
+  std::uint64_t malformed[kTelemetryTopics] = {};  // dropped: could not be deserialized
 
   bool has(Topic t) const { return received_ns[index_of(t)] != 0; }
   bool any() const {
@@ -70,7 +72,8 @@ struct Snapshot {
 };
 
 // Filled on Fast DDS's threads (the readers' listeners): takes every sample and keeps the
-// latest, so the view never misses the newest state however slowly it is drawn.
+// latest, so the view never misses the newest state however slowly it is drawn. Malformed
+// samples are dropped and counted per topic.
 class LatestSamples {
  public:
   void take(Topic topic, fdds::DataReader& reader) {
@@ -102,11 +105,15 @@ class LatestSamples {
   void take_into(fdds::DataReader& reader, T Snapshot::*field, Topic topic) {
     T sample;
     fdds::SampleInfo info;
-    while (reader.take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data) continue;
+    std::uint64_t malformed = 0;
+    while (take_next_valid(reader, &sample, info, malformed)) {
       std::lock_guard<std::mutex> lock(mutex_);
       latest_.*field = sample;
       latest_.received_ns[index_of(topic)] = monotonic_ns();
+    }
+    if (malformed > 0) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      latest_.malformed[index_of(topic)] += malformed;
     }
   }
 
@@ -277,6 +284,19 @@ std::vector<std::string> render(const Snapshot& s, const DashboardOptions& o, st
       lines.push_back(fmt("%-10s", i == 1 ? "age" : "") + ages);
       ages.clear();
     }
+  }
+  // Samples dropped because they could not be deserialized (only when there were any).
+  std::uint64_t malformed = 0;
+  std::string per_topic;
+  for (int i = 0; i < kTelemetryTopics; ++i) {
+    malformed += s.malformed[i];
+    per_topic += fmt("%s%s %llu", i > 0 ? ", " : "",
+                     std::string(topic_info(kTelemetry[i]).short_name).c_str(),
+                     static_cast<unsigned long long>(s.malformed[i]));
+  }
+  if (malformed > 0) {
+    lines.push_back(fmt("%-10s%llu malformed samples dropped (%s)", "dropped",
+                        static_cast<unsigned long long>(malformed), per_topic.c_str()));
   }
   if (live) lines.push_back("q or Ctrl-C quits");
   for (auto& line : lines) line.erase(line.find_last_not_of(' ') + 1);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "checked_types.hpp"
 #include "craneassist/dds/telemetry_publisher.hpp"
 #include "craneassist/dds/tools.hpp"
 #include "craneassist_msgs.h"
@@ -326,11 +327,34 @@ int echo_topic(const TopicInfo& topic, const EchoOptions& o) {
     std::fflush(o.err);
     discovery_reported = true;
   };
+  // Samples that cannot be deserialized are dropped: said once when the first comes, and the
+  // count when echo ends.
+  std::uint64_t malformed = 0;
+  bool malformed_reported = false;
+  auto report_malformed = [&] {
+    if (malformed == 0 || malformed_reported) return;
+    std::fprintf(o.err,
+                 "craneassist echo: %s: dropped a malformed sample (cannot be deserialized); "
+                 "echo goes on\n",
+                 std::string(topic.dds_name).c_str());
+    std::fflush(o.err);
+    malformed_reported = true;
+  };
+  struct ReportAtEnd {
+    const EchoOptions& o;
+    const TopicInfo& topic;
+    const std::uint64_t& malformed;
+    ~ReportAtEnd() {
+      if (malformed == 0) return;
+      std::fprintf(o.err, "craneassist echo: %s: %llu malformed samples dropped\n",
+                   std::string(topic.dds_name).c_str(), static_cast<unsigned long long>(malformed));
+      std::fflush(o.err);
+    }
+  } report_at_end{o, topic, malformed};
   while (!stop_requested()) {
     report_discovery();
-    while (!stop_requested() &&
-           reader.reader().take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data) continue;
+    while (!stop_requested() && take_next_valid(reader.reader(), &sample, info, malformed)) {
+      report_malformed();
       report_discovery();
       if (o.format == EchoFormat::kCsv) {
         csv.write(sample);
@@ -340,6 +364,7 @@ int echo_topic(const TopicInfo& topic, const EchoOptions& o) {
       ++printed;
       if (o.count > 0 && printed >= o.count) return kToolOk;
     }
+    report_malformed();
     double wait_s = 0.1;
     if (printed == 0 && o.timeout_s > 0.0) {
       const double left = o.timeout_s - session->elapsed_s();

@@ -10,7 +10,7 @@
 #include <mutex>
 #include <stdexcept>
 
-#include "craneassist_msgsPubSubTypes.h"
+#include "checked_types.hpp"
 #include "craneassist_msgsTypeObject.h"
 
 namespace craneassist::dds {
@@ -103,11 +103,14 @@ ParticipantPtr make_participant(const ParticipantOptions& options) {
                       "certificates, the key, and that governance and permissions are signed by "
                       "the permissions CA; Fast DDS logs the reason above)");
   }
-  register_type<craneassist::msg::StatusPubSubType>(*p);
-  register_type<craneassist::msg::JointStatePubSubType>(*p);
-  register_type<craneassist::msg::HydraulicsPubSubType>(*p);
-  register_type<craneassist::msg::CommandPathPubSubType>(*p);
-  register_type<craneassist::msg::OperatorCommandPubSubType>(*p);
+  if (!options.register_types) return p;
+  // Every reader of the participant deserializes with these: a malformed sample is dropped and
+  // counted, never an exception on Fast DDS's thread (checked_types.hpp).
+  register_type<CheckedPubSubType<craneassist::msg::StatusPubSubType>>(*p);
+  register_type<CheckedPubSubType<craneassist::msg::JointStatePubSubType>>(*p);
+  register_type<CheckedPubSubType<craneassist::msg::HydraulicsPubSubType>>(*p);
+  register_type<CheckedPubSubType<craneassist::msg::CommandPathPubSubType>>(*p);
+  register_type<CheckedPubSubType<craneassist::msg::OperatorCommandPubSubType>>(*p);
   return p;
 }
 

@@ -21,6 +21,9 @@ struct ParticipantOptions {
   // Non-empty: the participant authenticates with PKI-DH, checks access with signed governance
   // and permissions, and encrypts as governance says (every file must be given).
   config::SecurityFiles security;
+  // false: no craneassist type is registered (a test's raw writer registers its own under the
+  // same name).
+  bool register_types = true;
 };
 
 ParticipantOptions participant_options(const config::TelemetryConfig& c);
@@ -33,8 +36,8 @@ using ParticipantPtr =
     std::unique_ptr<eprosima::fastdds::dds::DomainParticipant, ParticipantDeleter>;
 
 // Creates the participant and registers every craneassist type on it (with type objects, so
-// remote tools get the type information). Throws std::runtime_error naming what failed (with
-// security: which file, when Fast DDS says).
+// remote tools get the type information), unless options.register_types is false. Throws
+// std::runtime_error naming what failed (with security: which file, when Fast DDS says).
 ParticipantPtr make_participant(const ParticipantOptions& options);
 
 // The topic of `topic` on the participant (created on first use).

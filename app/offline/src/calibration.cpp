@@ -154,6 +154,7 @@ SectionCalibration calibrate_section(const config::CraneConfig& config, int sect
       control::LoopOptions loop;
       loop.period_s = period;
       loop.max_cycles = settle_cycles + measure_cycles + 1;
+      loop.stop_at_end = false;  // one level of the sweep on the simulator: the next continues
       loop.observers = {&probe};
       control::run_control_loop(task, machine, loop);
       const SweepPoint point = probe.point();

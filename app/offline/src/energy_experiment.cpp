@@ -102,7 +102,7 @@ void write_energy_csv(std::ostream& out, const std::vector<EnergyRun>& runs) {
          "peak_power_w,penalised_stages,pump_saturated_cycles,plan_time_s\n";
   char line[512];
   for (const auto& r : runs) {
-    std::snprintf(line, sizeof line, "%s,%s,%s,%s,%.1f,%.1f,%.5f,%.5f,%.1f,%d,%d,%.3f\n",
+    std::snprintf(line, sizeof line, "%s,%s,%s,%s,%.1f,%.1f,%.5f,%.5f,%.1f,%d,%ld,%.3f\n",
                   r.path.c_str(), r.start.c_str(), r.method.c_str(), r.system.c_str(), r.energy_j,
                   r.model_energy_j, r.max_tip_error_m, r.rms_tip_error_m, r.peak_power_w,
                   r.penalised_stages, r.pump_saturated_cycles, r.plan_time_s);

@@ -4,15 +4,18 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "craneassist/control/control_loop.hpp"
+
 namespace craneassist::offline {
 
 planner::TipSamples sample_path(const input::PrescribedPath& path, double dt_s) {
   if (!(dt_s > 0.0)) throw std::invalid_argument("the planner's time step must be positive");
   planner::TipSamples s;
   s.dt_s = dt_s;
-  const int n = std::max(1, static_cast<int>(std::ceil(path.duration_s() / dt_s - 1e-9)));
-  for (int k = 0; k <= n; ++k) {
-    const auto point = path.at(path.start_time_s() + k * dt_s);
+  const long n =
+      std::max(1L, control::run_cycles(std::ceil(path.duration_s() / dt_s - 1e-9), "the path"));
+  for (long k = 0; k <= n; ++k) {
+    const auto point = path.at(path.start_time_s() + static_cast<double>(k) * dt_s);
     s.p_m.push_back(point.p_m);
     s.v_m_s.push_back(point.v_m_s);
     s.a_m_s2.push_back(point.a_m_s2);

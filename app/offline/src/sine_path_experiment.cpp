@@ -141,7 +141,7 @@ class PowerLimitedCycles final : public control::CycleObserver {
   void on_cycle(const control::CycleRecord& c) noexcept override {
     cycles += c.state.pump.limit == valves::PumpLimit::kPower;
   }
-  int cycles = 0;
+  long cycles = 0;
 };
 
 }  // namespace
@@ -155,7 +155,8 @@ SinePathSummary run_sine_path(const config::CraneConfig& config, const SinePathO
   PowerLimitedCycles power_limited;
   control::LoopOptions loop;
   loop.period_s = period;
-  loop.max_cycles = std::lround(options.duration_s / period);
+  loop.max_cycles = control::run_cycles(std::round(options.duration_s / period), "the duration");
+  loop.stop_at_end = false;  // the paper's fixed-length run on the simulated arm, as published
   loop.log = log;
   loop.observers = {&statistics, &power_limited};
   const control::RunSummary s = statistics.summary(control::run_control_loop(task, machine, loop));

@@ -66,11 +66,20 @@ JoystickConfig read_config(const Reader& r, const YAML::Node& root, std::string_
   c.name = r.text(root, "name", "");
 
   const YAML::Node in = r.child(root, "input", "");
-  r.check_keys(in, "input", {"stale_timeout", "max_speed"});
+  r.check_keys(in, "input", {"stale_timeout", "max_speed", "deadman_hold", "stop_latch"});
   c.monitor.stale_timeout_s =
       r.value(in, "stale_timeout", "input", Dimension::kTime, 0.005, 2.0, "5 ms to 2 s");
   c.monitor.max_speed_m_s =
       r.value(in, "max_speed", "input", Dimension::kVelocity, 0.01, 5.0, "0.01 to 5 m/s");
+  // Optional (files written before these rules get the defaults).
+  if (in["deadman_hold"].IsDefined()) {
+    c.monitor.deadman_hold_s =
+        r.value(in, "deadman_hold", "input", Dimension::kTime, 0.0, 2.0, "0 to 2 s");
+  }
+  if (in["stop_latch"].IsDefined()) {
+    c.monitor.stop_latch_s =
+        r.value(in, "stop_latch", "input", Dimension::kTime, 0.0, 10.0, "0 to 10 s");
+  }
 
   const YAML::Node js = r.child(root, "joystick", "");
   r.check_keys(js, "joystick", {"frame", "slew", "deadman", "min_radius", "device", "axes"});

@@ -95,7 +95,11 @@ struct CanBackend::Impl {
     CanFrame block_frame;                    // preencoded
     CanFrame command_frame;
     bool seen = false;
+    // The newest position frame: its receive stamp (CLOCK_REALTIME, the kernel's; for the
+    // velocity estimate and the log) and when read() took it (CLOCK_MONOTONIC; for freshness,
+    // so a wall-clock step neither hides lost feedback nor fakes it).
     TimestampUs last_position_us = 0;
+    std::int64_t last_position_mono_us = 0;
     double q = 0.0, qdot = 0.0, pa = 0.0, pb = 0.0;
   };
 
@@ -118,7 +122,7 @@ struct CanBackend::Impl {
   // Pump measurements (when the mapping has them): control thread only.
   PumpMapping pump_map;
   double pump_pressure_pa = 0.0, pump_flow_m3_s = 0.0, pump_energy_j = 0.0;
-  TimestampUs pump_last_us = 0;         // newest pump frame
+  std::int64_t pump_last_us = 0;        // newest pump frame, taken (CLOCK_MONOTONIC)
   std::int64_t pump_integrated_us = 0;  // mono time of the last energy step
   // The heartbeat (when the mapping has one): control thread only.
   std::optional<HeartbeatSpec> heartbeat;
@@ -297,6 +301,8 @@ CanBackendCounters CanBackend::counters() const {
 valves::BackendStatus CanBackend::read(valves::MachineState& state) {
   Impl& m = *impl_;
   const int n = static_cast<int>(m.joints.size());
+  // Frames waiting now arrived since the last read (at most a cycle ago): they are fresh now.
+  const std::int64_t taken_us = mono_us();
   for (int k = 0; k < kMaxDrainPerRead; ++k) {
     m.transport.receive(m.rx);
     if (m.rx.kind == ReceiveKind::kNone) break;
@@ -339,8 +345,9 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
                 j.map.name.c_str(), f.id, static_cast<unsigned>(f.dlc), to_string(st));
           continue;
         }
-        if (j.seen && m.rx.timestamp_us > j.last_position_us) {
-          const double dt = static_cast<double>(m.rx.timestamp_us - j.last_position_us) * 1e-6;
+        // The velocity from the kernel's stamps, unless a wall-clock step lies between them.
+        const double dt = static_cast<double>(m.rx.timestamp_us - j.last_position_us) * 1e-6;
+        if (j.seen && dt > 0.0 && dt < 1.0) {
           const double rate = (value - j.q) / dt;
           const double a = dt / (m.options.velocity_filter_s + dt);
           j.qdot += a * (rate - j.qdot);
@@ -348,6 +355,7 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
         j.q = value;
         j.seen = true;
         j.last_position_us = m.rx.timestamp_us;
+        j.last_position_mono_us = taken_us;
       }
       for (int side = 0; side < 2; ++side) {
         const auto& spec = side == 0 ? j.map.pressure_a : j.map.pressure_b;
@@ -374,25 +382,25 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
         continue;
       }
       (which == 0 ? m.pump_pressure_pa : m.pump_flow_m3_s) = value;
-      m.pump_last_us = m.rx.timestamp_us;
+      m.pump_last_us = taken_us;
     }
     if (!known) m.counters.unknown_frames.fetch_add(1, std::memory_order_relaxed);
   }
 
-  const TimestampUs now = realtime_now_us();
-  const auto timeout_us = static_cast<TimestampUs>(m.options.feedback_timeout_s * 1e6);
+  const std::int64_t now = mono_us();
+  const auto timeout_us = static_cast<std::int64_t>(m.options.feedback_timeout_s * 1e6);
   bool fresh = true;
   state.q.resize(n);
   state.qdot.resize(n);
   state.load_pressure_pa.resize(n);
   for (int i = 0; i < n; ++i) {
     auto& j = m.joints[static_cast<std::size_t>(i)];
-    const bool stale = !j.seen || now - j.last_position_us > timeout_us;
+    const bool stale = !j.seen || now - j.last_position_mono_us > timeout_us;
     if (stale) {
       fresh = false;
       if (enabled() && j.seen) {
         latch(FaultReason::kFeedbackLost, "joint %s: no position frame for %.0f ms",
-              j.map.name.c_str(), static_cast<double>(now - j.last_position_us) * 1e-3);
+              j.map.name.c_str(), static_cast<double>(now - j.last_position_mono_us) * 1e-3);
       } else if (enabled()) {
         latch(FaultReason::kFeedbackLost, "joint %s: no position frame yet", j.map.name.c_str());
       }
@@ -408,13 +416,13 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
   return state.valid ? valves::BackendStatus::kOk : valves::BackendStatus::kNoData;
 }
 
-void CanBackend::read_pump(valves::PumpMeasurement& pump, std::int64_t now_rt_us,
+void CanBackend::read_pump(valves::PumpMeasurement& pump, std::int64_t now_mono_us,
                            std::int64_t timeout_us) {
   // Measured when the mapping has pump signals and they are fresh; unmeasured: zeros.
   Impl& m = *impl_;
   pump = valves::PumpMeasurement{};
   const std::int64_t mono = mono_us();
-  const bool fresh = m.pump_last_us != 0 && now_rt_us - m.pump_last_us <= timeout_us;
+  const bool fresh = m.pump_last_us != 0 && now_mono_us - m.pump_last_us <= timeout_us;
   if (fresh) {
     pump.pressure_pa = m.pump_pressure_pa;
     pump.flow_m3_s = m.pump_flow_m3_s;

@@ -1,9 +1,11 @@
 // A replay file as a live CommandSource (`craneassist sim --input replay FILE`, tests): the
 // command at the loop's clock since the first cycle, stamped with that clock. The scripted
 // operator holds the deadman, releasing it for the first cycle only, so the input monitor arms
-// as it would for a person pressing the button after start-up. A stop row (docs/replay-format.md)
-// is played as the deadman released with a zero command: the monitor stops the crane (valves
-// neutral once at rest) and the next row re-arms it, as a person releasing and pressing again.
+// as it would for a person pressing the button after start-up (the command passes once the
+// deadman has been held for the monitor's deadman_hold). A stop row (docs/replay-format.md) is
+// played as the deadman released with a zero command: the monitor stops the crane (valves
+// neutral once at rest) and the next row re-arms it, as a person releasing and pressing again
+// (the motion resumes after the monitor's stop_latch and deadman_hold).
 #pragma once
 
 #include "craneassist/input/command_source.hpp"

@@ -71,6 +71,9 @@ struct CycleRecord {
   const LogRow& row;
   CycleStatus status;
   const ControllerOutput* controller;  // CycleTask::controller_output()
+  // The loop's stop in progress ("operator quit", "machine fault", "end of run"); nullptr while
+  // the run goes on.
+  const char* stop_cause = nullptr;
 };
 
 // Something that watches the loop cycle by cycle (statistics, DDS telemetry, recording, a test
@@ -90,8 +93,14 @@ class CycleObserver {
 struct LoopOptions {
   double period_s = 0.01;
   double t0_s = 0.0;  // machine time of cycle 0
-  // Cycles to run at most; a stop request may end the run earlier.
+  // The run's length in cycles; a stop request may end it earlier. When the run reaches it with
+  // the machine not stopped, the loop stops it as for a stop request (cause "end of run"): a
+  // jerk-limited stop, then the task's neutral valves, or safe_stop() after stop_settle_max_s.
+  // Build it with run_cycles().
   long max_cycles = 0;
+  // false: the run just ends at max_cycles (a segment of a study on the simulator that the next
+  // segment continues, e.g. one level of a valve calibration sweep).
+  bool stop_at_end = true;
   // true: paced at the period on CLOCK_MONOTONIC (absolute clock_nanosleep, as cyclictest), the
   // input clock is steady_clock; false: as fast as possible, the input clock is machine time.
   bool realtime = false;
@@ -122,11 +131,22 @@ struct LoopSummary {
   // stopped as for a stop request (stop reason "machine fault").
   bool machine_fault = false;
   bool stop_requested = false;  // by the stop flag or a fault
+  bool end_stop = false;        // the run reached max_cycles and the loop stopped the machine
+  long stop_cycles = 0;         // cycles from the stop (request or end of run) to the run's end
   // The task did not bring the machine to rest within stop_settle_max_s of the stop request:
   // the loop called MachineInterface::safe_stop().
   bool safe_stopped = false;
   std::size_t log_rows_dropped = 0;
 };
+
+// The most cycles a run may have (about 317 years at 100 Hz): a bound that keeps every count in
+// range; the files a run reads bound their times far lower (docs/safety.md).
+inline constexpr long kMaxRunCycles = 1'000'000'000'000;
+
+// `cycles` (a count computed in floating point, e.g. from a duration and a period) as a run
+// length. Throws std::invalid_argument naming `what` when it is not finite, negative or above
+// kMaxRunCycles (before any conversion: no undefined behaviour on 1e30 or NaN).
+long run_cycles(double cycles, const char* what);
 
 // Runs the task on the machine: task.start() with the first measurement, then the cycles.
 // Closes the log at the end.

@@ -77,19 +77,23 @@ struct LiveOptions {
 };
 
 struct LiveSummary {
-  int cycles = 0;
+  long cycles = 0;
   double duration_s = 0.0;   // machine time
   double wall_time_s = 0.0;  // computer time
   double max_late_s = 0.0;   // realtime: the latest a cycle started after its tick
   double peak_tip_speed_m_s = 0.0;
   double tip_path_m = 0.0;
-  int enabled_cycles = 0;  // cycles the operator's command passed the monitor
+  long enabled_cycles = 0;  // cycles the operator's command passed the monitor
   int disconnects = 0, reconnects = 0;
   std::size_t log_rows_dropped = 0;
   std::size_t record_rows_dropped = 0;
   // The machine reported a fault (BackendStatus::kFault, e.g. a latched CAN fault): the loop
   // stopped as for a stop request (stop reason "machine fault").
   bool machine_fault = false;
+  // How the run ended: its duration reached with the crane moving (end_stop) or a stop request;
+  // the loop's stop took stop_cycles cycles (jerk-limited, then neutral valves).
+  bool end_stop = false;
+  long stop_cycles = 0;
   RealtimeResult realtime_result;  // what the system granted of LiveOptions::realtime_setup
   CycleTiming timing;              // start latency, compute time, overruns (cycle_timing.hpp)
 };

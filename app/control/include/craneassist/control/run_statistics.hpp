@@ -22,7 +22,7 @@ struct RunStatisticsOptions {
 };
 
 struct RunSummary {
-  int cycles = 0;
+  long cycles = 0;
   double duration_s = 0.0;   // machine time
   double wall_time_s = 0.0;  // computer time
   double energy_j = 0.0;
@@ -33,16 +33,20 @@ struct RunSummary {
   // Angle between commanded and measured tip velocity (steady cycles, see RunStatisticsOptions).
   double max_direction_error_deg = 0.0;
   double rms_direction_error_deg = 0.0;
-  int direction_samples = 0;
+  long direction_samples = 0;
   // Angle between commanded and reference tip velocity (what the controller asked for).
   double max_reference_direction_error_deg = 0.0;
-  int pump_saturated_cycles = 0;
-  double peak_path_jerk = 0.0;   // max |sdddot| of the reference (full scaling)
-  int stopped_cycles = 0;        // the controller stopping or stopped (kStopping, kStopped)
-  int input_stop_cycles = 0;     // cycles without a command (a replay stop row, an input fault)
-  int neutral_valve_cycles = 0;  // kStopped: at rest with every valve neutral
-  std::array<int, scaling::kActiveLimitCount> limit_cycles{};  // indexed by scaling::ActiveLimit
-  bool machine_fault = false;                                  // the loop stopped for it
+  long pump_saturated_cycles = 0;
+  double peak_path_jerk = 0.0;    // max |sdddot| of the reference (full scaling)
+  long stopped_cycles = 0;        // the controller stopping or stopped (kStopping, kStopped)
+  long input_stop_cycles = 0;     // cycles without a command (a replay stop row, an input fault)
+  long neutral_valve_cycles = 0;  // kStopped: at rest with every valve neutral
+  std::array<long, scaling::kActiveLimitCount> limit_cycles{};  // indexed by scaling::ActiveLimit
+  bool machine_fault = false;                                   // the loop stopped for it
+  // The run reached its end moving and the loop stopped it (jerk-limited, then neutral valves)
+  // in stop_cycles cycles; also set for a stop request (quit, fault) that ended the run.
+  bool end_stop = false;
+  long stop_cycles = 0;
   std::size_t log_rows_dropped = 0;
   MotionQualityResult feel;  // stall events and lateral speed (motion_quality.hpp)
 };

@@ -21,15 +21,15 @@ struct TrajectoryRunOptions {
 };
 
 struct TrajectoryRunSummary {
-  int cycles = 0;
+  long cycles = 0;
   double duration_s = 0.0, wall_time_s = 0.0;
   double energy_j = 0.0;  // pump energy measured by the backend
   double peak_power_w = 0.0, peak_flow_m3_s = 0.0;
   // Measured tip against the plan's tip at the same time.
   double max_tip_error_m = 0.0, rms_tip_error_m = 0.0;
   double start_error_m = 0.0;  // tip distance between the machine and the plan at the start
-  int pump_saturated_cycles = 0;
-  int invalid_state_cycles = 0;  // cycles without a valid measurement (valves neutral)
+  long pump_saturated_cycles = 0;
+  long invalid_state_cycles = 0;  // cycles without a valid measurement (valves neutral)
   std::size_t log_rows_dropped = 0;
 };
 

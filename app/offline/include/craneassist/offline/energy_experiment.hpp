@@ -33,7 +33,7 @@ struct EnergyRun {
   double max_tip_error_m = 0.0, rms_tip_error_m = 0.0;
   double peak_power_w = 0.0;
   int penalised_stages = 0;  // stages of the plan that violate a cylinder limit
-  int pump_saturated_cycles = 0;
+  long pump_saturated_cycles = 0;
   double plan_time_s = 0.0;  // planning wall time (the DP's backward phase is shared by starts)
 };
 

@@ -26,11 +26,11 @@ struct SinePathOptions {
 };
 
 struct SinePathSummary {
-  int cycles = 0;
+  long cycles = 0;
   double s_final = 0.0;
   double peak_pump_power_w = 0.0;        // measured by the simulated pump
   double peak_planned_ls_power_w = 0.0;  // LS power of the reference, from the model
-  int cycles_power_limited = 0;          // the pump's power limiter held the flow back
+  long cycles_power_limited = 0;         // the pump's power limiter held the flow back
   double peak_path_jerk = 0.0;
   double energy_j = 0.0;
 };

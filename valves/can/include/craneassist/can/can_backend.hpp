@@ -120,7 +120,7 @@ class CanBackend final : public valves::MachineInterface {
   enum : int { kClear = 0, kLatching = 1, kLatched = 2 };
   void latch(FaultReason reason, const char* fmt, ...);
   void send_heartbeat(std::int64_t now_us, std::int64_t now_rt_us);
-  void read_pump(valves::PumpMeasurement& pump, std::int64_t now_rt_us, std::int64_t timeout_us);
+  void read_pump(valves::PumpMeasurement& pump, std::int64_t now_mono_us, std::int64_t timeout_us);
   void watchdog_loop();
   void log_loop();
 
