@@ -1,12 +1,12 @@
 // DDS samples (app/dds/idl/craneassist_msgs.idl): bytes as a DataReader receives them, for every
-// topic type, through the generated type support's deserialize (the first input byte picks the
+// topic type, through the type support every craneassist reader registers (checked_types.hpp: the
+// generated one, never throwing, with the IDL's bounds checked; the first input byte picks the
 // type, the rest is the serialized payload with its encapsulation). A sample that deserializes is
 // handed to what consumes it: `craneassist echo` (text and CSV), the dashboard's view, and for
 // the operator's command the input monitor of the DDS command input. Serialized again it gives
 // bytes that deserialize to a sample that serializes to the same bytes.
 //
 // Plain C++17, like the dds module (Debian's Fast CDR headers are not C++20-clean).
-#include <fastcdr/exceptions/BadParamException.h>
 #include <fastrtps/rtps/common/SerializedPayload.h>
 
 #include <cmath>
@@ -16,6 +16,7 @@
 #include <cstring>
 #include <vector>
 
+#include "checked_types.hpp"
 #include "craneassist/input/input_monitor.hpp"
 #include "craneassist_msgsPubSubTypes.h"
 #include "fuzz_check.hpp"
@@ -32,22 +33,14 @@ std::FILE* null_out() {
   return out;
 }
 
-// The bytes into the type's deserialize. False when the type support refuses them.
+// The bytes into the readers' deserialize. False when it refuses them (never an exception).
 template <typename PubSubType, typename T>
 bool deserialize(const std::uint8_t* data, std::size_t size, T& sample) {
-  PubSubType type;
+  dds::CheckedPubSubType<PubSubType> type;
   SerializedPayload_t payload(static_cast<std::uint32_t>(size));
   if (size > 0) std::memcpy(payload.data, data, size);
   payload.length = static_cast<std::uint32_t>(size);
-  try {
-    return type.deserialize(&payload, &sample);
-  } catch (const eprosima::fastcdr::exception::BadParamException&) {
-    // TODO(dds module, malformed samples): the generated deserialize lets Fast CDR's
-    // BadParamException (a boolean byte other than 0 or 1, an unknown encapsulation) escape; the
-    // dds module's fix for that bug will give a deserialize function that reports a malformed
-    // sample instead of throwing. Call that here instead of catching, once it exists.
-    return false;
-  }
+  return type.deserialize(&payload, &sample);
 }
 
 template <typename PubSubType, typename T>
