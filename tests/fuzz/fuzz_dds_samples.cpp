@@ -22,7 +22,6 @@
 #include "fuzz_check.hpp"
 #include "sample_views.hpp"
 
-namespace dds = craneassist::dds;
 namespace msg = craneassist::msg;
 using eprosima::fastrtps::rtps::SerializedPayload_t;
 
@@ -36,7 +35,7 @@ std::FILE* null_out() {
 // The bytes into the readers' deserialize. False when it refuses them (never an exception).
 template <typename PubSubType, typename T>
 bool deserialize(const std::uint8_t* data, std::size_t size, T& sample) {
-  dds::CheckedPubSubType<PubSubType> type;
+  craneassist::dds::CheckedPubSubType<PubSubType> type;
   SerializedPayload_t payload(static_cast<std::uint32_t>(size));
   if (size > 0) std::memcpy(payload.data, data, size);
   payload.length = static_cast<std::uint32_t>(size);
@@ -65,16 +64,16 @@ template <typename PubSubType, typename T>
 void check_topic(const std::uint8_t* data, std::size_t size) {
   T sample;
   if (!deserialize<PubSubType>(data, size, sample)) return;
-  dds::echo_sample(sample, dds::EchoFormat::kText, null_out());
-  dds::echo_sample(sample, dds::EchoFormat::kCsv, null_out());
+  craneassist::dds::echo_sample(sample, craneassist::dds::EchoFormat::kText, null_out());
+  craneassist::dds::echo_sample(sample, craneassist::dds::EchoFormat::kCsv, null_out());
   if constexpr (std::is_same_v<T, msg::Status>) {
-    (void)dds::dashboard_view(&sample, nullptr, nullptr, nullptr);
+    (void)craneassist::dds::dashboard_view(&sample, nullptr, nullptr, nullptr);
   } else if constexpr (std::is_same_v<T, msg::JointState>) {
-    (void)dds::dashboard_view(nullptr, &sample, nullptr, nullptr);
+    (void)craneassist::dds::dashboard_view(nullptr, &sample, nullptr, nullptr);
   } else if constexpr (std::is_same_v<T, msg::Hydraulics>) {
-    (void)dds::dashboard_view(nullptr, nullptr, &sample, nullptr);
+    (void)craneassist::dds::dashboard_view(nullptr, nullptr, &sample, nullptr);
   } else if constexpr (std::is_same_v<T, msg::CommandPath>) {
-    (void)dds::dashboard_view(nullptr, nullptr, nullptr, &sample);
+    (void)craneassist::dds::dashboard_view(nullptr, nullptr, nullptr, &sample);
   } else if constexpr (std::is_same_v<T, msg::OperatorCommand>) {
     // What the DDS command input passes on (DdsCommandSource::poll) through the input monitor.
     craneassist::input::InputMonitor monitor(craneassist::input::InputMonitorSettings{});
