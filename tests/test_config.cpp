@@ -1,6 +1,7 @@
 // Config loading: the shipped models, and every kind of error naming file, line and field.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <fstream>
 #include <string>
 
@@ -243,6 +244,30 @@ TEST(CraneConfig, MissingFileIsReported) {
     EXPECT_EQ(e.file(), "/nonexistent/crane.yaml");
     EXPECT_EQ(e.line(), 0);
   }
+}
+
+// A config is read with the YAML files' bound (1 MiB): a larger file, or one without an end
+// (/dev/zero), is refused naming the file, not read until the memory runs out.
+TEST(CraneConfig, AFileOverTheSizeLimitIsRefused) {
+  const std::string big = ::testing::TempDir() + "craneassist_big_crane.yaml";
+  {
+    std::ofstream out(big, std::ios::binary);
+    out << read_file(kK70mPath);
+    while (out.tellp() <= static_cast<std::streamoff>(1 << 20)) {
+      out << "# a comment line that makes the file larger than the limit\n";
+    }
+  }
+  for (const std::string& file : {big, std::string("/dev/zero")}) {
+    try {
+      craneassist::config::load_crane_config(file);
+      ADD_FAILURE() << "accepted " << file;
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(std::string(e.what()),
+                file + ": larger than 1 MiB (the limit for crane config files)");
+      EXPECT_EQ(e.line(), 0);
+    }
+  }
+  std::remove(big.c_str());
 }
 
 TEST(CraneConfig, PayloadMassCanBeSet) {

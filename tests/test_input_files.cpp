@@ -3,6 +3,7 @@
 // style, in every format. The formats' own rules are in test_replay.cpp,
 // test_prescribed_path.cpp and test_joint_trajectory.cpp.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <filesystem>
 #include <fstream>
@@ -10,8 +11,10 @@
 #include <random>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <vector>
 
+#include "craneassist/files/text_file.hpp"
 #include "craneassist/input/file_error.hpp"
 #include "craneassist/input/joint_trajectory.hpp"
 #include "craneassist/input/prescribed_path.hpp"
@@ -212,7 +215,7 @@ TEST(InputFiles, UnreadableFilesAreLineZero) {
       f.load(missing);
       ADD_FAILURE() << "accepted";
     } catch (const FileError& e) {
-      EXPECT_EQ(std::string(e.what()), missing.string() + ":0: file not found");
+      EXPECT_EQ(std::string(e.what()), missing.string() + ": file not found");
       EXPECT_EQ(e.line(), 0u);
       EXPECT_EQ(e.field(), "");
     }
@@ -244,6 +247,71 @@ TEST(InputFiles, ErrorsInAFileNameThePath) {
     }
   }
   fs::remove(file);
+}
+
+// Every input file is read with a bound (craneassist/files/text_file.hpp, 64 MiB for the CSV
+// formats): a larger regular file is refused by its size, and a file that states no size
+// (/dev/zero) one byte past the bound, instead of the reader growing until the memory runs out.
+TEST(InputFiles, AFileOverTheSizeLimitIsRefused) {
+  const fs::path big = fs::temp_directory_path() /
+                       ("craneassist_test_big_" + std::to_string(std::random_device{}()) + ".csv");
+  {
+    std::ofstream out(big, std::ios::binary);
+    out << "t,v_x,v_y,v_z\n0,0,0,0\n";
+  }
+  fs::resize_file(big, files::kMaxCsvBytes + 1);  // sparse: no 64 MiB written
+  for (const Format& f : formats()) {
+    SCOPED_TRACE(f.name);
+    const std::string kind = f.name == "replay" ? "replay"
+                             : f.name == "path" ? "tip path"
+                                                : "joint trajectory";
+    for (const fs::path& file : {big, fs::path("/dev/zero")}) {
+      try {
+        f.load(file);
+        ADD_FAILURE() << "accepted " << file;
+      } catch (const FileError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  file.string() + ": larger than 64 MiB (the limit for " + kind + " files)");
+        EXPECT_EQ(e.line(), 0u);
+      }
+    }
+  }
+  fs::remove(big);
+}
+
+// The bounded read itself: a file of the limit's size is read, one byte more is not; a FIFO
+// states no size, and what its writer sends is read up to the bound.
+TEST(InputFiles, TheBoundedReadStopsOneBytePastTheLimit) {
+  const std::string name = "craneassist_test_bound_" + std::to_string(std::random_device{}());
+  const fs::path at_limit = fs::temp_directory_path() / (name + ".csv");
+  {
+    std::ofstream out(at_limit, std::ios::binary);
+    out << "t,v_x,v_y,v_z\n0,0,0,0\n";
+    out << std::string(1000 - 22, '\n');
+  }
+  EXPECT_EQ(files::read_text_file(at_limit, 1000, "test").size(), 1000u);
+  EXPECT_THROW(files::read_text_file(at_limit, 999, "test"), files::ReadError);
+  EXPECT_EQ(Replay::load_file(at_limit).rows().size(), 1u);
+  fs::remove(at_limit);
+
+  const fs::path fifo = fs::temp_directory_path() / (name + ".fifo");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const auto send = [&](std::string text) {
+    return std::thread([&fifo, text] { std::ofstream(fifo, std::ios::binary) << text; });
+  };
+  std::thread writer = send("t,v_x,v_y,v_z\n0,0.1,0,0\n1,0,0,0\n");
+  EXPECT_EQ(Replay::load_file(fifo).rows().size(), 2u);
+  writer.join();
+  writer = send(std::string(2000, 'x'));  // fits the pipe's buffer: the writer never blocks
+  try {
+    files::read_text_file(fifo, 1000, "test");
+    ADD_FAILURE() << "accepted";
+  } catch (const files::ReadError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              fifo.string() + ": larger than 1000 bytes (the limit for test files)");
+  }
+  writer.join();
+  fs::remove(fifo);
 }
 
 }  // namespace

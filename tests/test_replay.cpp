@@ -261,7 +261,7 @@ TEST(ReplayFile, MissingFileIsLineZero) {
   } catch (const FileError& e) {
     EXPECT_EQ(e.line(), 0u);
     EXPECT_EQ(e.field(), "");
-    EXPECT_EQ(std::string(e.what()), missing.string() + ":0: file not found");
+    EXPECT_EQ(std::string(e.what()), missing.string() + ": file not found");
   }
 }
 

@@ -24,7 +24,7 @@ set(GRAPHVIZ_IGNORE_TARGETS "^test_;^bench_;^socketcan_smoke$;^can_backend_check
 # Rooms, for the drawing: which folder holds each target.
 ROOMS = [
     ("app", ["craneassist", "control", "offline", "dds"]),
-    ("input", ["input", "input_devices"]),
+    ("input", ["input", "input_devices", "files"]),
     ("config", ["config", "joystick_config"]),
     ("valves", ["valves", "can", "can_backend"]),
     ("dynamics", ["dynamics", "planner"]),

@@ -9,7 +9,7 @@
 
 #include "crane_options.hpp"
 #include "craneassist/config/crane_config.hpp"
-#include "craneassist/config/yaml_reader.hpp"
+#include "craneassist/files/text_file.hpp"
 #include "craneassist/offline/path_bound.hpp"
 #include "exit_codes.hpp"
 
@@ -114,12 +114,18 @@ int run_bound_command(const BoundArgs& args) {
   try {
     cfg = load_crane(args.config_file);
     apply_crane_options(cfg, {.payload_kg = args.payload_kg, .resolution = args.resolution});
-    header = header_of(config::read_text_file(args.file));
+    std::string text;
+    try {  // read once, with the CSV formats' size limit; the header says which format it is
+      text = files::read_text_file(args.file, files::kMaxCsvBytes, "tip path and replay");
+    } catch (const files::ReadError& e) {
+      throw input::FileError(e.file(), 0, "", e.reason());
+    }
+    header = header_of(text);
     if (header == "t,x,y,z") {
       format = "path";
-      path = input::PrescribedPath::load_file(args.file);
+      path = input::PrescribedPath::parse(text, args.file);
     } else if (header == "t,v_x,v_y,v_z" || header == "t,v_x,v_y,v_z,stop") {
-      replay = input::Replay::load_file(args.file);
+      replay = input::Replay::parse(text, args.file);
     } else {
       spdlog::error("{}: header '{}': expected a tip path (t,x,y,z) or a replay (t,v_x,v_y,v_z)",
                     args.file, header);

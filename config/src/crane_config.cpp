@@ -497,7 +497,7 @@ CraneConfig parse_crane_config(std::string_view yaml_text, std::string_view sour
 }
 
 CraneConfig load_crane_config(const std::filesystem::path& path) {
-  return parse_crane_config(read_text_file(path), path.string());
+  return parse_crane_config(read_yaml_file(path, "crane config"), path.string());
 }
 
 CraneConfig default_crane_config() {

@@ -189,7 +189,8 @@ TelemetryConfig parse_telemetry_config(std::string_view yaml_text, std::string_v
 }
 
 TelemetryConfig load_telemetry_config(const std::filesystem::path& path) {
-  return parse_telemetry_config(read_text_file(path), path.string(), path.parent_path());
+  return parse_telemetry_config(read_yaml_file(path, "telemetry config"), path.string(),
+                                path.parent_path());
 }
 
 TelemetryConfig default_telemetry_config() {

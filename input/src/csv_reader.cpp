@@ -1,13 +1,10 @@
 #include "csv_reader.hpp"
 
 #include <algorithm>
-#include <array>
-#include <cerrno>
 #include <cmath>
-#include <fstream>
-#include <system_error>
 #include <utility>
 
+#include "craneassist/files/text_file.hpp"
 #include "text_fields.hpp"
 
 namespace craneassist::input::detail {
@@ -221,29 +218,12 @@ std::string_view header_line(std::string_view text) {
   return {};
 }
 
-std::string read_file_text(const std::filesystem::path& path) {
-  const std::string name = path.string();
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    throw FileError(name, 0, "", "cannot read file: is a directory");
+std::string read_file_text(const std::filesystem::path& path, std::string_view kind) {
+  try {
+    return files::read_text_file(path, files::kMaxCsvBytes, kind);
+  } catch (const files::ReadError& e) {
+    throw FileError(e.file(), 0, "", e.reason());
   }
-  errno = 0;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    const int open_errno = errno;
-    if (!std::filesystem::exists(path, ec) && !ec) throw FileError(name, 0, "", "file not found");
-    throw FileError(
-        name, 0, "",
-        "cannot open file" +
-            (open_errno != 0 ? ": " + std::generic_category().message(open_errno) : std::string()));
-  }
-  std::string text;
-  std::array<char, 1 << 16> buffer{};
-  while (in.read(buffer.data(), static_cast<std::streamsize>(buffer.size())) || in.gcount() > 0) {
-    text.append(buffer.data(), static_cast<std::size_t>(in.gcount()));
-  }
-  if (in.bad()) throw FileError(name, 0, "", "read error");
-  return text;
 }
 
 }  // namespace craneassist::input::detail

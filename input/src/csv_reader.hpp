@@ -79,8 +79,10 @@ std::string csv_header(const CsvFormat& format, std::size_t columns = std::strin
 // trimmed; empty when there is none.
 std::string_view header_line(std::string_view text);
 
-// The contents of a file. Throws FileError at line 0 when it cannot be read ("file not found",
-// "cannot open file: REASON", "cannot read file: is a directory", "read error").
-std::string read_file_text(const std::filesystem::path& path);
+// The contents of a file, at most files::kMaxCsvBytes (64 MiB): the bounded read of
+// craneassist/files/text_file.hpp. Throws FileError at line 0 when it cannot be read ("file not
+// found", "cannot open file: REASON", "cannot read file: is a directory", "read error: REASON")
+// or is larger ("larger than 64 MiB (the limit for replay files)"; `kind` names the format).
+std::string read_file_text(const std::filesystem::path& path, std::string_view kind);
 
 }  // namespace craneassist::input::detail

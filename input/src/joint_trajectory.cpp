@@ -40,7 +40,7 @@ JointTrajectory::JointTrajectory(int joints) : joints_(joints) {
 }
 
 JointTrajectory JointTrajectory::load_file(const std::filesystem::path& path) {
-  return parse(detail::read_file_text(path), path.string());
+  return parse(detail::read_file_text(path, "joint trajectory"), path.string());
 }
 
 JointTrajectory JointTrajectory::parse(std::string_view text, std::string_view source_name) {

@@ -246,7 +246,7 @@ PrescribedPath PrescribedPath::parse(std::string_view text, std::string_view sou
 }
 
 PrescribedPath PrescribedPath::load_file(const std::filesystem::path& path) {
-  return parse(detail::read_file_text(path), path.string());
+  return parse(detail::read_file_text(path, "tip path"), path.string());
 }
 
 void write_prescribed_path(std::ostream& out, const PrescribedPath& path,

@@ -58,7 +58,7 @@ Replay Replay::parse(std::string_view text, std::string_view source_name,
 }
 
 Replay Replay::load_file(const std::filesystem::path& path, const ReplayLimits& limits) {
-  return parse(detail::read_file_text(path), path.string(), limits);
+  return parse(detail::read_file_text(path, "replay"), path.string(), limits);
 }
 
 Eigen::Vector3d ReplayCursor::command_at(double t_s) noexcept {

@@ -1,6 +1,7 @@
 #!/bin/sh
 # A broken input file of each format (replay, tip path, joint trajectory), through every command
-# that reads it: exit code 2 and one message naming format, file, line and field.
+# that reads it, and a file over the size limit of each format: exit code 2 and one message
+# naming format, file, line and field.
 # Usage: bad_input_files.sh CRANEASSIST DATA_DIR WORKDIR
 set -u
 bin=$1 data=$2 work=$3
@@ -31,5 +32,29 @@ expect bound_replay "$replay" bound "$data/bad_replay.csv"
 expect plan_path "$path" plan "$data/bad_path.csv" --quiet --out "$work/plan.csv"
 expect bound_path "$path" bound "$data/bad_path.csv"
 expect trajectory "$trajectory" replay --trajectory "$data/bad_trajectory.csv" --no-log
+# Every file is read with its format's size bound (YAML 1 MiB, CSV 64 MiB): a file without an
+# end (/dev/zero) and a larger regular file (sparse, nothing written) are refused, not read
+# until the memory runs out.
+limit() { echo "$1: larger than $2 MiB (the limit for $3 files)"; }
+demo=$data/../../examples/replays/demo.csv
+expect zero_replay "replay: $(limit /dev/zero 64 replay)" replay /dev/zero --no-log
+expect zero_config "config: $(limit /dev/zero 1 'crane config')" replay --config /dev/zero --no-log
+expect zero_trajectory "trajectory: $(limit /dev/zero 64 'joint trajectory')" \
+  replay --trajectory /dev/zero --no-log
+expect zero_telemetry "config: $(limit /dev/zero 1 'telemetry config')" \
+  replay --telemetry-config /dev/zero --no-log
+expect zero_plan "path: $(limit /dev/zero 64 'tip path')" plan /dev/zero --quiet --out "$work/plan.csv"
+expect zero_bound "replay: $(limit /dev/zero 64 'tip path and replay')" bound /dev/zero
+expect zero_sim "replay: $(limit /dev/zero 64 replay)" sim --input replay /dev/zero --no-realtime
+expect zero_joystick "config: $(limit /dev/zero 1 'joystick mapping')" \
+  sim --input replay "$demo" --no-realtime --joystick /dev/zero
+expect zero_suite "$(limit /dev/zero 1 'suite manifest')" suite /dev/zero
+rm -f "$work/big.csv" "$work/big.yaml"
+truncate -s $((64 * 1024 * 1024 + 1)) "$work/big.csv"
+truncate -s $((1024 * 1024 + 1)) "$work/big.yaml"
+expect big_replay "replay: $(limit "$work/big.csv" 64 replay)" replay "$work/big.csv" --no-log
+expect big_config "config: $(limit "$work/big.yaml" 1 'crane config')" \
+  replay --config "$work/big.yaml" --no-log
+rm -f "$work/big.csv" "$work/big.yaml"
 [ "$failed" -eq 0 ] && echo "bad input files OK"
 exit "$failed"

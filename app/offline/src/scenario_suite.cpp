@@ -171,7 +171,8 @@ void check_suite(const Suite& suite, const config::CraneConfig& cfg) {
 }
 
 Suite load_suite(const std::filesystem::path& path) {
-  return parse_suite(config::read_text_file(path), path.string(), path.parent_path());
+  return parse_suite(config::read_yaml_file(path, "suite manifest"), path.string(),
+                     path.parent_path());
 }
 
 SuiteOutcome run_suite_run(const config::CraneConfig& base, const SuiteRun& run,

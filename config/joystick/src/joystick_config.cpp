@@ -147,7 +147,7 @@ JoystickConfig parse_joystick_config(std::string_view yaml_text, std::string_vie
 }
 
 JoystickConfig load_joystick_config(const std::filesystem::path& path) {
-  return parse_joystick_config(read_text_file(path), path.string());
+  return parse_joystick_config(read_yaml_file(path, "joystick mapping"), path.string());
 }
 
 JoystickConfig default_joystick_config() {

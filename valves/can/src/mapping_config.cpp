@@ -381,7 +381,7 @@ CanMapping parse_can_mapping(std::string_view yaml_text, std::string_view source
 }
 
 CanMapping load_can_mapping(const std::filesystem::path& path) {
-  return parse_can_mapping(config::read_text_file(path), path.string());
+  return parse_can_mapping(config::read_yaml_file(path, "CAN mapping"), path.string());
 }
 
 }  // namespace craneassist::can

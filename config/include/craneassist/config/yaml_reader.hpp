@@ -6,9 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
-#include <fstream>
 #include <initializer_list>
-#include <sstream>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -105,13 +103,10 @@ auto read_yaml(std::string_view yaml_text, std::string_view source_name, Read&& 
   }
 }
 
-// The whole file as text; ConfigError naming the file when it cannot be opened.
-inline std::string read_text_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(path.string(), 0, "", "cannot open the file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+// A YAML file's text, at most files::kMaxYamlBytes (1 MiB) of it: the bounded read of
+// craneassist/files/text_file.hpp. ConfigError naming the file (line 0) when it cannot be read or
+// is larger; `kind` names the file in that message ("crane config": "FILE: larger than 1 MiB (the
+// limit for crane config files)").
+std::string read_yaml_file(const std::filesystem::path& path, std::string_view kind);
 
 }  // namespace craneassist::config

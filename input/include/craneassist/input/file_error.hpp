@@ -11,7 +11,7 @@ namespace craneassist::input {
 
 // what() is "FILE:LINE: field 'NAME': REASON", or "FILE:LINE: REASON" when the problem is not tied
 // to one field. LINE is 1-based and counts every line of the file; 0 means the file could not be
-// read.
+// read (or is over its size limit), and what() is then "FILE: REASON", as config::ConfigError's.
 class FileError : public std::runtime_error {
  public:
   FileError(std::string file, std::size_t line, std::string field, std::string reason);
