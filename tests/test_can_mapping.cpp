@@ -182,6 +182,12 @@ TEST(CanMapping, ErrorsNameFileLineAndField) {
                  kPosition),
        7, "joints[0].position", "other direction"},
       {"format: craneassist-can-map/1\njoints: [\n", 3, "", "YAML syntax"},
+      // A repeated key (yaml-cpp keeps both, a lookup takes the first): at the second.
+      {file_with(kValve + "    position: {id: 0x101, start_bit: 0, length: 16, byte_order: intel,\n"
+                          "               scale: 0.01, unit: deg, scale: 1}\n"),
+       7, "joints[0].position.scale", "duplicate key (first at line 7)"},
+      {"format: craneassist-can-map/1\nformat: craneassist-can-map/1\njoints: []\n", 2, "format",
+       "duplicate key (first at line 1)"},
   };
   for (const Case& c : cases) {
     const ConfigError e = error_of(c.text);

@@ -7,6 +7,7 @@
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/config/quantity.hpp"
+#include "craneassist/config/yaml_reader.hpp"
 
 using craneassist::config::ConfigError;
 using craneassist::config::Dimension;
@@ -234,6 +235,37 @@ TEST(CraneConfig, YamlSyntaxErrorHasALine) {
   const auto e = error_after_edit("joints:\n", "joints: [\n");
   EXPECT_GT(e.line(), 0);
   EXPECT_NE(e.reason().find("YAML syntax"), std::string::npos);
+}
+
+// yaml-cpp keeps both entries of a repeated key and a lookup takes the first, so a second value
+// would be silently ignored: it is an error at the second, naming the first's line. At the top
+// level, in a section and in a list entry; an alias is not a repeat.
+TEST(CraneConfig, DuplicateKeysAreRejected) {
+  auto e = error_after_edit("  rate: 100 Hz, assumed\n",
+                            "  rate: 100 Hz, assumed\n  rate: 7 Hz, assumed\n");
+  EXPECT_EQ(std::string(e.what()), "edited.yaml:" + std::to_string(line_of("  rate: 100 Hz") + 1) +
+                                       ": field 'control.rate': duplicate key (first at line " +
+                                       std::to_string(line_of("  rate: 100 Hz")) + ")");
+  e = error_after_edit("      stroke: 725 mm, paper\n",
+                       "      stroke: 725 mm, paper\n      stroke: 500 mm, paper\n");
+  EXPECT_EQ(e.field(), "joints[2].cylinder.stroke");
+  EXPECT_EQ(e.line(), line_of("      stroke: 725 mm") + 1);
+  e = error_after_edit("backend: sim\n", "backend: sim\nbackend: can\n");
+  EXPECT_EQ(e.field(), "backend");
+  EXPECT_EQ(e.reason(),
+            "duplicate key (first at line " + std::to_string(line_of("backend: sim")) + ")");
+  // A mapping reached twice through an anchor and its alias is no repeat, and a node that
+  // contains itself (yaml-cpp builds the cycle) is walked once.
+  const YAML::Node aliased = YAML::Load("a: &m {x: 1, y: 2}\nb: *m\nc: [*m, *m]\nd: &s [*s]\n");
+  EXPECT_NO_THROW(craneassist::config::check_unique_keys(aliased, "aliased.yaml"));
+  try {
+    craneassist::config::check_unique_keys(YAML::Load("a:\n  - {x: 1}\n  - {x: 1, x: 2}\n"),
+                                           "list.yaml");
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& list_error) {
+    EXPECT_EQ(std::string(list_error.what()),
+              "list.yaml:3: field 'a[1].x': duplicate key (first at line 3)");
+  }
 }
 
 TEST(CraneConfig, MissingFileIsReported) {

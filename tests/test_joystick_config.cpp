@@ -2,6 +2,7 @@
 // every mistake is reported with file, line and field.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -153,4 +154,17 @@ TEST(JoystickConfig, MissingFileAndYamlSyntax) {
   } catch (const config::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("YAML syntax"), std::string::npos);
   }
+}
+
+// A repeated key is an error at the second one (yaml-cpp keeps both, a lookup takes the first).
+TEST(JoystickConfig, DuplicateKeysAreRejected) {
+  const std::string text = default_text();
+  const std::string line = "  max_speed: 2 m/s";
+  const auto at = text.find(line);
+  ASSERT_NE(at, std::string::npos);
+  const int first = 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+  const auto e = error_after_edit(line, line + "\n  max_speed: 5 m/s");
+  EXPECT_EQ(std::string(e.what()), "pad.yaml:" + std::to_string(first + 1) +
+                                       ": field 'input.max_speed': duplicate key (first at line " +
+                                       std::to_string(first) + ")");
 }

@@ -92,6 +92,9 @@ TEST(TelemetryConfig, ErrorsNameFileLineAndField) {
   expect_error("topics:\n  jionts:\n    depth: 1\n", 3, "topics.jionts", "unknown field");
   expect_error("enabled: yes\n", 2, "enabled", "true or false");
   expect_error("domian_id: 3\n", 2, "domian_id", "unknown field");
+  expect_error("domain_id: 3\ndomain_id: 4\n", 3, "domain_id", "duplicate key (first at line 2)");
+  expect_error("topics:\n  joints:\n    rate: 50 Hz\n    depth: 2\n    rate: 5 Hz\n", 6,
+               "topics.joints.rate", "duplicate key (first at line 4)");
   try {
     parse_telemetry_config("format: craneassist-telemetry/9\n", "v.yaml");
     FAIL();

@@ -56,5 +56,11 @@ expect big_replay "replay: $(limit "$work/big.csv" 64 replay)" replay "$work/big
 expect big_config "config: $(limit "$work/big.yaml" 1 'crane config')" \
   replay --config "$work/big.yaml" --no-log
 rm -f "$work/big.csv" "$work/big.yaml"
+# A key given twice in one mapping is an error at the second (YAML readers would take the first).
+crane=$data/../../config/cranes/k70m.yaml
+first=$(grep -n '^  rate: 100 Hz' "$crane" | cut -d: -f1)
+sed "${first}a\\  rate: 7 Hz, assumed" "$crane" > "$work/duplicate.yaml"
+expect duplicate_key "config: $work/duplicate.yaml:$((first + 1)): field 'control.rate': duplicate key (first at line $first)" \
+  replay --config "$work/duplicate.yaml" --no-log
 [ "$failed" -eq 0 ] && echo "bad input files OK"
 exit "$failed"

@@ -1,6 +1,6 @@
 // The checks every craneassist YAML file shares (crane configs, CAN mappings): fail with file,
-// line and field; reject unknown keys; require a child. Readers of a file format derive from it
-// and add their own value conversions. Needs yaml-cpp in the including target.
+// line and field; reject duplicate and unknown keys; require a child. Readers of a file format
+// derive from it and add their own value conversions. Needs yaml-cpp in the including target.
 #pragma once
 
 #include <yaml-cpp/yaml.h>
@@ -85,8 +85,14 @@ class YamlReader {
   std::string file_;
 };
 
-// Parses YAML text and reads it with read(root): a syntax error, or a conversion yaml-cpp refuses
-// inside read, becomes a ConfigError naming the source and the line.
+// Throws ConfigError at the second of two equal keys in one mapping, anywhere in the tree
+// ("file:12: field 'control.rate': duplicate key (first at line 9)"): yaml-cpp keeps both, and a
+// lookup would silently take the first. Each node is visited once, so aliases cost nothing.
+void check_unique_keys(const YAML::Node& root, std::string_view source_name);
+
+// Parses YAML text, checks that no mapping repeats a key, and reads it with read(root): a syntax
+// error, a duplicate key, or a conversion yaml-cpp refuses inside read, becomes a ConfigError
+// naming the source and the line.
 template <typename Read>
 auto read_yaml(std::string_view yaml_text, std::string_view source_name, Read&& read)
     -> decltype(read(std::declval<const YAML::Node&>())) {
@@ -96,6 +102,7 @@ auto read_yaml(std::string_view yaml_text, std::string_view source_name, Read&& 
   } catch (const YAML::ParserException& e) {
     throw ConfigError(std::string(source_name), e.mark.line + 1, "", "YAML syntax: " + e.msg);
   }
+  check_unique_keys(root, source_name);
   try {
     return read(root);
   } catch (const YAML::Exception& e) {  // a conversion yaml-cpp refused; report where
