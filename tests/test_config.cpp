@@ -163,6 +163,64 @@ TEST(CraneConfig, OutOfRangeValuesAreRejected) {
   EXPECT_EQ(error_after_edit("step: 1 ms", "step: 3 ms").field(), "simulation.step");
 }
 
+// The geometry, masses, inertias and gravity are checked against ranges in which the simulator
+// and the dynamics model run (docs/config.md#ranges; the edges run in test_replay_e2e): values
+// they cannot take (a 1e30 m link, gravity -1000) were accepted and aborted the run in ODE or
+// ran it into nonsense. Each is refused naming its line and field.
+TEST(CraneConfig, GeometryMassesAndGravityOutsideTheirRangesAreRejected) {
+  struct Case {
+    std::string from, to, field, reason_part;
+  };
+  const Case cases[] = {
+      {"    a: 3.504 m, paper", "    a: 1e30 m, paper", "joints[1].a", "within +-100 m"},
+      {"    a: 3.504 m, paper", "    a: 100.1 m, paper", "joints[1].a", "within +-100 m"},
+      {"    d: 1.605 m, paper", "    d: -101 m, paper", "joints[0].d", "within +-100 m"},
+      {"    alpha: 90 deg, paper", "    alpha: 361 deg, paper", "joints[0].alpha", "+-360 deg"},
+      {"    theta_offset: 90 deg, paper", "    theta_offset: -1e9 deg, paper",
+       "joints[2].theta_offset", "+-360 deg"},
+      {"    max: 3.7 m, paper", "    max: 150 m, paper", "joints[3].max", "within +-100 m"},
+      {"      length_at_zero: 0.36 m, assumed", "      length_at_zero: 1e30 m, assumed",
+       "joints[0].cylinder.length_at_zero", "within +-100 m"},
+      {"      arm: 0.5 m, paper", "      arm: 200 m, paper", "joints[3].cylinder.arm",
+       "within +-100 m"},
+      {"      l1: 0.44 m, assumed", "      l1: 101 m, assumed", "joints[1].cylinder.l1",
+       "at most 100 m"},
+      {"      angle_offset: 1.01 rad, assumed", "      angle_offset: 100 rad, assumed",
+       "joints[1].cylinder.angle_offset", "+-360 deg"},
+      {"-0.23441829 1.08923838 m", "-0.23441829 1e9 m", "joints[2].cylinder.coefficients",
+       "cylinder length leaves +-100 m"},
+      {"    mass: 420 kg, assumed", "    mass: 0.5 kg, assumed", "bodies[1].mass",
+       "between 1 kg and 100000 kg"},
+      {"    mass: 420 kg, assumed", "    mass: 2e5 kg, assumed", "bodies[1].mass",
+       "between 1 kg and 100000 kg"},
+      {"    com: -1.754 0 0 m, assumed", "    com: -1e20 0 0 m, assumed", "bodies[1].com",
+       "each must be within +-100 m"},
+      {"    inertia: 10 429 429 kg*m^2", "    inertia: 1e30 429 429 kg*m^2", "bodies[1].inertia",
+       "radius of gyration 1 cm to 30 m"},
+      {"    inertia: 10 429 429 kg*m^2", "    inertia: 0 429 429 kg*m^2", "bodies[1].inertia",
+       "between m (1 cm)^2 and m (30 m)^2, 0.042 to 378000 kg*m^2"},
+      {"    inertia: 10 429 429 kg*m^2", "    inertia: 10 429 500 kg*m^2", "bodies[1].inertia",
+       "principal moment 3 (500 kg*m^2) exceeds the sum of the other two (439 kg*m^2)"},
+      {"gravity: 0 0 -9.81 m/s^2", "gravity: 0 0 -1000 m/s^2", "frames.gravity",
+       "magnitude 1000 m/s^2 must be at most 20 m/s^2"},
+      {"gravity: 0 0 -9.81 m/s^2", "gravity: 0 0 9.81 m/s^2", "frames.gravity",
+       "must point down, within 45 deg of the crane frame's -y"},
+      {"gravity: 0 0 -9.81 m/s^2", "gravity: 9.81 0 -8 m/s^2", "frames.gravity", "it is 50.8"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.to);
+    const auto e = error_after_edit(c.from, c.to);
+    EXPECT_EQ(e.field(), c.field) << e.what();
+    EXPECT_EQ(e.line(), line_of(c.from)) << e.what();
+    EXPECT_NE(e.reason().find(c.reason_part), std::string::npos) << e.what();
+  }
+  // At the edges the file loads; zero gravity has no direction to check.
+  EXPECT_NO_THROW(config_after_edit("gravity: 0 0 -9.81 m/s^2", "gravity: 0 0 0 m/s^2"));
+  EXPECT_NO_THROW(config_after_edit("gravity: 0 0 -9.81 m/s^2", "gravity: 14.14 0 -14.14 m/s^2"));
+  EXPECT_NO_THROW(config_after_edit("    inertia: 10 429 429", "    inertia: 4.2e-2 429 429"));
+  EXPECT_NO_THROW(config_after_edit("    inertia: 10 429 429", "    inertia: 200 200 400"));
+}
+
 TEST(CraneConfig, ConstantPressurePumpIsParsed) {
   using craneassist::dynamics::PumpMode;
   const auto cp = config_after_edit("mode: load-sensing", "mode: constant-pressure");

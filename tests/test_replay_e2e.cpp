@@ -172,3 +172,75 @@ TEST(ReplayEndToEnd, ReachingTheJointRangeEndStopsWithoutHittingIt) {
     EXPECT_LE(state.q[i], cfg.model.joints[static_cast<std::size_t>(i)].q_max + 0.01);
   }
 }
+
+// The crane config's ranges (docs/config.md#ranges) are where the simulator and the dynamics
+// model run: models at their edges load and run the controller on the simulated crane without an
+// abort or an exception. The worst mix: every body either at the lightest and slimmest (1 kg,
+// radius of gyration 1 cm) or at the heaviest and largest (100 t, 30 m, its centre of mass 100 m
+// out), with and without 100 m links, a 100 t payload and 20 m/s^2 of gravity tilted 45 deg.
+// Outside them, a 1 mm radius of gyration next to such masses, the dynamics probe already fails.
+TEST(ReplayEndToEnd, ModelsAtTheConfigRangeEdgesRun) {
+  std::ifstream in(kSource + "/config/cranes/k70m.yaml");
+  const std::string k70m{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const auto edit = [](std::string text, const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return at == std::string::npos ? text : text.replace(at, from.size(), to);
+  };
+  struct BodyLines {
+    const char *mass, *com, *inertia;
+  };
+  const BodyLines bodies[] = {
+      {"    mass: 500 kg", "    com: 0.208 -0.805 0 m", "    inertia: 118 22.5 118 kg*m^2"},
+      {"    mass: 420 kg", "    com: -1.754 0 0 m", "    inertia: 10 429 429 kg*m^2"},
+      {"    mass: 300 kg", "    com: 0 0 1.1 m", "    inertia: 156 156 8 kg*m^2"},
+      {"    mass: 160 kg", "    com: 0 1.85 0 m", "    inertia: 182 4 182 kg*m^2"},
+      {"    mass: 180 kg", "    com: 0 0 0 m", "    inertia: 6.5 6.5 6.5 kg*m^2"},
+  };
+  const auto replay =
+      input::Replay::parse("t,v_x,v_y,v_z\n0,0.2,0.1,0.1\n0.5,0,0,0\n", "edges.csv");
+  int runs = 0;
+  for (int heavy = 0; heavy < 32; ++heavy) {
+    for (const bool long_links : {false, true}) {
+      std::string text = k70m;
+      text = edit(text, "gravity: 0 0 -9.81 m/s^2", "gravity: 0 14.142 -14.142 m/s^2");
+      text = edit(text, "  mass: 0 kg, assumed", "  mass: 1e5 kg, assumed");  // the payload
+      for (int b = 0; b < 5; ++b) {
+        const bool h = (heavy >> b & 1) != 0;
+        text = edit(text, bodies[b].mass, h ? "    mass: 1e5 kg" : "    mass: 1 kg");
+        text = edit(text, bodies[b].inertia,
+                    h ? "    inertia: 9e7 9e7 9e7 kg*m^2" : "    inertia: 1e-4 1e-4 1e-4 kg*m^2");
+        if (h) text = edit(text, bodies[b].com, "    com: 100 -100 100 m");
+      }
+      if (long_links) {
+        text = edit(text, "    a: -0.208 m", "    a: -100 m");
+        text = edit(text, "    d: 1.605 m", "    d: -100 m");
+        text = edit(text, "    a: 3.504 m", "    a: 100 m");
+        text = edit(text, "    a: 0.376 m", "    a: -100 m");
+        text = edit(text, "    d: 2.13 m", "    d: 100 m");
+      }
+      SCOPED_TRACE("heavy bodies " + std::to_string(heavy) + (long_links ? ", 100 m links" : ""));
+      const auto cfg = config::parse_crane_config(text, "edges.yaml");
+      sim_backend::SimBackend machine(cfg.model, {cfg.simulation.step_s, cfg.simulation.q_initial});
+      control::RunOptions options;
+      options.settle_s = 0.5;
+      const auto s = control::run_replay(cfg, replay, machine, options, nullptr);
+      EXPECT_GE(s.cycles, 100);  // the replay and the settling second, to the end
+      valves::MachineState state;
+      machine.read(state);
+      EXPECT_TRUE(state.q.allFinite());
+      ++runs;
+    }
+  }
+  // The light end everywhere: every body 1 kg and slim, no gravity.
+  std::string text = edit(k70m, "gravity: 0 0 -9.81 m/s^2", "gravity: 0 0 0 m/s^2");
+  for (const auto& b : bodies) {
+    text = edit(text, b.mass, "    mass: 1 kg");
+    text = edit(text, b.inertia, "    inertia: 1e-4 1e-4 2e-4 kg*m^2");
+  }
+  const auto cfg = config::parse_crane_config(text, "light.yaml");
+  sim_backend::SimBackend machine(cfg.model, {cfg.simulation.step_s, cfg.simulation.q_initial});
+  const auto s = control::run_replay(cfg, replay, machine, {}, nullptr);
+  EXPECT_GT(s.tip_path_m, 0.0);
+  EXPECT_EQ(runs, 64);
+}

@@ -2,11 +2,13 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -21,6 +23,32 @@ namespace craneassist::config {
 namespace {
 
 constexpr const char* kFormat = "craneassist-crane/1";
+
+// A field's accepted values, [lo, hi], and how the message says so ("must be " + text). One
+// definition per field: the reader checks the file's value with it, and the setters below the
+// command line's overrides (docs/config.md#ranges).
+struct FieldRange {
+  double lo;
+  double hi;
+  const char* text;
+
+  bool contains(double v) const { return v >= lo && v <= hi; }  // false for NaN
+};
+
+// The machine's geometry and masses, within what the simulator and the dynamics model run
+// (docs/config.md#ranges; tests/test_config.cpp runs a model at these edges).
+constexpr double kMaxLengthM = 100.0;  // every length, offset and centre of mass
+constexpr FieldRange kLength{-kMaxLengthM, kMaxLengthM, "within +-100 m"};
+constexpr FieldRange kPositiveLength{1e-6, kMaxLengthM, "positive and at most 100 m"};
+constexpr FieldRange kAngleOffset{-2.0 * std::numbers::pi, 2.0 * std::numbers::pi,
+                                  "within +-360 deg"};
+constexpr FieldRange kBodyMass{1.0, 1e5, "between 1 kg and 100000 kg"};
+// Each principal moment of inertia I = m r^2 with the radius of gyration r between these: a rod
+// of 1.4 cm radius about its axis, a 100 m rod about its middle.
+constexpr double kMinGyrationM = 0.01;
+constexpr double kMaxGyrationM = 30.0;
+constexpr double kMaxGravityM_S2 = 20.0;
+constexpr double kMaxGravityTiltDeg = 45.0;  // from the crane frame's down, -y
 
 // Walks the YAML tree, converting and checking values; every failure names file, line, field.
 class Reader : public YamlReader {
@@ -54,6 +82,22 @@ class Reader : public YamlReader {
                   Dimension dimension, double lo, double hi, const std::string& range_text) {
     const double v = value(map, key, path, dimension);
     if (v < lo || v > hi) fail(map[key], join(path, key), "must be " + range_text);
+    return v;
+  }
+  double value_in(const YAML::Node& map, const std::string& key, const std::string& path,
+                  Dimension dimension, const FieldRange& range) {
+    return value_in(map, key, path, dimension, range.lo, range.hi, range.text);
+  }
+
+  // `count` values, each in the range.
+  std::vector<double> values_in(const YAML::Node& map, const std::string& key,
+                                const std::string& path, Dimension dimension, std::size_t count,
+                                const FieldRange& range) {
+    auto v = values(map, key, path, dimension, count);
+    for (const double x : v) {
+      if (!range.contains(x))
+        fail(map[key], join(path, key), std::string("each must be ") + range.text);
+    }
     return v;
   }
 
@@ -97,14 +141,14 @@ dynamics::Cylinder read_cylinder(Reader& r, const YAML::Node& node, const std::s
   const std::string linkage = r.text(node, "linkage", path);
   if (linkage == "constant_arm") {
     c.linkage = LinkageType::kConstantArm;
-    c.arm_m = r.value(node, "arm", path, Dimension::kLength);
-    c.c0_m = r.value(node, "length_at_zero", path, Dimension::kLength);
+    c.arm_m = r.value_in(node, "arm", path, Dimension::kLength, kLength);
+    c.c0_m = r.value_in(node, "length_at_zero", path, Dimension::kLength, kLength);
     if (c.arm_m == 0.0) r.fail(node["arm"], path + ".arm", "must not be zero");
   } else if (linkage == "triangle") {
     c.linkage = LinkageType::kTriangle;
-    c.l1_m = r.value_in(node, "l1", path, Dimension::kLength, 1e-6, 100.0, "positive");
-    c.l2_m = r.value_in(node, "l2", path, Dimension::kLength, 1e-6, 100.0, "positive");
-    c.angle_offset_rad = r.value(node, "angle_offset", path, Dimension::kAngle);
+    c.l1_m = r.value_in(node, "l1", path, Dimension::kLength, kPositiveLength);
+    c.l2_m = r.value_in(node, "l2", path, Dimension::kLength, kPositiveLength);
+    c.angle_offset_rad = r.value_in(node, "angle_offset", path, Dimension::kAngle, kAngleOffset);
   } else if (linkage == "polynomial") {
     c.linkage = LinkageType::kPolynomial;
     c.poly_coeffs = r.values(node, "coefficients", path, Dimension::kLength, 0);
@@ -150,8 +194,12 @@ dynamics::Cylinder read_cylinder(Reader& r, const YAML::Node& node, const std::s
     const double q = joint.q_min + (joint.q_max - joint.q_min) * k / kSamples;
     const double len = dynamics::cylinder_length(c, q);
     const double arm = dynamics::cylinder_arm(c, q);
-    if (!std::isfinite(len) || !std::isfinite(arm) || std::abs(arm) < 1e-6 ||
-        (arm_sign != 0.0 && arm * arm_sign < 0.0)) {
+    if (!(std::abs(len) <= kMaxLengthM)) {
+      const bool poly = c.linkage == LinkageType::kPolynomial;
+      r.fail(node[poly ? "coefficients" : "linkage"], path + (poly ? ".coefficients" : ".linkage"),
+             "the cylinder length leaves +-100 m inside the joint range");
+    }
+    if (!std::isfinite(arm) || std::abs(arm) < 1e-6 || (arm_sign != 0.0 && arm * arm_sign < 0.0)) {
       r.fail(node["linkage"], path + ".linkage",
              "the torque arm dc/dq vanishes or changes sign inside the joint range");
     }
@@ -195,10 +243,10 @@ void read_joints(Reader& r, const YAML::Node& root, dynamics::CraneModel& model)
     }
     const Dimension qdim =
         joint.type == dynamics::JointType::kRevolute ? Dimension::kAngle : Dimension::kLength;
-    joint.a_m = r.value(j, "a", path, Dimension::kLength);
-    joint.alpha_rad = r.value(j, "alpha", path, Dimension::kAngle);
-    joint.d_m = r.value(j, "d", path, Dimension::kLength);
-    joint.theta_rad = r.value(j, "theta_offset", path, Dimension::kAngle);
+    joint.a_m = r.value_in(j, "a", path, Dimension::kLength, kLength);
+    joint.alpha_rad = r.value_in(j, "alpha", path, Dimension::kAngle, kAngleOffset);
+    joint.d_m = r.value_in(j, "d", path, Dimension::kLength, kLength);
+    joint.theta_rad = r.value_in(j, "theta_offset", path, Dimension::kAngle, kAngleOffset);
     joint.q_min = r.value(j, "min", path, qdim);
     joint.q_max = r.value(j, "max", path, qdim);
     if (!(joint.q_min < joint.q_max)) r.fail(j["max"], path + ".max", "must be greater than min");
@@ -206,9 +254,63 @@ void read_joints(Reader& r, const YAML::Node& root, dynamics::CraneModel& model)
         (joint.q_min < -M_PI - 1e-9 || joint.q_max > M_PI + 1e-9)) {
       r.fail(j["min"], path + ".min", "a revolute range must lie within [-180, 180] deg");
     }
+    if (joint.type == dynamics::JointType::kPrismatic) {
+      for (const char* end : {"min", "max"}) {
+        if (!kLength.contains(end[1] == 'i' ? joint.q_min : joint.q_max)) {
+          r.fail(j[end], path + "." + end, "a prismatic range must lie within +-100 m");
+        }
+      }
+    }
     model.cylinders.push_back(
         read_cylinder(r, r.child(j, "cylinder", path), path + ".cylinder", joint));
     model.joints.push_back(joint);
+  }
+}
+
+// The principal moments of a rigid body: each m r^2 with the radius of gyration r in
+// [kMinGyrationM, kMaxGyrationM] (so the tensor is positive definite), and none larger than the
+// sum of the other two (the triangle inequality every mass distribution meets).
+void check_inertia(Reader& r, const YAML::Node& node, const std::string& field, double mass_kg,
+                   const Eigen::Vector3d& moments) {
+  const double lo = mass_kg * kMinGyrationM * kMinGyrationM;
+  const double hi = mass_kg * kMaxGyrationM * kMaxGyrationM;
+  for (int i = 0; i < 3; ++i) {
+    if (!(moments[i] >= lo && moments[i] <= hi)) {
+      std::ostringstream why;
+      why << "each principal moment must be between m (1 cm)^2 and m (30 m)^2, " << lo << " to "
+          << hi << " kg*m^2 for the mass of " << mass_kg << " kg (radius of gyration 1 cm to 30 m)";
+      r.fail(node, field, why.str());
+    }
+  }
+  for (int i = 0; i < 3; ++i) {
+    const double others = moments[(i + 1) % 3] + moments[(i + 2) % 3];
+    if (moments[i] > others * (1.0 + 1e-9)) {
+      std::ostringstream why;
+      why << "not a rigid body's: principal moment " << i + 1 << " (" << moments[i]
+          << " kg*m^2) exceeds the sum of the other two (" << others << " kg*m^2)";
+      r.fail(node, field, why.str());
+    }
+  }
+}
+
+// Gravity in the base frame: at most kMaxGravityM_S2, and (unless zero) pointing within
+// kMaxGravityTiltDeg of the crane frame's down (-y, as tip commands are given).
+void check_gravity(Reader& r, const YAML::Node& node, const std::string& field,
+                   const Eigen::Vector3d& g, const Eigen::Matrix3d& crane_from_base) {
+  const double magnitude = g.norm();
+  if (!(magnitude <= kMaxGravityM_S2)) {
+    std::ostringstream why;
+    why << "magnitude " << magnitude << " m/s^2 must be at most 20 m/s^2 (9.81 on earth)";
+    r.fail(node, field, why.str());
+  }
+  if (magnitude == 0.0) return;
+  const double down = -(crane_from_base * g).y() / magnitude;  // cos of the angle from down
+  if (!(down >= std::cos(kMaxGravityTiltDeg * std::numbers::pi / 180.0) - 1e-12)) {
+    std::ostringstream why;
+    why << "must point down, within 45 deg of the crane frame's -y (frames.crane_from_base maps "
+           "it): it is "
+        << std::acos(std::clamp(down, -1.0, 1.0)) * 180.0 / std::numbers::pi << " deg from it";
+    r.fail(node, field, why.str());
   }
 }
 
@@ -230,14 +332,12 @@ void read_bodies(Reader& r, const YAML::Node& root, dynamics::CraneModel& model)
     if (body.frame < 1 || body.frame > model.dof()) {
       r.fail(frame, path + ".frame", "must name a joint frame 1.." + std::to_string(model.dof()));
     }
-    body.mass_kg = r.value_in(b, "mass", path, Dimension::kMass, 0.0, 1e6, "between 0 and 1e6 kg");
-    const auto com = r.values(b, "com", path, Dimension::kLength, 3);
+    body.mass_kg = r.value_in(b, "mass", path, Dimension::kMass, kBodyMass);
+    const auto com = r.values_in(b, "com", path, Dimension::kLength, 3, kLength);
     body.com_m = Eigen::Vector3d(com[0], com[1], com[2]);
     const auto inertia = r.values(b, "inertia", path, Dimension::kInertia, 3);
     body.inertia_diag_kgm2 = Eigen::Vector3d(inertia[0], inertia[1], inertia[2]);
-    if (body.inertia_diag_kgm2.minCoeff() < 0.0) {
-      r.fail(b["inertia"], path + ".inertia", "principal moments must not be negative");
-    }
+    check_inertia(r, b["inertia"], path + ".inertia", body.mass_kg, body.inertia_diag_kgm2);
     model.bodies.push_back(body);
   }
   const YAML::Node payload = r.child(root, "payload", "");
@@ -389,6 +489,7 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   model.task_from_base = read_matrix3(r, frames, "crane_from_base", "frames");
   const auto g = r.values(frames, "gravity", "frames", Dimension::kAcceleration, 3);
   model.gravity_m_s2 = Eigen::Vector3d(g[0], g[1], g[2]);
+  check_gravity(r, frames["gravity"], "frames.gravity", model.gravity_m_s2, model.task_from_base);
 
   read_joints(r, root, model);
   read_bodies(r, root, model);

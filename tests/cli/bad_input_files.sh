@@ -62,5 +62,15 @@ first=$(grep -n '^  rate: 100 Hz' "$crane" | cut -d: -f1)
 sed "${first}a\\  rate: 7 Hz, assumed" "$crane" > "$work/duplicate.yaml"
 expect duplicate_key "config: $work/duplicate.yaml:$((first + 1)): field 'control.rate': duplicate key (first at line $first)" \
   replay --config "$work/duplicate.yaml" --no-log
+# A crane the simulator cannot take is refused before it runs (it ran: gravity -1000 m/s^2 with
+# 170 deg of direction error, exit 0; a 1e30 m link aborted in ODE, exit 134).
+line=$(grep -n 'gravity: 0 0 -9.81' "$crane" | cut -d: -f1)
+sed 's|gravity: 0 0 -9.81 m/s^2|gravity: 0 0 -1000 m/s^2|' "$crane" > "$work/gravity.yaml"
+expect gravity "config: $work/gravity.yaml:$line: field 'frames.gravity': magnitude 1000 m/s^2 must be at most 20 m/s^2" \
+  replay --config "$work/gravity.yaml" --no-log
+line=$(grep -n '    a: 3.504 m' "$crane" | cut -d: -f1)
+sed 's|    a: 3.504 m|    a: 1e30 m|' "$crane" > "$work/long_link.yaml"
+expect long_link "config: $work/long_link.yaml:$line: field 'joints[1].a': must be within +-100 m" \
+  replay --config "$work/long_link.yaml" --no-log
 [ "$failed" -eq 0 ] && echo "bad input files OK"
 exit "$failed"
