@@ -200,4 +200,49 @@ TEST(ProportionalValves, ActivationRuleKeepsRestingSectionsClosed) {
   EXPECT_EQ(a.spool[3], b.spool[3]);
 }
 
+// A plan is for one crane: given its joints' ranges, a position outside them (a plan for another
+// crane, an edited file) is refused at its line and column, as is a file for another joint count.
+TEST(JointTrajectory, PositionsOutsideTheCranesRangesAreRejected) {
+  input::TrajectoryLimits limits;
+  limits.joints = {{"slew", -3.0, 3.0, "rad"}, {"extension", 0.0, 3.7, "m"}};
+  const auto error = [&](std::string_view text) {
+    try {
+      input::JointTrajectory::parse(text, "traj.csv", limits);
+    } catch (const input::FileError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string header = "# plan\nt,q_1,q_2,qdot_1,qdot_2,qddot_1,qddot_2\n";
+  EXPECT_EQ(
+      error(header + "0,0,0,0,0,0,0\n1,0,3.75,0,0,0,0\n"),
+      "traj.csv:4: field 'q_2': 3.75 m is outside the range of joint 'extension', [0, 3.7] m");
+  EXPECT_EQ(error(header + "0,-3.5,0,0,0,0,0\n"),
+            "traj.csv:3: field 'q_1': -3.5 rad is outside the range of joint 'slew', [-3, 3] rad");
+  EXPECT_EQ(error(header + "0,-3,0,0,0,0,0\n1,3,3.7,0,0,0,0\n"), "no error");  // the ends
+  EXPECT_EQ(error("t,q_1,qdot_1,qddot_1\n0,0,0,0\n"),
+            "traj.csv:1: the header names 1 joint (q_1), the crane has 2");
+  // Without limits (no crane) only the format is checked.
+  EXPECT_NO_THROW(input::JointTrajectory::parse(header + "0,9,9,0,0,0,0\n", "traj.csv"));
+}
+
+// sample() holds the first sample before the start and the last after the end for any time the
+// caller may compute: NaN (which compares false with every sample and sent the search past the
+// last one, a read beyond the buffer), infinities, negative and huge times.
+TEST(JointTrajectory, SamplingHoldsTheEndsForEveryTime) {
+  const auto traj = input::JointTrajectory::parse(kTwoJoints, "traj.csv");
+  Eigen::VectorXd q(2), qd(2);
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  for (const double t : {std::numeric_limits<double>::quiet_NaN(), -kInf, -1.0, -1e300}) {
+    traj.sample(t, q, qd);
+    EXPECT_EQ(q, traj.q(0)) << t;
+    EXPECT_EQ(qd, Eigen::VectorXd::Zero(2)) << t;
+  }
+  for (const double t : {2.5, 1e300, kInf}) {
+    traj.sample(t, q, qd);
+    EXPECT_EQ(q, traj.q(2)) << t;
+    EXPECT_EQ(qd, Eigen::VectorXd::Zero(2)) << t;
+  }
+}
+
 }  // namespace

@@ -174,12 +174,13 @@ int run_trajectory_command(const ReplayArgs& args, const config::CraneConfig& cf
     return kExitUsage;
   }
   try {
-    traj = input::JointTrajectory::load_file(args.trajectory_file);
-    if (traj->joints() != cfg.model.dof()) {
-      spdlog::error("trajectory: {}: {} joints, but the crane {} has {}", args.trajectory_file,
-                    traj->joints(), cfg.model.name, cfg.model.dof());
-      return kExitUsage;
+    // The plan must be for this crane: its joint count, every position within the joint ranges.
+    input::TrajectoryLimits limits;
+    for (const auto& joint : cfg.model.joints) {
+      const bool revolute = joint.type == dynamics::JointType::kRevolute;
+      limits.joints.push_back({joint.name, joint.q_min, joint.q_max, revolute ? "rad" : "m"});
     }
+    traj = input::JointTrajectory::load_file(args.trajectory_file, limits);
   } catch (const input::FileError& e) {
     spdlog::error("trajectory: {}", e.what());
     return kExitUsage;

@@ -153,6 +153,7 @@ CsvFile Reader::read(std::string_view text, const std::function<void(const CsvRo
     }
     if (columns_ == 0) {
       check_header(content, line);
+      file.header_line = line;
       continue;
     }
     split_fields(content, fields_);

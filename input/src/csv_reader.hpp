@@ -63,6 +63,7 @@ struct CsvRow {
 struct CsvFile {
   std::size_t columns = 0;            // columns in the header read
   std::size_t rows = 0;               // data rows (at least 1)
+  std::size_t header_line = 0;        // the header's line
   std::size_t last_line = 1;          // the line whole-file problems are reported at
   std::vector<std::string> comments;  // the comment lines, without '#' and one space after it
 };

@@ -39,18 +39,40 @@ JointTrajectory::JointTrajectory(int joints) : joints_(joints) {
   if (joints < 0 || joints > kMaxJoints) throw std::invalid_argument("bad joint count");
 }
 
-JointTrajectory JointTrajectory::load_file(const std::filesystem::path& path) {
-  return parse(detail::read_file_text(path, "joint trajectory"), path.string());
+JointTrajectory JointTrajectory::load_file(const std::filesystem::path& path,
+                                           const TrajectoryLimits& limits) {
+  return parse(detail::read_file_text(path, "joint trajectory"), path.string(), limits);
 }
 
-JointTrajectory JointTrajectory::parse(std::string_view text, std::string_view source_name) {
+JointTrajectory JointTrajectory::parse(std::string_view text, std::string_view source_name,
+                                       const TrajectoryLimits& limits) {
   const int n = std::max(joints_in_header(detail::header_line(text)), 1);
+  const auto crane_joints = static_cast<int>(limits.joints.size());
+  const bool check_ranges = crane_joints == n;
   JointTrajectory traj(n);
   detail::CsvFile file =
       detail::read_csv(text, source_name, trajectory_format(n), [&](const detail::CsvRow& row) {
+        for (int i = 0; check_ranges && i < n; ++i) {
+          const TrajectoryJoint& joint = limits.joints[static_cast<std::size_t>(i)];
+          const double q = row.values[static_cast<std::size_t>(1 + i)];
+          if (!(q >= joint.min && q <= joint.max)) {
+            throw row.error("q_" + std::to_string(i + 1),
+                            detail::number(q) + " " + joint.unit +
+                                " is outside the range of joint '" + joint.name + "', [" +
+                                detail::number(joint.min) + ", " + detail::number(joint.max) +
+                                "] " + joint.unit);
+          }
+        }
         traj.t_s_.push_back(row.values[0]);
         traj.values_.insert(traj.values_.end(), row.values.begin() + 1, row.values.end());
       });
+  if (crane_joints > 0 && !check_ranges) {
+    const std::string columns =
+        n == 1 ? "1 joint (q_1)" : std::to_string(n) + " joints (q_1..q_" + std::to_string(n) + ")";
+    throw FileError(
+        std::string(source_name), file.header_line, "",
+        "the header names " + columns + ", the crane has " + std::to_string(crane_joints));
+  }
   // Keep the comment lines (the planner's summary, for reports).
   traj.comments = std::move(file.comments);
   return traj;

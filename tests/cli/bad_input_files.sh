@@ -32,6 +32,11 @@ expect bound_replay "$replay" bound "$data/bad_replay.csv"
 expect plan_path "$path" plan "$data/bad_path.csv" --quiet --out "$work/plan.csv"
 expect bound_path "$path" bound "$data/bad_path.csv"
 expect trajectory "$trajectory" replay --trajectory "$data/bad_trajectory.csv" --no-log
+# A plan's positions must lie in the crane's joint ranges (the K70M's lift ends at 1.097 rad).
+printf 't,q_1,q_2,q_3,q_4,qdot_1,qdot_2,qdot_3,qdot_4,qddot_1,qddot_2,qddot_3,qddot_4\n%s\n%s\n' \
+  0,0,0.3,-1.2,0.5,0,0,0,0,0,0,0,0 1,0,1.2,-1.2,0.5,0,0,0,0,0,0,0,0 > "$work/far_lift.csv"
+expect trajectory_range "trajectory: $work/far_lift.csv:3: field 'q_2': 1.2 rad is outside the range of joint 'lift', [-0.425, 1.097] rad" \
+  replay --trajectory "$work/far_lift.csv" --no-log
 # Every file is read with its format's size bound (YAML 1 MiB, CSV 64 MiB): a file without an
 # end (/dev/zero) and a larger regular file (sparse, nothing written) are refused, not read
 # until the memory runs out.

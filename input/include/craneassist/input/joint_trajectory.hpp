@@ -14,6 +14,18 @@
 
 namespace craneassist::input {
 
+// The crane a trajectory is for: its joints' ranges, base to tip, in the order of q_1..q_n. A
+// position outside them, or a file for another number of joints, is refused on reading.
+struct TrajectoryJoint {
+  std::string name;  // for the message: "joint 'lift'"
+  double min = 0.0;  // rad or m
+  double max = 0.0;
+  std::string unit;  // "rad" or "m", for the message
+};
+struct TrajectoryLimits {
+  std::vector<TrajectoryJoint> joints;  // empty: no crane to check against
+};
+
 class JointTrajectory {
  public:
   static constexpr int kMaxJoints = 6;
@@ -22,10 +34,13 @@ class JointTrajectory {
   explicit JointTrajectory(int joints = 0);
 
   // Reads and validates a file (header t,q_1..q_n,qdot_1..qdot_n,qddot_1..qddot_n with n in
-  // 1..kMaxJoints, time >= 0 and strictly increasing, every value finite). Throws FileError (the
+  // 1..kMaxJoints, time >= 0 and strictly increasing, every value finite) and, given the crane's
+  // limits, n equal to its joints and every q_i within joint i's range. Throws FileError (the
   // field is the column, e.g. "qdot_2"), as the replay and path readers.
-  static JointTrajectory load_file(const std::filesystem::path& path);
-  static JointTrajectory parse(std::string_view text, std::string_view source_name);
+  static JointTrajectory load_file(const std::filesystem::path& path,
+                                   const TrajectoryLimits& limits = {});
+  static JointTrajectory parse(std::string_view text, std::string_view source_name,
+                               const TrajectoryLimits& limits = {});
 
   // Appends a sample; t must exceed the last one and the vectors have joints() entries (else
   // std::invalid_argument).
