@@ -2,12 +2,15 @@
 // mistake is reported with file, line and field.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <numbers>
 #include <string>
 
 #include "craneassist/can/mapping_config.hpp"
 #include "craneassist/config/config_error.hpp"
+#include "craneassist/config/crane_config.hpp"
 
 using namespace craneassist::can;
 using craneassist::config::ConfigError;
@@ -83,6 +86,55 @@ TEST(CanMapping, ShippedExampleLoads) {
   double q = 0.0;
   ASSERT_EQ(decode(slew.position, f, q), SignalStatus::kOk);
   EXPECT_NEAR(q, std::numbers::pi / 2, 1e-12);
+}
+
+// A mapping that does not fit the crane is an input error naming the mapping's line and field,
+// found before a bus is opened (it was found by CanBackend's constructor, after the command
+// line had opened the bus, and exited 3).
+TEST(CanMapping, MappingThatDoesNotFitTheCraneNamesLineAndField) {
+  const auto crane = craneassist::config::default_crane_config().model;
+  const std::string text = [] {
+    std::ifstream in(kExample);
+    return std::string{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }();
+  EXPECT_NO_THROW(check_mapping_fits(parse_can_mapping(text, "k70m_can.yaml"), crane));
+  const auto line_of = [&](const std::string& needle) {
+    const auto at = text.find(needle);
+    EXPECT_NE(at, std::string::npos) << needle;
+    return 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+  };
+  const auto error_for = [&](const std::string& from, const std::string& to) {
+    std::string edited = text;
+    edited.replace(edited.find(from), from.size(), to);
+    try {
+      check_mapping_fits(parse_can_mapping(edited, "map.yaml"), crane);
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string lift_position = "signed: true, scale: 0.01, unit: deg, min: -90, max: 90}";
+  const std::string lift_line = std::to_string(line_of(lift_position) - 1);
+  EXPECT_EQ(error_for(lift_position, "signed: true, scale: 0.01, unit: deg, min: -10, max: 90}"),
+            "map.yaml:" + lift_line +
+                ": field 'joints[1].position': joint 'lift': the position signal's min/max do not "
+                "cover the joint range [-0.425, 1.097] rad");
+  EXPECT_EQ(error_for("  - name: lift", "  - name: boom"),
+            "map.yaml:" + std::to_string(line_of("  - name: lift")) +
+                ": field 'joints[1].name': joint 2 is 'boom', the crane's is 'lift'");
+  EXPECT_EQ(error_for(lift_position, "signed: true, scale: 0.01, unit: mm}"),
+            "map.yaml:" + lift_line +
+                ": field 'joints[1].position': joint 'lift': the crane's joint is revolute, its "
+                "position signal's unit is a length");
+  const auto planar = craneassist::config::planar_2r_config().model;
+  try {
+    check_mapping_fits(parse_can_mapping(text, "k70m_can.yaml"), planar);
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.line(), line_of("joints:"));
+    EXPECT_EQ(e.field(), "joints");
+    EXPECT_NE(e.reason().find("the mapping has 4 joints, the crane 2"), std::string::npos);
+  }
 }
 
 TEST(CanMapping, MinimalFileAndDefaults) {

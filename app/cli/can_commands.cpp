@@ -30,9 +30,8 @@ can::CanMapping load_mapping_or_default(const std::string& file) {
 }
 
 CanMachine::CanMachine(const dynamics::CraneModel& model, const std::string& iface,
-                       const std::string& mapping_file, const std::string& candump_log,
+                       const can::CanMapping& mapping, const std::string& candump_log,
                        double feedback_timeout_s) {
-  const auto mapping = load_mapping_or_default(mapping_file);
   transport_ = std::make_unique<can::SocketCanTransport>(iface);
   can::CanBackendOptions options;
   options.candump_log = candump_log;
@@ -115,15 +114,12 @@ int run_emulate_command(const EmulateArgs& args) {
   try {
     cfg = load_crane(args.config_file);
     mapping = load_mapping_or_default(args.mapping_file);
+    can::check_mapping_fits(mapping, cfg.model);  // before the bus is opened
   } catch (const std::exception& e) {
     spdlog::error("config: {}", e.what());
     return kExitUsage;
   }
   const int n = cfg.model.dof();
-  if (static_cast<int>(mapping.joints.size()) != n) {
-    spdlog::error("{}: {} joints, the crane has {}", mapping.source, mapping.joints.size(), n);
-    return kExitUsage;
-  }
   try {
     can::SocketCanTransport bus(args.iface);
     sim_backend::SimBackend sim(cfg.model, {cfg.simulation.step_s, cfg.simulation.q_initial});

@@ -16,11 +16,12 @@ namespace craneassist::cli {
 // The mapping file, or the embedded K70M mapping (config/can/k70m_can.yaml) when file is empty.
 can::CanMapping load_mapping_or_default(const std::string& file);
 
-// replay --backend can: the SocketCAN transport and the backend on it.
+// replay --backend can: the SocketCAN transport and the backend on it, for a mapping already
+// loaded and checked against the crane (load_machine_inputs).
 class CanMachine {
  public:
   CanMachine(const dynamics::CraneModel& model, const std::string& iface,
-             const std::string& mapping_file, const std::string& candump_log,
+             const can::CanMapping& mapping, const std::string& candump_log,
              double feedback_timeout_s = 0.05);
   can::CanBackend& backend() { return *backend_; }
   // Prints the counters and, after a fault, its reason and how to recover.

@@ -35,7 +35,18 @@ bool uses_can_backend(const BackendArgs& args, const config::CraneConfig& cfg) {
   return kind == config::BackendKind::kCan;
 }
 
-int Machine::open(const config::CraneConfig& cfg, const BackendArgs& args) {
+MachineInputs load_machine_inputs(const config::CraneConfig& cfg, const BackendArgs& args) {
+  MachineInputs inputs;
+  if (uses_can_backend(args, cfg)) {
+    inputs.mapping = load_mapping_or_default(args.mapping_file.empty() ? cfg.backend.can.mapping
+                                                                       : args.mapping_file);
+    can::check_mapping_fits(*inputs.mapping, cfg.model);
+  }
+  return inputs;
+}
+
+int Machine::open(const config::CraneConfig& cfg, const BackendArgs& args,
+                  const MachineInputs& inputs) {
   if (!uses_can_backend(args, cfg)) {
     sim_.emplace(cfg.model, offline::sim_settings(cfg));
     machine_ = &*sim_;
@@ -47,9 +58,11 @@ int Machine::open(const config::CraneConfig& cfg, const BackendArgs& args) {
                   cfg.source_name);
     return kExitUsage;
   }
-  const std::string mapping =
-      args.mapping_file.empty() ? cfg.backend.can.mapping : args.mapping_file;
-  can_.emplace(cfg.model, iface, mapping, args.can_log,
+  if (!inputs.mapping) {
+    spdlog::error("the can backend's mapping was not loaded (load_machine_inputs)");
+    return kExitRuntime;
+  }
+  can_.emplace(cfg.model, iface, *inputs.mapping, args.can_log,
                args.feedback_timeout_s.value_or(cfg.backend.can.feedback_timeout_s));
   machine_ = &can_->backend();
   if (std::string why; !machine_->activate(2.0, &why)) {

@@ -29,14 +29,24 @@ void add_backend_options(CLI::App& command, BackendArgs& args);
 // The resolved choice: --backend, else the config's `backend:`.
 bool uses_can_backend(const BackendArgs& args, const config::CraneConfig& cfg);
 
+// What the machine of a run needs from files, read and checked with the run's other inputs,
+// before anything is opened: on the can backend the CAN mapping (--mapping, else the config's
+// can.mapping, else the embedded K70M one), checked against the crane (can::check_mapping_fits).
+struct MachineInputs {
+  std::optional<can::CanMapping> mapping;
+};
+// Throws config::ConfigError naming the file, line and field (an input error: exit 2).
+MachineInputs load_machine_inputs(const config::CraneConfig& cfg, const BackendArgs& args);
+
 // Holds the machine of a run: the simulator or the CAN machine (transport and backend). Callers
 // use the machine through its interface only.
 class Machine {
  public:
   valves::MachineInterface& get() { return *machine_; }
   // Builds and activates the machine (a bus machine waits up to 2 s for every joint's
-  // feedback). Returns kExitOk, or logs why not and returns the exit code.
-  int open(const config::CraneConfig& cfg, const BackendArgs& args);
+  // feedback) from the inputs load_machine_inputs read. Returns kExitOk, or logs why not and
+  // returns the exit code.
+  int open(const config::CraneConfig& cfg, const BackendArgs& args, const MachineInputs& inputs);
   // The normal end of a run: the machine deactivated (every valve to its safe state, its
   // threads ended) and the bus report printed. Returns kExitRuntime after a latched fault.
   int finish();

@@ -208,6 +208,7 @@ int run_replay_command(const ReplayArgs& args) {
   config::CraneConfig cfg;
   std::optional<input::Replay> loaded;
   config::TelemetryConfig telemetry_settings;
+  MachineInputs machine_inputs;
   try {
     cfg = load_crane(args.config_file);
     apply_crane_options(cfg, {args.payload_kg, args.initial, args.resolution,
@@ -249,6 +250,7 @@ int run_replay_command(const ReplayArgs& args) {
       return run_trajectory_command(args, cfg);
     }
     telemetry_settings = load_telemetry_settings(args.telemetry);
+    machine_inputs = load_machine_inputs(cfg, args.machine);
     if (args.replay_file.empty()) {
       loaded =
           input::Replay::parse(embedded::kDemoReplayCsv, "<bundled examples/replays/demo.csv>");
@@ -263,7 +265,7 @@ int run_replay_command(const ReplayArgs& args) {
   const std::string replay_name(replay.source_name());
   try {
     Machine machines;
-    if (const int rc = machines.open(cfg, args.machine); rc != kExitOk) return rc;
+    if (const int rc = machines.open(cfg, args.machine, machine_inputs); rc != kExitOk) return rc;
     valves::MachineInterface& machine = machines.get();
     Telemetry telemetry;
     const bool telemetry_wanted = args.telemetry.on || !args.telemetry.config_file.empty();

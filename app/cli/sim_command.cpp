@@ -225,6 +225,7 @@ int run_sim_command(const SimArgs& args) {
   config::JoystickConfig jcfg;
   config::TelemetryConfig tcfg;
   std::optional<input::Replay> replay;
+  MachineInputs machine_inputs;
   try {
     cfg = load_crane(args.config_file);
     apply_crane_options(cfg, {args.payload_kg, args.initial, args.resolution,
@@ -234,6 +235,7 @@ int run_sim_command(const SimArgs& args) {
     if (kind == "replay") replay = input::Replay::load_file(args.input[1]);
     tcfg = load_telemetry_settings(args.telemetry);
     if (kind == "dds") check_remote_input_settings(tcfg);
+    machine_inputs = load_machine_inputs(cfg, args.machine);
   } catch (...) {
     return input_error_exit("replay");
   }
@@ -245,7 +247,7 @@ int run_sim_command(const SimArgs& args) {
 
   try {
     Machine machines;
-    if (const int rc = machines.open(cfg, args.machine); rc != kExitOk) return rc;
+    if (const int rc = machines.open(cfg, args.machine, machine_inputs); rc != kExitOk) return rc;
     valves::MachineInterface& machine = machines.get();
     g_stop.store(false);
     std::unique_ptr<input::CommandSource> source;

@@ -23,6 +23,7 @@ expect() {
     failed=1
   fi
 }
+demo=$data/../../examples/replays/demo.csv
 replay="replay: $data/bad_replay.csv:4: field 'v_y': not a number: '0.1x'"
 path="path: $data/bad_path.csv:4: field 'y': not a number: '2.O4'"
 trajectory="trajectory: $data/bad_trajectory.csv:3: field 'qdot_2': not a number: 'abc'"
@@ -37,11 +38,24 @@ printf 't,q_1,q_2,q_3,q_4,qdot_1,qdot_2,qdot_3,qdot_4,qddot_1,qddot_2,qddot_3,qd
   0,0,0.3,-1.2,0.5,0,0,0,0,0,0,0,0 1,0,1.2,-1.2,0.5,0,0,0,0,0,0,0,0 > "$work/far_lift.csv"
 expect trajectory_range "trajectory: $work/far_lift.csv:3: field 'q_2': 1.2 rad is outside the range of joint 'lift', [-0.425, 1.097] rad" \
   replay --trajectory "$work/far_lift.csv" --no-log
+# A CAN mapping that is broken or does not fit the crane is an input error (exit 2), found
+# before a bus is opened (this host may have no CAN at all: the bus would fail with exit 3).
+mapping=$data/../../config/can/k70m_can.yaml
+printf 'format: craneassist-can-map/1\njoints: 3\n' > "$work/bad_map.yaml"
+bad_map="config: $work/bad_map.yaml:2: field 'joints': expected a list of joints"
+expect can_bad_mapping "$bad_map" replay --backend can --can vcan0 --mapping "$work/bad_map.yaml" --no-log
+expect emulate_bad_mapping "$bad_map" emulate --can vcan0 --mapping "$work/bad_map.yaml"
+line=$(grep -n 'unit: deg, min: -90, max: 90}' "$mapping" | cut -d: -f1)
+sed 's/unit: deg, min: -90, max: 90}/unit: deg, min: -10, max: 90}/' "$mapping" > "$work/narrow_map.yaml"
+narrow="config: $work/narrow_map.yaml:$((line - 1)): field 'joints[1].position': joint 'lift': the position signal's min/max do not cover the joint range"
+expect can_narrow_mapping "$narrow" replay --backend can --can vcan0 --mapping "$work/narrow_map.yaml" --no-log
+expect sim_narrow_mapping "$narrow" sim --backend can --can vcan0 --mapping "$work/narrow_map.yaml" \
+  --input replay "$demo"
+expect emulate_narrow_mapping "$narrow" emulate --can vcan0 --mapping "$work/narrow_map.yaml"
 # Every file is read with its format's size bound (YAML 1 MiB, CSV 64 MiB): a file without an
 # end (/dev/zero) and a larger regular file (sparse, nothing written) are refused, not read
 # until the memory runs out.
 limit() { echo "$1: larger than $2 MiB (the limit for $3 files)"; }
-demo=$data/../../examples/replays/demo.csv
 expect zero_replay "replay: $(limit /dev/zero 64 replay)" replay /dev/zero --no-log
 expect zero_config "config: $(limit /dev/zero 1 'crane config')" replay --config /dev/zero --no-log
 expect zero_trajectory "trajectory: $(limit /dev/zero 64 'joint trajectory')" \
@@ -53,6 +67,8 @@ expect zero_bound "replay: $(limit /dev/zero 64 'tip path and replay')" bound /d
 expect zero_sim "replay: $(limit /dev/zero 64 replay)" sim --input replay /dev/zero --no-realtime
 expect zero_joystick "config: $(limit /dev/zero 1 'joystick mapping')" \
   sim --input replay "$demo" --no-realtime --joystick /dev/zero
+expect zero_mapping "config: $(limit /dev/zero 1 'CAN mapping')" \
+  replay --backend can --can vcan0 --mapping /dev/zero --no-log
 expect zero_suite "$(limit /dev/zero 1 'suite manifest')" suite /dev/zero
 rm -f "$work/big.csv" "$work/big.yaml"
 truncate -s $((64 * 1024 * 1024 + 1)) "$work/big.csv"

@@ -10,6 +10,7 @@
 
 #include "craneassist/can/heartbeat.hpp"
 #include "craneassist/can/valve_frames.hpp"
+#include "craneassist/config/config_error.hpp"
 
 namespace craneassist::can {
 
@@ -157,33 +158,14 @@ SendStatus send_counted(Transport& transport, Counters& counters, Ring& ring, bo
 CanBackend::CanBackend(const CanMapping& mapping, const dynamics::CraneModel& model,
                        Transport& transport, const CanBackendOptions& options)
     : impl_(std::make_unique<Impl>(transport, options)) {
-  if (static_cast<int>(mapping.joints.size()) != model.dof()) {
-    throw std::invalid_argument(mapping.source + ": the mapping has " +
-                                std::to_string(mapping.joints.size()) + " joints, the crane " +
-                                std::to_string(model.dof()));
+  try {
+    check_mapping_fits(mapping, model);
+  } catch (const config::ConfigError& e) {
+    throw std::invalid_argument(e.what());
   }
   for (int i = 0; i < model.dof(); ++i) {
     const auto s = static_cast<std::size_t>(i);
     const JointMapping& jm = mapping.joints[s];
-    if (!model.joints[s].name.empty() && jm.name != model.joints[s].name) {
-      throw std::invalid_argument(mapping.source + ": joint " + std::to_string(i + 1) + " is '" +
-                                  jm.name + "', the crane's is '" + model.joints[s].name + "'");
-    }
-    // The position signal must measure what the joint is, over the joint's whole range (a valid
-    // position outside the signal's min/max would be read as a malformed frame).
-    const auto& joint = model.joints[s];
-    const bool revolute = joint.type == dynamics::JointType::kRevolute;
-    if (revolute != (jm.position_kind == PositionKind::kAngle)) {
-      throw std::invalid_argument(
-          mapping.source + ": joint '" + jm.name + "': the crane's joint is " +
-          (revolute ? "revolute" : "prismatic") + ", its position signal's unit is " +
-          (revolute ? "a length" : "an angle"));
-    }
-    if ((jm.position.minimum && *jm.position.minimum > joint.q_min + 1e-9) ||
-        (jm.position.maximum && *jm.position.maximum < joint.q_max - 1e-9)) {
-      throw std::invalid_argument(mapping.source + ": joint '" + jm.name +
-                                  "': the position signal's min/max do not cover the joint range");
-    }
     Impl::Joint j;
     j.map = jm;
     if (s < model.cylinders.size() && model.cylinders[s].area_a_m2 > 0.0) {

@@ -273,6 +273,9 @@ CanMapping read_mapping(const Reader& r, const YAML::Node& root) {
   }
   CanMapping mapping;
   mapping.source = r.file();
+  for (const auto& kv : root) {  // the line of the key (a block list's mark is its first entry)
+    if (kv.first.Scalar() == "joints") mapping.joints_line = kv.first.Mark().line + 1;
+  }
   std::vector<Occupancy> occupancy;
   for (std::size_t i = 0; i < joints.size(); ++i) {
     const YAML::Node j = joints[i];
@@ -281,10 +284,12 @@ CanMapping read_mapping(const Reader& r, const YAML::Node& root) {
     JointMapping jm;
     const YAML::Node name = r.child(j, "name", path);
     jm.name = r.text(name, path + ".name");
+    jm.name_line = name.Mark().line + 1;
     for (const auto& other : mapping.joints) {
       if (other.name == jm.name) r.fail(name, path + ".name", "duplicate joint '" + jm.name + "'");
     }
     jm.valve = read_valve(r, r.child(j, "valve", path), path + ".valve");
+    jm.valve_line = j["valve"].Mark().line + 1;
     if (jm.valve.kind == ValveOutputKind::kIso11783Avc) {
       for (const auto& other : mapping.joints) {
         if (other.valve.kind == ValveOutputKind::kIso11783Avc &&
@@ -302,6 +307,7 @@ CanMapping read_mapping(const Reader& r, const YAML::Node& root) {
     }
     jm.position = read_signal(r, r.child(j, "position", path), path + ".position",
                               SignalUse::kPosition, kSignalKeys, &jm.position_kind);
+    jm.position_line = j["position"].Mark().line + 1;
     occupancy.push_back({jm.position.id, jm.position.extended, occupied_bits(jm.position),
                          path + ".position", j["position"], false});
     for (const char* key : {"pressure_a", "pressure_b"}) {
@@ -382,6 +388,48 @@ CanMapping parse_can_mapping(std::string_view yaml_text, std::string_view source
 
 CanMapping load_can_mapping(const std::filesystem::path& path) {
   return parse_can_mapping(config::read_yaml_file(path, "CAN mapping"), path.string());
+}
+
+void check_mapping_fits(const CanMapping& mapping, const dynamics::CraneModel& model) {
+  const auto fail = [&](int line, const std::string& field, const std::string& reason) {
+    throw ConfigError(mapping.source, line, field, reason);
+  };
+  if (static_cast<int>(mapping.joints.size()) != model.dof()) {
+    fail(mapping.joints_line, "joints",
+         "the mapping has " + std::to_string(mapping.joints.size()) + " joints, the crane " +
+             std::to_string(model.dof()) + " (" + model.name + ")");
+  }
+  for (int i = 0; i < model.dof(); ++i) {
+    const auto s = static_cast<std::size_t>(i);
+    const JointMapping& jm = mapping.joints[s];
+    const auto& joint = model.joints[s];
+    const std::string path = "joints[" + std::to_string(i) + "]";
+    if (!joint.name.empty() && jm.name != joint.name) {
+      fail(jm.name_line, path + ".name",
+           "joint " + std::to_string(i + 1) + " is '" + jm.name + "', the crane's is '" +
+               joint.name + "'");
+    }
+    const bool revolute = joint.type == dynamics::JointType::kRevolute;
+    if (revolute != (jm.position_kind == PositionKind::kAngle)) {
+      fail(jm.position_line, path + ".position",
+           "joint '" + jm.name + "': the crane's joint is " +
+               (revolute ? "revolute" : "prismatic") + ", its position signal's unit is " +
+               (revolute ? "a length" : "an angle"));
+    }
+    if ((jm.position.minimum && *jm.position.minimum > joint.q_min + 1e-9) ||
+        (jm.position.maximum && *jm.position.maximum < joint.q_max - 1e-9)) {
+      std::ostringstream why;
+      why << "joint '" << jm.name
+          << "': the position signal's min/max do not cover the joint range [" << joint.q_min
+          << ", " << joint.q_max << "] " << (revolute ? "rad" : "m");
+      fail(jm.position_line, path + ".position", why.str());
+    }
+    CanFrame block;
+    if (!encode_valve_block(jm.valve, block)) {
+      fail(jm.valve_line, path + ".valve",
+           "joint '" + jm.name + "': its valve command cannot be encoded");
+    }
+  }
 }
 
 }  // namespace craneassist::can

@@ -26,6 +26,7 @@
 
 #include "craneassist/can/iso11783_valve.hpp"
 #include "craneassist/can/signal_map.hpp"
+#include "craneassist/dynamics/model.hpp"
 
 namespace craneassist::can {
 
@@ -64,6 +65,10 @@ struct JointMapping {
   PositionKind position_kind = PositionKind::kAngle;
   std::optional<SignalSpec> pressure_a;  // Pa, piston side
   std::optional<SignalSpec> pressure_b;  // Pa, rod side
+  // Where the entry is in its file, for check_mapping_fits's errors (1-based; 0: built in code).
+  int name_line = 0;
+  int valve_line = 0;
+  int position_line = 0;
 };
 
 // craneassist's own alive message (docs/can.md, "Heartbeat"): sent by the control loop at
@@ -84,7 +89,8 @@ struct PumpMapping {
 };
 
 struct CanMapping {
-  std::string source;  // the file name, for messages
+  std::string source;   // the file name, for messages
+  int joints_line = 0;  // the line of `joints:` (0: built in code)
   std::vector<JointMapping> joints;
   std::optional<HeartbeatSpec> heartbeat;
   PumpMapping pump;
@@ -93,5 +99,14 @@ struct CanMapping {
 // Throws config::ConfigError (file:line: field 'joints[1].position.length': reason).
 CanMapping parse_can_mapping(std::string_view yaml_text, std::string_view source_name);
 CanMapping load_can_mapping(const std::filesystem::path& path);
+
+// Whether the mapping fits the crane: the same joints in the same order (as many, the same
+// names), each position signal measuring what its joint is (an angle for a revolute joint, a
+// length for a prismatic one) over the joint's whole range (a valid position outside the signal's
+// min/max would be read as a malformed frame), each valve command encodable. Throws
+// config::ConfigError naming the mapping file, line and field ("k70m_can.yaml:12: field
+// 'joints[1].position': joint 'lift': the position signal's min/max do not cover the joint range
+// ..."). The command line checks this before it opens a bus; CanBackend's constructor again.
+void check_mapping_fits(const CanMapping& mapping, const dynamics::CraneModel& model);
 
 }  // namespace craneassist::can
