@@ -12,6 +12,7 @@
 #include "craneassist/files/text_file.hpp"
 #include "craneassist/offline/path_bound.hpp"
 #include "exit_codes.hpp"
+#include "option_checks.hpp"
 
 namespace craneassist::cli {
 namespace {
@@ -98,7 +99,7 @@ CLI::App* add_bound_command(CLI::App& cli, BoundArgs& args) {
       ->check(CLI::IsMember(names_of(offline::kStartExtensions)))
       ->capture_default_str();
   bound->add_option("--ds", args.ds_m, "Path sample spacing, m")
-      ->check(CLI::Range(1e-3, 0.1))
+      ->check(FiniteRange(1e-3, 0.1))
       ->capture_default_str();
   bound->add_option("--profile", args.profile_file,
                     "Write s, the bound's and the online scaler's path speed to this CSV");

@@ -18,6 +18,7 @@
 #include "craneassist/sim_backend/sim_backend.hpp"
 #include "embedded_replays.hpp"
 #include "exit_codes.hpp"
+#include "option_checks.hpp"
 
 namespace craneassist::cli {
 
@@ -101,10 +102,10 @@ CLI::App* add_emulate_command(CLI::App& cli, EmulateArgs& args) {
                   "CAN mapping YAML (default: the embedded config/can/k70m_can.yaml)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--feedback-period", args.feedback_period_s, "Seconds between feedback frames")
-      ->check(CLI::Range(0.001, 1.0))
+      ->check(FiniteRange(0.001, 1.0))
       ->capture_default_str();
   cmd->add_option("--duration", args.duration_s, "Seconds to run (default: until killed)")
-      ->check(CLI::Range(0.0, 1e6));
+      ->check(FiniteRange(0.0, 1e6));
   return cmd;
 }
 

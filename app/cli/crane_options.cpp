@@ -3,6 +3,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "option_checks.hpp"
+
 namespace craneassist::cli {
 
 CLI::Option* add_config_option(CLI::App& command, std::string& file) {
@@ -14,7 +16,7 @@ CLI::Option* add_config_option(CLI::App& command, std::string& file) {
 
 CLI::Option* add_payload_option(CLI::App& command, std::optional<double>& kg) {
   return command.add_option("--payload", kg, "Payload mass in the grapple, kg")
-      ->check(CLI::Range(0.0, 100000.0));
+      ->check(FiniteRange(0.0, 100000.0));
 }
 
 CLI::Option* add_initial_option(CLI::App& command, std::string& pose) {

@@ -5,6 +5,7 @@
 #include "craneassist/config/telemetry_config.hpp"
 #include "craneassist/dds/tools.hpp"
 #include "exit_codes.hpp"
+#include "option_checks.hpp"
 
 namespace craneassist::cli {
 namespace {
@@ -42,7 +43,7 @@ void add_common_options(CLI::App& app, int& domain_id, double& timeout_s, std::s
   app.add_option("--domain", domain_id, "DDS domain id (the telemetry config's domain_id)")
       ->check(CLI::Range(0, 232))
       ->capture_default_str();
-  app.add_option("--timeout", timeout_s, timeout_help)->check(CLI::PositiveNumber);
+  app.add_option("--timeout", timeout_s, timeout_help)->check(FiniteRange(1e-3, 1e6));
   app.add_option("--transport", transport,
                  "default (shared memory and UDP), udp (UDPv4 only) or shm (shared memory only)")
       ->check(CLI::IsMember(names_of(config::kDdsTransports)))

@@ -10,6 +10,7 @@
 #include "craneassist/offline/sine_path_experiment.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
 #include "exit_codes.hpp"
+#include "option_checks.hpp"
 
 namespace craneassist::cli {
 
@@ -77,13 +78,13 @@ CLI::App* add_experiment_command(CLI::App& cli, ExperimentArgs& args) {
       ->check(CLI::IsMember(names_of(dynamics::kPowerBounds)))
       ->capture_default_str();
   experiment->add_option("--speed", args.speed, "Requested path speed, 1/s")
-      ->check(CLI::Range(0.01, 20.0))
+      ->check(FiniteRange(0.01, 20.0))
       ->capture_default_str();
   experiment->add_option("--duration", args.duration_s, "Seconds to run")
-      ->check(CLI::Range(0.1, 600.0))
+      ->check(FiniteRange(0.1, 600.0))
       ->capture_default_str();
   experiment->add_option("--jerk", args.jerk_max, "Path jerk bound, 1/s^3")
-      ->check(CLI::Range(1.0, 1e6))
+      ->check(FiniteRange(1.0, 1e6))
       ->capture_default_str();
   experiment->add_option("--log", args.log_file, "Per-cycle CSV log")->capture_default_str();
   experiment->add_flag("--no-log", args.no_log, "Do not write the log");

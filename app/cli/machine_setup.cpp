@@ -4,6 +4,7 @@
 
 #include "craneassist/offline/sim_setup.hpp"
 #include "exit_codes.hpp"
+#include "option_checks.hpp"
 
 namespace craneassist::cli {
 
@@ -26,7 +27,7 @@ void add_backend_options(CLI::App& command, BackendArgs& args) {
       .add_option("--can-feedback-timeout", args.feedback_timeout_s,
                   "--backend can: fault when a joint's position is older than this, s "
                   "(default: can.feedback_timeout, 0.05)")
-      ->check(CLI::Range(0.005, 1.0));
+      ->check(FiniteRange(0.005, 1.0));
 }
 
 bool uses_can_backend(const BackendArgs& args, const config::CraneConfig& cfg) {

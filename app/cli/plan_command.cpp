@@ -11,6 +11,7 @@
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/offline/planning.hpp"
 #include "exit_codes.hpp"
+#include "option_checks.hpp"
 
 namespace craneassist::cli {
 
@@ -92,7 +93,7 @@ CLI::App* add_plan_command(CLI::App& cli, PlanArgs& args) {
       ->check(CLI::Range(0, 64))
       ->capture_default_str();
   plan->add_option("--dt", args.dt_s, "Stage length, s")
-      ->check(CLI::Range(0.005, 1.0))
+      ->check(FiniteRange(0.005, 1.0))
       ->capture_default_str();
   add_config_option(*plan, args.config_file);
   add_payload_option(*plan, args.payload_kg);

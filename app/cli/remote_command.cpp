@@ -25,6 +25,7 @@
 #include "craneassist/input/keyboard_source.hpp"
 #include "craneassist/input/replay.hpp"
 #include "exit_codes.hpp"
+#include "option_checks.hpp"
 
 namespace craneassist::cli {
 namespace {
@@ -84,14 +85,14 @@ CLI::App* add_remote_command(CLI::App& cli, RemoteArgs& args) {
   remote
       ->add_option("--duration", args.duration_s,
                    "Seconds to send (default: keyboard until q or Ctrl-C; replay: its length)")
-      ->check(CLI::Range(0.01, 1e6));
+      ->check(FiniteRange(0.01, 1e6));
   remote->add_option("--rate", args.rate_hz, "Samples per second")
-      ->check(CLI::Range(1.0, 1000.0))
+      ->check(FiniteRange(1.0, 1000.0))
       ->capture_default_str();
   remote
       ->add_option("--wait", args.wait_s,
                    "Replay: play after at most this long even if no crane's reader matched")
-      ->check(CLI::Range(0.0, 600.0))
+      ->check(FiniteRange(0.0, 600.0))
       ->capture_default_str();
   remote->add_option("--sender", args.sender,
                      "The sender name the crane shows (default: USER@host)");

@@ -25,6 +25,7 @@
 #include "embedded_replays.hpp"
 #include "exit_codes.hpp"
 #include "machine_setup.hpp"
+#include "option_checks.hpp"
 #include "telemetry_setup.hpp"
 
 namespace craneassist::cli {
@@ -318,8 +319,8 @@ CLI::App* add_replay_command(CLI::App& cli, ReplayArgs& args) {
   add_config_option(*replay, args.config_file);
   add_backend_options(*replay, args.machine);
   add_telemetry_options(*replay, args.telemetry, false);
-  replay->add_option("--test-freeze-at", args.freeze_at_s)->group("");
-  replay->add_option("--test-freeze-for", args.freeze_for_s)->group("");
+  replay->add_option("--test-freeze-at", args.freeze_at_s)->check(FiniteNumber())->group("");
+  replay->add_option("--test-freeze-for", args.freeze_for_s)->check(FiniteNumber())->group("");
   replay->add_option("--log", args.log_file, "Per-cycle CSV log (docs/log-format.md)")
       ->capture_default_str();
   replay->add_flag("--no-log", args.no_log, "Do not write the log");
@@ -340,7 +341,7 @@ CLI::App* add_replay_command(CLI::App& cli, ReplayArgs& args) {
   replay->add_flag("--realtime", args.realtime,
                    "Pace the loop at real time (default: as fast as possible)");
   replay->add_option("--settle", args.settle_s, "Seconds to keep running after the last replay row")
-      ->check(CLI::Range(0.0, 600.0))
+      ->check(FiniteRange(0.0, 600.0))
       ->capture_default_str();
   add_payload_option(*replay, args.payload_kg);
   add_initial_option(*replay, args.initial);

@@ -24,6 +24,7 @@
 #include "craneassist/input/sdl_source.hpp"
 #include "craneassist/offline/sim_setup.hpp"
 #include "exit_codes.hpp"
+#include "option_checks.hpp"
 #include "remote_input.hpp"
 
 namespace craneassist::cli {
@@ -174,7 +175,7 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
   sim->add_option(
          "--duration", args.duration_s,
          "Seconds to run (default: until q, Ctrl-C or SIGTERM; a replay: its length + 1 s)")
-      ->check(CLI::Range(0.01, 1e6));
+      ->check(FiniteRange(0.01, 1e6));
   sim->add_option("--log", args.log_file, "Per-cycle CSV log (docs/log-format.md)");
   sim->add_option("--record", args.record_file,
                   "Record the command the controller got, in the replay format");

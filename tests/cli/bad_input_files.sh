@@ -1,7 +1,8 @@
 #!/bin/sh
-# A broken input file of each format (replay, tip path, joint trajectory), through every command
-# that reads it, and a file over the size limit of each format: exit code 2 and one message
-# naming format, file, line and field.
+# A broken input file of each format (replay, tip path, joint trajectory, the YAML files), through
+# every command that reads it, a file over the size limit of each format, and option values no
+# check may let through (NaN): exit code 2 and one message naming format, file, line and field,
+# or the option.
 # Usage: bad_input_files.sh CRANEASSIST DATA_DIR WORKDIR
 set -u
 bin=$1 data=$2 work=$3
@@ -17,7 +18,7 @@ expect() {
     echo "$name: exit code $code, expected 2"
     failed=1
   fi
-  if ! grep -qF "$message" "$work/$name.txt"; then
+  if ! grep -qF -e "$message" "$work/$name.txt"; then
     echo "$name: no '$message' in:"
     cat "$work/$name.txt"
     failed=1
@@ -93,5 +94,18 @@ line=$(grep -n '    a: 3.504 m' "$crane" | cut -d: -f1)
 sed 's|    a: 3.504 m|    a: 1e30 m|' "$crane" > "$work/long_link.yaml"
 expect long_link "config: $work/long_link.yaml:$line: field 'joints[1].a': must be within +-100 m" \
   replay --config "$work/long_link.yaml" --no-log
+# A floating-point option given NaN or an infinity is refused naming the option (CLI11's Range
+# lets NaN through: every comparison with it is false).
+expect nan_settle "--settle: 'nan' is not a finite number in [0, 600]" replay --settle nan --no-log
+expect nan_feedback_timeout "--can-feedback-timeout: 'nan' is not a finite number" \
+  replay --can-feedback-timeout nan --no-log
+expect nan_payload "--payload: 'nan' is not a finite number" replay --payload nan --no-log
+expect inf_duration "--duration: 'inf' is not a finite number" \
+  sim --input replay "$demo" --no-realtime --duration inf
+expect nan_dt "--dt: 'nan' is not a finite number" plan "$data/../../examples/paths/vertical.csv" --dt nan
+expect nan_ds "--ds: 'nan' is not a finite number" bound "$data/../../examples/paths/vertical.csv" --ds nan
+expect nan_emulate "--feedback-period: 'nan' is not a finite number" \
+  emulate --can vcan0 --feedback-period nan
+expect nan_speed "--speed: '-nan' is not a finite number" experiment-2r --speed -nan
 [ "$failed" -eq 0 ] && echo "bad input files OK"
 exit "$failed"
