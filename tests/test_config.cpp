@@ -3,6 +3,8 @@
 
 #include <cstdio>
 #include <fstream>
+#include <limits>
+#include <stdexcept>
 #include <string>
 
 #include "craneassist/config/crane_config.hpp"
@@ -358,6 +360,47 @@ TEST(CraneConfig, AFileOverTheSizeLimitIsRefused) {
     }
   }
   std::remove(big.c_str());
+}
+
+// The fields the command line overrides are set through the config's own range check: the same
+// range and reason as the file's error, and an out-of-range value leaves the field as it was.
+TEST(CraneConfig, OverridesHaveTheFieldsRanges) {
+  using namespace craneassist::config;
+  auto cfg = default_crane_config();
+  const auto reason_of = [](auto&& set) {
+    try {
+      set();
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const double l_min = 1e-3 / 60.0;
+  EXPECT_EQ(reason_of([&] { set_pump_max_flow(cfg.model, 1e30 * l_min); }),
+            error_after_edit("max_flow: 325 L/min", "max_flow: 1e30 L/min").reason());
+  EXPECT_EQ(reason_of([&] { set_pump_max_flow(cfg.model, 0.0); }),
+            "must be positive and at most 60000 L/min (1 m^3/s)");
+  EXPECT_NEAR(cfg.model.pump.max_flow_m3_s, 325 * l_min, 1e-12);  // unchanged
+  EXPECT_EQ(reason_of([&] { set_pump_max_flow(cfg.model, 100 * l_min); }), "accepted");
+  EXPECT_NEAR(cfg.model.pump.max_flow_m3_s, 100 * l_min, 1e-12);
+  EXPECT_EQ(reason_of([&] { set_prime_mover_power(cfg.model, 1e30); }),
+            error_after_edit("prime_mover_power: 35 kW", "prime_mover_power: 1e30 W").reason());
+  EXPECT_EQ(reason_of([&] { set_prime_mover_power(cfg.model, 60e3); }), "accepted");
+  EXPECT_EQ(reason_of([&] { set_supply_pressure(cfg.model, -1.0); }),
+            error_after_edit("supply_pressure: 20 MPa", "supply_pressure: -1 Pa").reason());
+  EXPECT_EQ(reason_of([&] { set_supply_pressure(cfg.model, 25e6); }),
+            "must be positive and at most max_pressure (the relief setting, 21.5 MPa)");
+  EXPECT_EQ(
+      reason_of([&] { set_payload_mass(cfg.model, 1e6); }),
+      error_after_edit("mass: 0 kg, assumed\n\nhydraulics", "mass: 1e6 kg, assumed\n\nhydraulics")
+          .reason());
+  EXPECT_EQ(reason_of([&] { set_can_feedback_timeout(cfg.backend, 30.0); }),
+            error_after_edit("feedback_timeout: 50 ms", "feedback_timeout: 30 s").reason());
+  EXPECT_EQ(reason_of([&] { set_can_feedback_timeout(cfg.backend, 0.002); }), "accepted");
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(reason_of([&] { set_pump_max_flow(cfg.model, nan); }), "accepted");
+  EXPECT_NE(reason_of([&] { set_supply_pressure(cfg.model, nan); }), "accepted");
+  EXPECT_NE(reason_of([&] { set_payload_mass(cfg.model, nan); }), "accepted");
 }
 
 TEST(CraneConfig, PayloadMassCanBeSet) {

@@ -15,8 +15,9 @@ CLI::Option* add_config_option(CLI::App& command, std::string& file) {
 }
 
 CLI::Option* add_payload_option(CLI::App& command, std::optional<double>& kg) {
-  return command.add_option("--payload", kg, "Payload mass in the grapple, kg")
-      ->check(FiniteRange(0.0, 100000.0));
+  // The range is payload.mass's, checked when the value is applied (config::set_payload_mass).
+  return command.add_option("--payload", kg, "Payload mass in the grapple, kg, 0 to 100000")
+      ->check(FiniteNumber());
 }
 
 CLI::Option* add_initial_option(CLI::App& command, std::string& pose) {
@@ -46,7 +47,9 @@ config::CraneConfig load_crane(const std::string& file) {
 }
 
 void apply_crane_options(config::CraneConfig& cfg, const CraneOptions& options) {
-  if (options.payload_kg) config::set_payload_mass(cfg.model, *options.payload_kg);
+  if (options.payload_kg) {
+    apply_override("--payload", [&] { config::set_payload_mass(cfg.model, *options.payload_kg); });
+  }
   if (!options.initial.empty()) {
     if (!options.initial_allowed) {
       throw CLI::ValidationError("--initial",

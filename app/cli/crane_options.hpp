@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "craneassist/config/crane_config.hpp"
@@ -40,5 +41,18 @@ struct CraneOptions {
 // Applies the options to `cfg`. A value the config cannot take throws CLI::ValidationError
 // naming the option ("--initial: 'boom': no joint of that name").
 void apply_crane_options(config::CraneConfig& cfg, const CraneOptions& options);
+
+// Applies a config field given on the command line with its config setter, set(), which checks
+// it against the file's range (config::set_pump_max_flow, ...): the setter's
+// std::invalid_argument becomes a CLI::ValidationError naming the option ("--pump-max-flow: must
+// be positive and at most 60000 L/min (1 m^3/s)").
+template <typename Set>
+void apply_override(const char* option, Set&& set) {
+  try {
+    set();
+  } catch (const std::invalid_argument& e) {
+    throw CLI::ValidationError(option, e.what());
+  }
+}
 
 }  // namespace craneassist::cli

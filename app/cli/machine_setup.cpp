@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "crane_options.hpp"
 #include "craneassist/offline/sim_setup.hpp"
 #include "exit_codes.hpp"
 #include "option_checks.hpp"
@@ -25,15 +26,23 @@ void add_backend_options(CLI::App& command, BackendArgs& args) {
                      "--backend can: write all CAN traffic as a candump -L log");
   command
       .add_option("--can-feedback-timeout", args.feedback_timeout_s,
-                  "--backend can: fault when a joint's position is older than this, s "
+                  "--backend can: fault when a joint's position is older than this, s, 0.001 to 1 "
                   "(default: can.feedback_timeout, 0.05)")
-      ->check(FiniteRange(0.005, 1.0));
+      ->check(FiniteNumber());  // the range is can.feedback_timeout's (apply_backend_options)
 }
 
 bool uses_can_backend(const BackendArgs& args, const config::CraneConfig& cfg) {
   const auto kind =
       args.backend.empty() ? cfg.backend.kind : config::parse_backend_kind(args.backend).value();
   return kind == config::BackendKind::kCan;
+}
+
+void apply_backend_options(config::CraneConfig& cfg, const BackendArgs& args) {
+  if (args.feedback_timeout_s) {
+    apply_override("--can-feedback-timeout", [&] {
+      config::set_can_feedback_timeout(cfg.backend, *args.feedback_timeout_s);
+    });
+  }
 }
 
 MachineInputs load_machine_inputs(const config::CraneConfig& cfg, const BackendArgs& args) {
@@ -64,7 +73,7 @@ int Machine::open(const config::CraneConfig& cfg, const BackendArgs& args,
     return kExitRuntime;
   }
   can_.emplace(cfg.model, iface, *inputs.mapping, args.can_log,
-               args.feedback_timeout_s.value_or(cfg.backend.can.feedback_timeout_s));
+               cfg.backend.can.feedback_timeout_s);  // --can-feedback-timeout applied to cfg
   machine_ = &can_->backend();
   if (std::string why; !machine_->activate(2.0, &why)) {
     spdlog::error("{} on {} (is the machine or `craneassist emulate --can {}` running?)", why,

@@ -38,6 +38,10 @@ struct MachineInputs {
 // Throws config::ConfigError naming the file, line and field (an input error: exit 2).
 MachineInputs load_machine_inputs(const config::CraneConfig& cfg, const BackendArgs& args);
 
+// Applies the backend options that override config fields (--can-feedback-timeout, through
+// can.feedback_timeout's range check). Throws CLI::ValidationError naming the option.
+void apply_backend_options(config::CraneConfig& cfg, const BackendArgs& args);
+
 // Holds the machine of a run: the simulator or the CAN machine (transport and backend). Callers
 // use the machine through its interface only.
 class Machine {

@@ -31,12 +31,13 @@
 namespace craneassist::cli {
 namespace {
 
-// Applies a quantity given on the command line ("120 L/min") or throws CLI-style.
+// A quantity given on the command line ("120 L/min"), in SI, or throws CLI-style. Its range is
+// the config field's, checked when it is applied (apply_override).
 double cli_quantity(const std::string& option, const std::string& text, config::Dimension dim) {
   std::string error;
   const auto q = config::parse_quantity(text, dim, error);
-  if (!q || q->si_values.size() != 1 || q->si_values[0] <= 0.0) {
-    throw CLI::ValidationError(option, error.empty() ? "expected one positive value" : error);
+  if (!q || q->si_values.size() != 1) {
+    throw CLI::ValidationError(option, error.empty() ? "expected one value" : error);
   }
   return q->si_values[0];
 }
@@ -45,7 +46,7 @@ double cli_quantity(const std::string& option, const std::string& text, config::
 double cli_pressure(const std::string& option, const std::string& text) {
   char* end = nullptr;
   const double mpa = std::strtod(text.c_str(), &end);
-  if (end != text.c_str() && *end == '\0' && std::isfinite(mpa) && mpa > 0.0) return mpa * 1e6;
+  if (end != text.c_str() && *end == '\0' && std::isfinite(mpa)) return mpa * 1e6;
   return cli_quantity(option, text, config::Dimension::kPressure);
 }
 
@@ -217,25 +218,23 @@ int run_replay_command(const ReplayArgs& args) {
     if (!args.power_bound.empty()) {
       cfg.scaling.power_bound = dynamics::parse_power_bound(args.power_bound).value();
     }
+    // The pump overrides, each through its config field's range check.
     if (!args.pump_max_flow.empty()) {
-      cfg.model.pump.max_flow_m3_s =
+      const double q =
           cli_quantity("--pump-max-flow", args.pump_max_flow, config::Dimension::kFlow);
+      apply_override("--pump-max-flow", [&] { config::set_pump_max_flow(cfg.model, q); });
     }
     if (!args.prime_mover_power.empty()) {
-      cfg.model.pump.prime_mover_power_w =
+      const double p =
           cli_quantity("--prime-mover-power", args.prime_mover_power, config::Dimension::kPower);
+      apply_override("--prime-mover-power", [&] { config::set_prime_mover_power(cfg.model, p); });
     }
     auto& pump = cfg.model.pump;
     if (args.pump_mode == "ls") pump.mode = dynamics::PumpMode::kLoadSensing;
     if (args.pump_mode == "cp") pump.mode = dynamics::PumpMode::kConstantPressure;
     if (!args.supply_pressure.empty()) {
-      pump.supply_pressure_pa = cli_pressure("--supply-pressure", args.supply_pressure);
-      if (pump.supply_pressure_pa > pump.max_pressure_pa) {
-        std::ostringstream why;
-        why << "must be at most max_pressure (the relief setting, " << pump.max_pressure_pa * 1e-6
-            << " MPa)";
-        throw CLI::ValidationError("--supply-pressure", why.str());
-      }
+      const double p = cli_pressure("--supply-pressure", args.supply_pressure);
+      apply_override("--supply-pressure", [&] { config::set_supply_pressure(cfg.model, p); });
     }
     config::apply_energy_optimal(cfg);  // the pump mode may have changed
     if (pump.mode == dynamics::PumpMode::kConstantPressure && !(pump.supply_pressure_pa > 0.0)) {
@@ -251,6 +250,7 @@ int run_replay_command(const ReplayArgs& args) {
       return run_trajectory_command(args, cfg);
     }
     telemetry_settings = load_telemetry_settings(args.telemetry);
+    apply_backend_options(cfg, args.machine);
     machine_inputs = load_machine_inputs(cfg, args.machine);
     if (args.replay_file.empty()) {
       loaded =

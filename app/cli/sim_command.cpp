@@ -236,6 +236,7 @@ int run_sim_command(const SimArgs& args) {
     if (kind == "replay") replay = input::Replay::load_file(args.input[1]);
     tcfg = load_telemetry_settings(args.telemetry);
     if (kind == "dds") check_remote_input_settings(tcfg);
+    apply_backend_options(cfg, args.machine);
     machine_inputs = load_machine_inputs(cfg, args.machine);
   } catch (...) {
     return input_error_exit("replay");

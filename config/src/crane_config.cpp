@@ -47,6 +47,21 @@ constexpr FieldRange kBodyMass{1.0, 1e5, "between 1 kg and 100000 kg"};
 // of 1.4 cm radius about its axis, a 100 m rod about its middle.
 constexpr double kMinGyrationM = 0.01;
 constexpr double kMaxGyrationM = 30.0;
+// The fields the command line overrides too (the setters at the end of this file).
+constexpr FieldRange kPayloadMass{0.0, 1e5, "between 0 and 100000 kg"};
+constexpr FieldRange kPumpMaxFlow{1e-7, 1.0, "positive and at most 60000 L/min (1 m^3/s)"};
+constexpr FieldRange kPrimeMoverPower{1.0, 1e7, "between 1 W and 10000 kW"};
+constexpr FieldRange kFeedbackTimeout{1e-3, 1.0, "between 1 ms and 1 s"};
+
+// The constant-pressure setpoint: positive and at most the relief setting; "" when it is.
+std::string supply_pressure_problem(const dynamics::Pump& pump, double pa) {
+  if (pa > 0.0 && pa <= pump.max_pressure_pa) return "";
+  std::ostringstream why;
+  why << "must be positive and at most max_pressure (the relief setting, "
+      << pump.max_pressure_pa * 1e-6 << " MPa)";
+  return why.str();
+}
+
 constexpr double kMaxGravityM_S2 = 20.0;
 constexpr double kMaxGravityTiltDeg = 45.0;  // from the crane frame's down, -y
 
@@ -345,8 +360,7 @@ void read_bodies(Reader& r, const YAML::Node& root, dynamics::CraneModel& model)
   dynamics::Body p;
   p.name = "payload";
   p.frame = model.dof();
-  p.mass_kg =
-      r.value_in(payload, "mass", "payload", Dimension::kMass, 0.0, 1e5, "between 0 and 100000 kg");
+  p.mass_kg = r.value_in(payload, "mass", "payload", Dimension::kMass, kPayloadMass);
   model.bodies.push_back(p);
 }
 
@@ -387,13 +401,13 @@ void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& mo
                {"mode", "max_flow", "max_pressure", "ls_margin", "prime_mover_power",
                 "standby_pressure", "supply_pressure"});
   auto& p = model.pump;
-  p.max_flow_m3_s = r.value_in(pump, "max_flow", pp, Dimension::kFlow, 1e-7, 1.0, "positive");
+  p.max_flow_m3_s = r.value_in(pump, "max_flow", pp, Dimension::kFlow, kPumpMaxFlow);
   p.max_pressure_pa = r.value_in(pump, "max_pressure", pp, Dimension::kPressure, 1e5, 1e8,
                                  "between 1 and 1000 bar");
   p.ls_margin_pa = r.value_in(pump, "ls_margin", pp, Dimension::kPressure, 1e4, p.max_pressure_pa,
                               "positive and below max_pressure");
   p.prime_mover_power_w =
-      r.value_in(pump, "prime_mover_power", pp, Dimension::kPower, 1.0, 1e7, "positive");
+      r.value_in(pump, "prime_mover_power", pp, Dimension::kPower, kPrimeMoverPower);
   p.standby_pressure_pa = r.value_in(pump, "standby_pressure", pp, Dimension::kPressure, 0.0,
                                      p.max_pressure_pa, "between 0 and max_pressure");
   // Optional: the mode defaults to load sensing; the constant-pressure setpoint is needed in that
@@ -409,11 +423,8 @@ void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& mo
   }
   if (pump["supply_pressure"].IsDefined()) {
     p.supply_pressure_pa = r.value(pump, "supply_pressure", pp, Dimension::kPressure);
-    if (!(p.supply_pressure_pa > 0.0 && p.supply_pressure_pa <= p.max_pressure_pa)) {
-      std::ostringstream why;
-      why << "must be positive and at most max_pressure (the relief setting, "
-          << p.max_pressure_pa * 1e-6 << " MPa)";
-      r.fail(pump["supply_pressure"], pp + ".supply_pressure", why.str());
+    if (const std::string why = supply_pressure_problem(p, p.supply_pressure_pa); !why.empty()) {
+      r.fail(pump["supply_pressure"], pp + ".supply_pressure", why);
     }
   } else if (p.mode == dynamics::PumpMode::kConstantPressure) {
     r.fail(pump, pp + ".supply_pressure",
@@ -464,8 +475,8 @@ void read_backend(Reader& r, const YAML::Node& root, BackendSettings& backend) {
     backend.can.mapping = mapping.string();
   }
   if (can["feedback_timeout"].IsDefined()) {
-    backend.can.feedback_timeout_s = r.value_in(can, "feedback_timeout", "can", Dimension::kTime,
-                                                1e-3, 1.0, "between 1 ms and 1 s");
+    backend.can.feedback_timeout_s =
+        r.value_in(can, "feedback_timeout", "can", Dimension::kTime, kFeedbackTimeout);
   }
 }
 
@@ -718,13 +729,41 @@ dynamics::JointVector parse_joint_pose(const dynamics::CraneModel& model, std::s
   return q;
 }
 
+namespace {
+
+void check_override(const FieldRange& range, double value) {
+  if (!range.contains(value)) throw std::invalid_argument(std::string("must be ") + range.text);
+}
+
+}  // namespace
+
 void set_payload_mass(dynamics::CraneModel& model, double mass_kg) {
-  if (!(mass_kg >= 0.0 && mass_kg <= 1e5)) {
-    throw std::invalid_argument("payload mass must be between 0 and 100000 kg");
-  }
+  check_override(kPayloadMass, mass_kg);
   for (auto& body : model.bodies) {
     if (body.name == "payload") body.mass_kg = mass_kg;
   }
+}
+
+void set_pump_max_flow(dynamics::CraneModel& model, double m3_s) {
+  check_override(kPumpMaxFlow, m3_s);
+  model.pump.max_flow_m3_s = m3_s;
+}
+
+void set_prime_mover_power(dynamics::CraneModel& model, double w) {
+  check_override(kPrimeMoverPower, w);
+  model.pump.prime_mover_power_w = w;
+}
+
+void set_supply_pressure(dynamics::CraneModel& model, double pa) {
+  if (const std::string why = supply_pressure_problem(model.pump, pa); !why.empty()) {
+    throw std::invalid_argument(why);
+  }
+  model.pump.supply_pressure_pa = pa;
+}
+
+void set_can_feedback_timeout(BackendSettings& backend, double seconds) {
+  check_override(kFeedbackTimeout, seconds);
+  backend.can.feedback_timeout_s = seconds;
 }
 
 }  // namespace craneassist::config

@@ -107,5 +107,16 @@ expect nan_ds "--ds: 'nan' is not a finite number" bound "$data/../../examples/p
 expect nan_emulate "--feedback-period: 'nan' is not a finite number" \
   emulate --can vcan0 --feedback-period nan
 expect nan_speed "--speed: '-nan' is not a finite number" experiment-2r --speed -nan
+# A command-line override of a config field goes through that field's range check (it skipped
+# it: --pump-max-flow "1e30 L/min" ran).
+expect big_flow "--pump-max-flow: must be positive and at most 60000 L/min" \
+  replay --pump-max-flow "1e30 L/min" --no-log
+expect big_power "--prime-mover-power: must be between 1 W and 10000 kW" \
+  replay --prime-mover-power "1e30 W" --no-log
+expect negative_supply "--supply-pressure: must be positive and at most max_pressure" \
+  replay --pump-mode cp --supply-pressure -5 --no-log
+expect big_payload "--payload: must be between 0 and 100000 kg" replay --payload 1e6 --no-log
+expect big_feedback_timeout "--can-feedback-timeout: must be between 1 ms and 1 s" \
+  replay --can-feedback-timeout 30 --no-log
 [ "$failed" -eq 0 ] && echo "bad input files OK"
 exit "$failed"

@@ -110,8 +110,16 @@ void set_resolution(CraneConfig& cfg, std::string_view name);
 // "min-ls-power (energy-optimal for load sensing)", "pinv-joint", ...
 std::string resolution_description(const CraneConfig& cfg);
 
-// Sets the payload body's mass (kg); throws std::invalid_argument outside [0, 100000].
-void set_payload_mass(dynamics::CraneModel& model, double mass_kg);
+// The config fields the command line overrides (replay --payload, --pump-max-flow,
+// --prime-mover-power, --supply-pressure, --can-feedback-timeout), checked against the same
+// ranges as the file's fields (docs/config.md#ranges). Each throws std::invalid_argument with the
+// reason, as the file's error gives it ("must be positive and at most 60000 L/min"), and then
+// leaves the value unchanged.
+void set_payload_mass(dynamics::CraneModel& model, double mass_kg);  // payload.mass
+void set_pump_max_flow(dynamics::CraneModel& model, double m3_s);    // hydraulics.pump.max_flow
+void set_prime_mover_power(dynamics::CraneModel& model, double w);   // ...prime_mover_power
+void set_supply_pressure(dynamics::CraneModel& model, double pa);    // ...supply_pressure
+void set_can_feedback_timeout(BackendSettings& backend, double seconds);  // can.feedback_timeout
 
 // A joint pose written as "NAME=VALUE UNIT, ..." with the model's joint names, e.g.
 // "lift=0 deg, tilt=-125 deg, extension=0.2 m" (angles in deg or rad, lengths in m, mm, cm).
