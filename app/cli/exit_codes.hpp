@@ -5,7 +5,7 @@
 namespace craneassist::cli {
 
 constexpr int kExitOk = 0;
-constexpr int kExitUsage = 2;    // bad command line, config, replay, path or trajectory file
+constexpr int kExitUsage = 2;    // bad command line or input file (any format, any size)
 constexpr int kExitRuntime = 3;  // the run itself failed
 
 // Inside a catch block around reading a run's inputs (config, files, option values): logs the
