@@ -1,23 +1,15 @@
 #include "craneassist/config/config_error.hpp"
 
+#include <cstddef>
+#include <utility>
+
+#include "craneassist/files/error_message.hpp"
+
 namespace craneassist::config {
-namespace {
-
-std::string format_message(const std::string& file, int line, const std::string& field,
-                           const std::string& reason) {
-  std::string msg;
-  msg.append(file);
-  if (line > 0) msg.append(":").append(std::to_string(line));
-  msg.append(": ");
-  if (!field.empty()) msg.append("field '").append(field).append("': ");
-  msg.append(reason);
-  return msg;
-}
-
-}  // namespace
 
 ConfigError::ConfigError(std::string file, int line, std::string field, std::string reason)
-    : std::runtime_error(format_message(file, line, field, reason)),
+    : std::runtime_error(
+          files::error_message(file, line > 0 ? static_cast<std::size_t>(line) : 0, field, reason)),
       file_(std::move(file)),
       line_(line),
       field_(std::move(field)),
