@@ -527,8 +527,13 @@ TEST(CanBackend, WrongDlcOnFeedbackLatchesAndUnknownFramesAreOnlyCounted) {
   EXPECT_EQ(backend.counters().bad_frames, 1u);
 }
 
-TEST(CanBackend, BusOffAndErrorPassiveLatch) {
-  for (auto flag : {kBusOff, kErrorPassive}) {
+TEST(CanBackend, BusOffErrorPassiveAndControllerRestartLatch) {
+  const std::pair<std::uint32_t, FaultReason> cases[] = {
+      {kBusOff, FaultReason::kBusOff},
+      {kErrorPassive, FaultReason::kErrorPassive},
+      {kControllerRestarted, FaultReason::kControllerRestarted},
+      {kBusOff | kControllerRestarted, FaultReason::kBusOff}};
+  for (const auto& [flag, reason] : cases) {
     Rig r;
     CanBackend backend(r.map, r.cfg.model, r.backend_end);
     valves::MachineState state;
@@ -541,11 +546,31 @@ TEST(CanBackend, BusOffAndErrorPassiveLatch) {
     err.timestamp_us = realtime_now_us();
     r.backend_end.deliver(err);
     send_feedback(r.sensors, r.map, r.q);
-    EXPECT_EQ(backend.read(state), valves::BackendStatus::kFault);
-    EXPECT_EQ(backend.fault_reason(),
-              flag == kBusOff ? FaultReason::kBusOff : FaultReason::kErrorPassive);
+    EXPECT_EQ(backend.read(state), valves::BackendStatus::kFault) << flag;
+    EXPECT_EQ(backend.fault_reason(), reason) << flag;
     EXPECT_EQ(backend.counters().bus_error_frames, 1u);
   }
+}
+
+TEST(CanBackend, AckProtocolAndWarningErrorsAreOnlyCounted) {
+  Rig r;
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  valves::MachineState state;
+  send_feedback(r.sensors, r.map, r.q);
+  backend.read(state);
+  backend.enable();
+  for (std::uint32_t flag : {std::uint32_t{kBusErrorOther}, std::uint32_t{kErrorWarning},
+                             std::uint32_t{kBusErrorOther | kErrorWarning}}) {
+    Received err;
+    err.kind = ReceiveKind::kBusError;
+    err.bus_error = flag;
+    err.timestamp_us = realtime_now_us();
+    r.backend_end.deliver(err);
+  }
+  send_feedback(r.sensors, r.map, r.q);
+  EXPECT_EQ(backend.read(state), valves::BackendStatus::kOk);
+  EXPECT_FALSE(backend.faulted());
+  EXPECT_EQ(backend.counters().bus_error_frames, 3u);
 }
 
 TEST(CanBackend, ConsecutiveSendErrorsLatch) {

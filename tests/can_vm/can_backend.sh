@@ -1,7 +1,9 @@
 # Guest script of the can_vm_can_backend test (tools/can-vm/run.sh, busybox sh in the VM, vcan0
 # up): the emulator and `craneassist replay --backend can` on vcan0, checked against the sim
 # backend and from independent candump captures; then the fault cases; then the live loop
-# (`craneassist sim --backend can`) against the live loop on the sim backend.
+# (`craneassist sim --backend can`) against the live loop on the sim backend; then controller
+# error frames on the bus and every way a run ends on the CAN backend (its end, --duration,
+# SIGINT): the valves come down gradually, never from flow to block in one frame.
 # The live runs leave DDS telemetry off (--no-telemetry): the one emulated CPU is busy enough.
 set -u
 status=0
@@ -25,6 +27,9 @@ start_capture() {
   sleep 0.2
 }
 stop_capture() { sleep 0.2; kill "$cd_pid"; wait "$cd_pid" 2>/dev/null; }
+
+echo "=== 0. the project's SocketCAN transport classifies controller error frames on this kernel"
+./transport_errors || fail "transport error-frame classification"
 
 echo "=== 1. the same replay on the sim backend and on the CAN backend (emulator on vcan0)"
 ./craneassist replay can_short.csv --log /tmp/sim.csv --settle 0.5 >/tmp/sim.out 2>&1 || fail "sim replay"
@@ -76,6 +81,8 @@ grep CAN /tmp/f3.out
 grep -q "CAN FAULT (bad feedback frame)" /tmp/f3.out || fail "no bad-frame fault"
 grep -q "unknown 2[0-9][0-9]," /tmp/f3.out || fail "garbage frames not counted"
 ./can_backend_check safe /tmp/cap3.log bad-frame 100 || fail "safe state after a wrong dlc"
+# The control of the stop check below: a fault blocks at once, and the check must see that.
+if ./can_backend_check stop /tmp/cap3.log 250; then fail "the stop check passed an abrupt block"; fi
 
 echo "=== 4. the control loop freezes (test hook: 0.5 s at t = 1 s)"
 start_emulator
@@ -131,4 +138,83 @@ cat /tmp/live_f7.out
 grep -q "CAN FAULT (feedback lost)" /tmp/live_f7.out || fail "no feedback-lost fault"
 grep -q "the machine reported a fault: run stopped" /tmp/live_f7.out || fail "the run did not stop"
 grep -q "ran [0-4]\.[0-9]* s of machine time" /tmp/live_f7.out || fail "the run went on after the fault"
+echo "=== 8. controller error frames during a replay: bus-off, error-passive and a restart latch"
+# cansend writes an error frame when the 8-digit id has CAN_ERR_FLAG (0x20000000): the class is
+# in the id, the controller state in byte 1 (linux/can/error.h).
+for c in "20000040#0000000000000000:bus-off" "20000004#0020000000000000:error-passive" \
+         "20000100#0000000000000000:controller restarted"; do
+  frame=${c%%:*}
+  reason=${c#*:}
+  start_emulator
+  candump -L vcan0,0:0,#FFFFFFFF >/tmp/cap8.log &
+  cd_pid=$!
+  sleep 0.2
+  ./craneassist replay can_short.csv --backend can --can vcan0 --no-log --settle 0 \
+    --can-feedback-timeout 0.3 >/tmp/f8.out 2>&1 &
+  rp=$!
+  ./can_backend_check wait-motion vcan0 10 || fail "$reason: the replay did not start moving"
+  sleep 0.3
+  cansend vcan0 "$frame"
+  wait "$rp"; rc=$?
+  stop_capture
+  kill "$emu" 2>/dev/null; wait "$emu"  # it may have stopped on the error frame itself
+  grep CAN /tmp/f8.out
+  [ "$rc" = 3 ] || fail "$reason: expected exit 3 after the fault, got $rc"
+  grep -q "CAN FAULT ($reason)" /tmp/f8.out || fail "$reason: no fault reported"
+  ./can_backend_check safe /tmp/cap8.log error-frame 100 || fail "$reason: safe state"
+done
+
+echo "=== 9. ACK and protocol errors are counted, the run goes on"
+start_emulator
+./craneassist replay can_short.csv --backend can --can vcan0 --log /tmp/can9.csv --settle 0.5 \
+  --can-feedback-timeout 0.3 >/tmp/f9.out 2>&1 &
+rp=$!
+./can_backend_check wait-motion vcan0 10 || fail "the replay did not start moving"
+for i in 1 2 3 4 5 6 7 8 9 10; do cansend vcan0 20000020#0000000000000000; done
+for i in 1 2 3 4 5; do cansend vcan0 20000008#0000040000000000; done
+wait "$rp"; rc=$?
+kill "$emu"; wait "$emu"
+grep CAN /tmp/f9.out
+[ "$rc" = 0 ] || fail "ACK errors: expected exit 0, got $rc"
+grep -q "bus errors 15," /tmp/f9.out || fail "ACK and protocol errors not counted"
+
+echo "=== 10. a replay that ends with the crane moving: jerk-limited stop, then block"
+start_emulator
+start_capture /tmp/cap10.log
+./craneassist replay can_ends_moving.csv --backend can --can vcan0 --no-log --settle 0 \
+  --can-feedback-timeout 0.3 >/tmp/f10.out 2>&1; rc=$?
+stop_capture
+kill "$emu"; wait "$emu"
+grep "CAN\|end of run" /tmp/f10.out
+[ "$rc" = 0 ] || fail "end of run: expected exit 0, got $rc"
+grep -q "end of run: stopped jerk-limited" /tmp/f10.out || fail "end of run: no stop reported"
+./can_backend_check stop /tmp/cap10.log 250 || fail "end of run: valves not brought down gradually"
+
+echo "=== 11. sim --duration ends while the crane moves"
+start_emulator
+start_capture /tmp/cap11.log
+./craneassist sim --no-telemetry --input replay can_short.csv --duration 1.5 --backend can \
+  --can vcan0 --can-feedback-timeout 0.3 >/tmp/f11.out 2>&1; rc=$?
+stop_capture
+kill "$emu"; wait "$emu"
+cat /tmp/f11.out
+[ "$rc" = 0 ] || fail "--duration: expected exit 0, got $rc"
+./can_backend_check stop /tmp/cap11.log 250 || fail "--duration: valves not brought down gradually"
+
+echo "=== 12. SIGINT while the crane moves (the operator quits)"
+start_emulator
+start_capture /tmp/cap12.log
+./craneassist sim --no-telemetry --input replay can_short.csv --backend can --can vcan0 \
+  --can-feedback-timeout 0.3 >/tmp/f12.out 2>&1 &
+rp=$!
+./can_backend_check wait-motion vcan0 10 || fail "the run did not start moving"
+sleep 0.8
+kill -INT "$rp"
+wait "$rp"; rc=$?
+stop_capture
+kill "$emu"; wait "$emu"
+cat /tmp/f12.out
+[ "$rc" = 0 ] || fail "SIGINT: expected exit 0, got $rc"
+grep -q "ran [0-2]\.[0-9]* s of machine time" /tmp/f12.out || fail "SIGINT: the run did not end early"
+./can_backend_check stop /tmp/cap12.log 250 || fail "SIGINT: valves not brought down gradually"
 exit "$status"

@@ -4,7 +4,12 @@
 //   traffic CAPTURE                     candump -L capture: identifiers, payloads, cycle times
 //   safe CAPTURE EVENT LIMIT_MS         time from EVENT to every section commanded to block;
 //        EVENT: last-feedback (the last position frame), bad-frame (the first position frame
-//        with a wrong dlc), last-motion (the last non-block command before the safe state)
+//        with a wrong dlc), last-motion (the last non-block command before the safe state),
+//        error-frame (the first controller error frame; needs a capture whose error mask
+//        passes them, e.g. candump -L vcan0,0:0,#FFFFFFFF)
+//   stop CAPTURE MIN_FALL_MS            the run's end brought the flow down gradually: the pump
+//                                       flow the emulator measures falls from 90 % to 10 % in at
+//                                       least MIN_FALL_MS (an abrupt block: about 100 ms)
 //   wait-motion IFACE TIMEOUT_S         waits until a command that is not block is on the bus:
 //                                       the run is moving
 // Prints the figures; exit 0 when they are within the bounds.
@@ -226,6 +231,24 @@ int traffic(const char* path) {
   return ok && bad_payload == 0 && unknown == 0 && moving > 0 ? 0 : 1;
 }
 
+// The first controller error frame of a candump -L -e capture: "(s.us) vcan0 20000040#...". The
+// project's candump parser reads data frames only, so this reads the id and the time itself.
+std::int64_t first_error_frame(const std::vector<std::string>& lines) {
+  for (const auto& l : lines) {
+    const auto hash = l.find('#');
+    const auto open = l.find('(');
+    if (hash == std::string::npos || hash < 8 || open == std::string::npos) continue;
+    const unsigned long id = std::strtoul(l.substr(hash - 8, 8).c_str(), nullptr, 16);
+    if ((id & CAN_ERR_FLAG) == 0) continue;
+    char* end = nullptr;
+    const long long sec = std::strtoll(l.c_str() + open + 1, &end, 10);
+    if (end == nullptr || *end != '.') continue;
+    const long long usec = std::strtoll(end + 1, nullptr, 10);
+    return static_cast<std::int64_t>(sec) * 1000000 + usec;
+  }
+  return -1;
+}
+
 int safe(const char* path, const std::string& event, double limit_ms) {
   std::vector<std::string> storage;
   const auto recs = read_capture(path, storage);
@@ -262,6 +285,7 @@ int safe(const char* path, const std::string& event, double limit_ms) {
       event_at = recs[i].timestamp;
     }
   }
+  if (event == "error-frame") event_at = first_error_frame(storage);
   if (event_at < 0) {
     std::printf("safe state: event %s not found in %s\n", event.c_str(), path);
     return 1;
@@ -271,6 +295,50 @@ int safe(const char* path, const std::string& event, double limit_ms) {
       "time to safe state (%s -> every section block, from candump): %.1f ms (limit %.0f)\n",
       event.c_str(), dt, limit_ms);
   return dt <= limit_ms ? 0 : 1;
+}
+
+// How the run's end brought the flow down, from the machine's side: the pump flow the emulator
+// measures (frame 0x310, bytes 2-3 Intel, 0.01 L/min; k70m_can.yaml) after the last motion.
+// The fall time is from the last 90 % to the last 10 % of the flow the crane had in the 1.5 s
+// before it came to rest. Valves blocked at once (a fault) close in the valve's lag, about
+// 0.1 s; a jerk-limited stop from speed takes several tenths.
+int stop(const char* path, double min_fall_ms) {
+  std::vector<std::string> storage;
+  const auto recs = read_capture(path, storage);
+  std::vector<std::pair<std::int64_t, double>> flow;  // (time us, L/min)
+  for (const auto& r : recs) {
+    if (!r.frame.extended && r.frame.id == 0x310 && r.frame.dlc >= 4) {
+      flow.emplace_back(r.timestamp, 0.01 * (r.frame.data[2] | (r.frame.data[3] << 8)));
+    }
+  }
+  if (flow.size() < 10) {
+    std::printf("stop: only %zu pump flow frames in %s\n", flow.size(), path);
+    return 1;
+  }
+  constexpr double kQuiet_lpm = 2.0;
+  std::size_t quiet = flow.size();  // from here on the flow stays below kQuiet_lpm
+  while (quiet > 0 && flow[quiet - 1].second < kQuiet_lpm) --quiet;
+  if (quiet == 0 || quiet == flow.size()) {
+    std::printf("stop: the flow %s in %s\n", quiet == 0 ? "never rose" : "never came down", path);
+    return 1;
+  }
+  const std::int64_t t_quiet = flow[quiet].first;
+  double peak = 0.0;
+  for (std::size_t i = 0; i < quiet; ++i) {
+    if (flow[i].first >= t_quiet - 1500000) peak = std::max(peak, flow[i].second);
+  }
+  std::int64_t t90 = -1, t10 = -1;
+  for (std::size_t i = 0; i < quiet; ++i) {
+    if (flow[i].first < t_quiet - 1500000) continue;
+    if (flow[i].second >= 0.9 * peak) t90 = flow[i].first;
+    if (flow[i].second >= 0.1 * peak) t10 = flow[i].first;
+  }
+  const double fall_ms = static_cast<double>(t10 - t90) * 1e-3;
+  std::printf(
+      "stop: pump flow %.1f L/min before the end, fall from 90 %% to 10 %% in %.0f ms (at least "
+      "%.0f), below %.0f L/min %.0f ms after the 90 %% point\n",
+      peak, fall_ms, min_fall_ms, kQuiet_lpm, static_cast<double>(t_quiet - t90) * 1e-3);
+  return peak > 10.0 && fall_ms >= min_fall_ms ? 0 : 1;
 }
 
 }  // namespace
@@ -317,8 +385,9 @@ int main(int argc, char** argv) {
   }
   if (mode == "traffic" && argc == 3) return traffic(argv[2]);
   if (mode == "safe" && argc == 5) return safe(argv[2], argv[3], std::strtod(argv[4], nullptr));
+  if (mode == "stop" && argc == 4) return stop(argv[2], std::strtod(argv[3], nullptr));
   if (mode == "wait-motion" && argc == 4)
     return wait_motion(argv[2], std::strtod(argv[3], nullptr));
-  std::fprintf(stderr, "usage: can_backend_check compare|traffic|safe|wait-motion ...\n");
+  std::fprintf(stderr, "usage: can_backend_check compare|traffic|safe|stop|wait-motion ...\n");
   return 2;
 }

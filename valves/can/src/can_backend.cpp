@@ -26,6 +26,8 @@ const char* to_string(FaultReason reason) {
       return "bus-off";
     case FaultReason::kErrorPassive:
       return "error-passive";
+    case FaultReason::kControllerRestarted:
+      return "controller restarted";
     case FaultReason::kSendError:
       return "send errors";
     case FaultReason::kLoopFrozen:
@@ -301,10 +303,17 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
         if ((m.rx.bus_error & kBusOff) != 0) {
           latch(FaultReason::kBusOff, "bus-off reported by the CAN controller on %s",
                 m.transport.interface_name());
+        } else if ((m.rx.bus_error & kControllerRestarted) != 0) {
+          // A restart follows a bus-off whose error frame may not have reached us: frames were
+          // lost either way, so the valves' state is not known.
+          latch(FaultReason::kControllerRestarted,
+                "the CAN controller on %s restarted after bus-off", m.transport.interface_name());
         } else if ((m.rx.bus_error & kErrorPassive) != 0) {
           latch(FaultReason::kErrorPassive, "error-passive reported by the CAN controller on %s",
                 m.transport.interface_name());
         }
+        // Warnings, protocol, ACK and arbitration errors are only counted: the controller
+        // retransmits, and errors that persist drive it error-passive, which latches.
         continue;
       default:
         break;

@@ -52,6 +52,7 @@ enum class FaultReason : std::uint8_t {
   kErrorPassive,
   kSendError,
   kLoopFrozen,
+  kControllerRestarted,  // the controller restarted: it was bus-off, frames were lost
 };
 const char* to_string(FaultReason reason);
 
