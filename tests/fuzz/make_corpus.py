@@ -54,6 +54,19 @@ write("fuzz_joint_trajectory", "six_joints.csv",
       ",".join(f"qddot_{i}" for i in range(1, 7)) + "\n0" + ",0" * 18 + "\n2" + ",1" * 18 + "\n")
 write("fuzz_joint_trajectory", "bad_trajectory.csv", read("tests/data/bad_trajectory.csv"))
 
+# Joint poses (--initial, suite poses) and suite manifests.
+for name, text in (("folded.txt", "lift=0 deg, tilt=-125 deg, extension=0.2 m"),
+                   ("units.txt", "slew=0.5 rad,lift=10deg , extension = 150 mm"),
+                   ("one_joint.txt", "tilt=-1.2 rad"),
+                   ("out_of_range.txt", "extension=9 m"),
+                   ("twice.txt", "lift=1 deg, lift=2 deg")):
+    write("fuzz_joint_pose", name, text)
+write("fuzz_suite_manifest", "suite.yaml", read("examples/replays/suite.yaml"))
+write("fuzz_suite_manifest", "payload_targets.yaml",
+      "format: craneassist-suite/1\nposes:\n  low: lift=5 deg\ntargets:\n  stall_events: 0\n"
+      "runs:\n  - replay: heavy_lift.csv\n    poses: [default, low]\n    payload: 650 kg\n"
+      "    targets: {lateral_speed: 0.05 m/s}\n")
+
 # The shared reader: a selector byte (flags of the format) and a file of its columns.
 write("fuzz_csv_reader", "full.csv", b"\x00t,a,b,f\n0,1,2,0\n0.5,-1,1e300,1\n")
 write("fuzz_csv_reader", "optional.csv", b"\x06# c\nt,a\n0,4.5\n0.0005,1\n")
