@@ -217,4 +217,18 @@ cat /tmp/f12.out
 [ "$rc" = 0 ] || fail "SIGINT: expected exit 0, got $rc"
 grep -q "ran [0-2]\.[0-9]* s of machine time" /tmp/f12.out || fail "SIGINT: the run did not end early"
 ./can_backend_check stop /tmp/cap12.log 250 || fail "SIGINT: valves not brought down gradually"
+echo "=== 13. feedback lost while the wall clock steps back (timed on CLOCK_MONOTONIC)"
+# The clock goes back years the moment the emulator dies: freshness timed on the wall clock
+# would see the last position frame in the future and the fault would wait for the run's end.
+start_emulator
+./craneassist replay can_short.csv --backend can --can vcan0 --no-log --settle 0 >/tmp/f13.out 2>&1 &
+rp=$!
+./can_backend_check wait-motion vcan0 10 || fail "the replay did not start moving"
+kill -9 "$emu"
+date -s "2020-01-01 00:00:00" >/dev/null
+wait "$rp"; rc=$?
+grep CAN /tmp/f13.out
+[ "$rc" = 3 ] || fail "clock step: expected exit 3 after the fault, got $rc"
+grep -q "CAN FAULT (feedback lost) at [0-3]\.[0-9]* s" /tmp/f13.out ||
+  fail "clock step: lost feedback not found within the run"
 exit "$status"
