@@ -168,3 +168,19 @@ TEST(JoystickConfig, DuplicateKeysAreRejected) {
                                        ": field 'input.max_speed': duplicate key (first at line " +
                                        std::to_string(first) + ")");
 }
+
+TEST(JoystickConfig, TheWebPageMapsLikeTheGamepadWithALongerStaleTimeout) {
+  const auto pad = config::default_joystick_config();
+  const auto web = config::web_joystick_config();
+  EXPECT_DOUBLE_EQ(web.monitor.stale_timeout_s, 0.25);
+  EXPECT_DOUBLE_EQ(pad.monitor.stale_timeout_s, 0.1);
+  EXPECT_DOUBLE_EQ(web.monitor.deadman_hold_s, pad.monitor.deadman_hold_s);
+  EXPECT_DOUBLE_EQ(web.monitor.stop_latch_s, pad.monitor.stop_latch_s);
+  EXPECT_EQ(web.mapping.deadman, pad.mapping.deadman);
+  EXPECT_EQ(web.mapping.frame, pad.mapping.frame);
+  for (std::size_t i = 0; i < input::kOperatorAxisCount; ++i) {
+    EXPECT_EQ(web.mapping.axes[i].axis, pad.mapping.axes[i].axis);
+    EXPECT_EQ(web.mapping.axes[i].invert, pad.mapping.axes[i].invert);
+    EXPECT_DOUBLE_EQ(web.mapping.axes[i].max, pad.mapping.axes[i].max);
+  }
+}

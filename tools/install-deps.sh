@@ -11,7 +11,10 @@ packages=(
   libevdev-dev libsdl2-dev tmux  # joysticks; tmux drives the keyboard joystick in tests
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools openssl  # DDS telemetry and security
   clang libclang-rt-14-dev llvm  # the clang sanitizer build and libFuzzer (docs/fuzzing.md)
+  libboost-dev nlohmann-json3-dev chromium  # the web view (docs/web.md) and its browser test
 )
+# npm bundles the web page at build time (Debian's npm, unless node and npm are already there).
+command -v npm >/dev/null || packages+=(npm)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -3,13 +3,15 @@
 # twice: a release build (with the SocketCAN tests in a qemu VM, label can_vm), then a clang build
 # with AddressSanitizer and UndefinedBehaviorSanitizer (with float-cast-overflow and implicit
 # integer conversion checks) that also runs each libFuzzer harness briefly (label fuzz_smoke;
-# docs/fuzzing.md). Also checks the formatting and that the executable builds without DDS.
+# docs/fuzzing.md). Also checks the formatting and that the executable builds without DDS and
+# without the web view.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/install-deps.sh
 tools/can-vm/prepare.sh  # Debian's stock kernel with CAN for the VM tests (cached in build/)
 jobs="$(nproc)"
 export CRANEASSIST_CAN_VM_REQUIRED=1  # here the VM tests must run, never be skipped
+export CRANEASSIST_WEB_REQUIRED=1     # and the browser test of the web view
 
 echo "== formatting (clang-format)"
 find app bench config dynamics input scaling sim_backend tests valves \( -name '*.cpp' -o -name '*.hpp' \) \
@@ -20,11 +22,11 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$jobs"
 ctest --test-dir build --output-on-failure -j"$jobs"
 
-echo "== build without DDS (CRANEASSIST_DDS=OFF): the executable alone, unoptimised, and its CLI checks"
+echo "== build without DDS and the web view: the executable alone, unoptimised, and its CLI checks"
 cmake -S . -B build-nodds -DCMAKE_BUILD_TYPE=Debug -DCRANEASSIST_DDS=OFF -DCRANEASSIST_BUILD_BENCH=OFF \
-  -DCRANEASSIST_CAN_VM_TESTS=OFF >/dev/null
+  -DCRANEASSIST_CAN_VM_TESTS=OFF -DCRANEASSIST_WEB=OFF >/dev/null
 cmake --build build-nodds -j"$jobs" --target craneassist
-ctest --test-dir build-nodds --output-on-failure -R 'cli_sim_without_dds|cli_replay_initial|cli_sim_bad_input'
+ctest --test-dir build-nodds --output-on-failure -R 'cli_sim_without_dds|cli_sim_without_web|cli_replay_initial|cli_sim_bad_input'
 
 echo "== clang AddressSanitizer + UndefinedBehaviorSanitizer build, tests and fuzz smoke runs"
 cmake -S . -B build-clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \

@@ -165,11 +165,12 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
   add_config_option(*sim, args.config_file);
   sim->add_option("--input", args.input,
                   "keyboard (default on a terminal), evdev, sdl, dds (a remote operator, "
-                  "docs/remote-commands.md), or replay FILE")
+                  "docs/remote-commands.md), web (the virtual joystick of --web; its default), "
+                  "or replay FILE")
       ->expected(1, 2);
   sim->add_option("--joystick", args.joystick_file,
                   "Joystick mapping YAML (docs/joystick.md; default: the embedded "
-                  "config/joysticks/gamepad.yaml)")
+                  "config/joysticks/gamepad.yaml, web.yaml for --input web)")
       ->check(CLI::ExistingFile);
   sim->add_option("--device", args.device, "evdev: the device, e.g. /dev/input/event5");
   sim->add_option(
@@ -194,14 +195,22 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
   add_resolution_option(*sim, args.resolution, "for the run");
   add_backend_options(*sim, args.machine);
   add_telemetry_options(*sim, args.telemetry, true);
+  add_web_options(*sim, args.web);
   return sim;
 }
 
 int run_sim_command(const SimArgs& args) {
-  std::string kind = args.input.empty() ? "keyboard" : args.input[0];
-  if (kind != "keyboard" && kind != "evdev" && kind != "sdl" && kind != "dds" && kind != "replay") {
-    spdlog::error("--input: unknown input '{}' (expected keyboard, evdev, sdl, dds or replay FILE)",
-                  kind);
+  std::string kind = !args.input.empty() ? args.input[0] : args.web.on ? "web" : "keyboard";
+  if (kind != "keyboard" && kind != "evdev" && kind != "sdl" && kind != "dds" && kind != "replay" &&
+      kind != "web") {
+    spdlog::error(
+        "--input: unknown input '{}' (expected keyboard, evdev, sdl, dds, web or replay FILE)",
+        kind);
+    return kExitUsage;
+  }
+  const bool web_on = args.web.on || kind == "web";
+  if (web_on && args.no_realtime) {
+    spdlog::error("--web: the web view runs in real time (leave out --no-realtime)");
     return kExitUsage;
   }
   if (kind == "dds" && !remote_input_available()) {
@@ -231,8 +240,9 @@ int run_sim_command(const SimArgs& args) {
     cfg = load_crane(args.config_file);
     apply_crane_options(cfg, {args.payload_kg, args.initial, args.resolution,
                               !uses_can_backend(args.machine, cfg)});
-    jcfg = args.joystick_file.empty() ? config::default_joystick_config()
-                                      : config::load_joystick_config(args.joystick_file);
+    jcfg = !args.joystick_file.empty() ? config::load_joystick_config(args.joystick_file)
+           : kind == "web"             ? config::web_joystick_config()
+                                       : config::default_joystick_config();
     if (kind == "replay") replay = input::Replay::load_file(args.input[1]);
     tcfg = load_telemetry_settings(args.telemetry);
     if (kind == "dds") check_remote_input_settings(tcfg);
@@ -273,9 +283,9 @@ int run_sim_command(const SimArgs& args) {
           input::EvdevSource::Options{});
     } else if (kind == "sdl") {
       source = std::make_unique<input::SdlSource>(jcfg.mapping, input::SdlSource::Options{});
-    } else {
+    } else if (kind == "replay") {
       source = std::make_unique<input::ReplaySource>(*replay);
-    }
+    }  // web: the page's joystick, once the server runs (below)
     std::set_terminate([] {
       input::KeyboardSource::restore_terminal();
       std::abort();
@@ -285,6 +295,11 @@ int run_sim_command(const SimArgs& args) {
     sigaction(SIGINT, &sa, nullptr);
     sigaction(SIGTERM, &sa, nullptr);
 
+    WebView web;
+    if (web_on) {
+      if (const int rc = web.open(args.web, cfg); rc != kExitOk) return rc;
+      if (kind == "web") source = web.pad_source(jcfg.mapping);
+    }
     Telemetry telemetry;
     if (const int rc = telemetry.open(tcfg, !args.telemetry.off, cfg, machine.name());
         rc != kExitOk) {
@@ -306,6 +321,7 @@ int run_sim_command(const SimArgs& args) {
     options.realtime_setup.priority = args.rt_priority > 0 ? args.rt_priority : args.rt ? 80 : 0;
     options.realtime_setup.cpu = args.cpu;
     if (control::CycleObserver* o = telemetry.observer()) options.observers.push_back(o);
+    if (control::CycleObserver* o = web.observer()) options.observers.push_back(o);
     if (!args.record_file.empty()) {
       options.record = &record;
       if (options.duration_s > 0.0) {
@@ -368,6 +384,7 @@ int run_sim_command(const SimArgs& args) {
     }
     std::printf("  input device: %d disconnects, %d re-attaches\n", s.disconnects, s.reconnects);
     if (!remote_report.empty()) std::printf("%s\n", remote_report.c_str());
+    if (const std::string r = web.report(); !r.empty()) std::printf("%s\n", r.c_str());
     if (log) std::printf("  log: %s (%zu rows)\n", log->path().c_str(), log->rows_written());
     if (!args.record_file.empty()) {
       std::printf("  record: %s (%zu rows%s)\n", args.record_file.c_str(), record.size(),

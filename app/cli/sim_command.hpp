@@ -11,6 +11,7 @@
 
 #include "machine_setup.hpp"
 #include "telemetry_setup.hpp"
+#include "web_view.hpp"
 
 namespace craneassist::cli {
 
@@ -32,6 +33,7 @@ struct SimArgs {
   std::string initial;     // start pose "NAME=VALUE UNIT, ..." (sim backend); empty: the config's
   BackendArgs machine;     // empty values: the config's backend: and can:
   TelemetryArgs telemetry;
+  WebArgs web;
 };
 
 CLI::App* add_sim_command(CLI::App& cli, SimArgs& args);

@@ -67,6 +67,11 @@ write("fuzz_suite_manifest", "payload_targets.yaml",
       "runs:\n  - replay: heavy_lift.csv\n    poses: [default, low]\n    payload: 650 kg\n"
       "    targets: {lateral_speed: 0.05 m/s}\n")
 
+# The web page's stick state.
+write("fuzz_web_pad", "pad.json", '{"type":"pad","axes":[0.5,-1,0,1,0,0],"deadman":true}')
+write("fuzz_web_pad", "short.json", '{"type":"pad","axes":[],"deadman":false}')
+write("fuzz_web_pad", "unicode.json", '{"type":"p\\u0061d","axes":[1e-3, -0.0],"deadman":true,"x":[{}]}')
+
 # The shared reader: a selector byte (flags of the format) and a file of its columns.
 write("fuzz_csv_reader", "full.csv", b"\x00t,a,b,f\n0,1,2,0\n0.5,-1,1e300,1\n")
 write("fuzz_csv_reader", "optional.csv", b"\x06# c\nt,a\n0,4.5\n0.0005,1\n")

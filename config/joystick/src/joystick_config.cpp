@@ -154,4 +154,8 @@ JoystickConfig default_joystick_config() {
   return parse_joystick_config(embedded::kGamepadYaml, "<embedded config/joysticks/gamepad.yaml>");
 }
 
+JoystickConfig web_joystick_config() {
+  return parse_joystick_config(embedded::kWebJoystickYaml, "<embedded config/joysticks/web.yaml>");
+}
+
 }  // namespace craneassist::config

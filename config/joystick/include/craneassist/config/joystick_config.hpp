@@ -28,5 +28,8 @@ JoystickConfig parse_joystick_config(std::string_view yaml_text, std::string_vie
 
 // The shipped default, embedded (config/joysticks/gamepad.yaml).
 JoystickConfig default_joystick_config();
+// The web view's virtual joystick (config/joysticks/web.yaml): the gamepad mapping with a stale
+// timeout for a browser over a network connection (250 ms).
+JoystickConfig web_joystick_config();
 
 }  // namespace craneassist::config

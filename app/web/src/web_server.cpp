@@ -1,0 +1,571 @@
+#include "craneassist/web/web_server.hpp"
+
+#include <atomic>
+#include <boost/asio.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <deque>
+#include <fstream>
+#include <future>
+#include <mutex>
+#include <stdexcept>
+#include <string_view>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "craneassist/input/gamepad.hpp"
+#include "craneassist/input/joystick_mapping.hpp"
+#include "pad_message.hpp"
+#include "scene.hpp"
+
+// The page, bundled by the build (app/web/page, esbuild) and linked in (page_assets.S).
+extern "C" {
+extern const char craneassist_web_index_html[];
+extern const char craneassist_web_index_html_end[];
+extern const char craneassist_web_app_js[];
+extern const char craneassist_web_app_js_end[];
+}
+
+namespace craneassist::web {
+namespace {
+
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+namespace net = boost::asio;
+using tcp = net::ip::tcp;
+
+std::string_view asset(const char* begin, const char* end) {
+  return {begin, static_cast<std::size_t>(end - begin)};
+}
+
+std::string random_token() {
+  unsigned char bytes[16] = {};
+  std::ifstream urandom("/dev/urandom", std::ios::binary);
+  urandom.read(reinterpret_cast<char*>(bytes), sizeof bytes);
+  if (!urandom) throw std::runtime_error("web: cannot read /dev/urandom for the session token");
+  std::string token;
+  char hex[3];
+  for (const unsigned char b : bytes) {
+    std::snprintf(hex, sizeof hex, "%02x", b);
+    token += hex;
+  }
+  return token;
+}
+
+// The value of `name` in the query of a request target ("/ws?token=abc&x=1"), or "".
+std::string query_value(std::string_view target, std::string_view name) {
+  const auto q = target.find('?');
+  if (q == std::string_view::npos) return {};
+  std::string_view rest = target.substr(q + 1);
+  while (!rest.empty()) {
+    const auto amp = rest.find('&');
+    const std::string_view pair = rest.substr(0, amp);
+    const auto eq = pair.find('=');
+    if (eq != std::string_view::npos && pair.substr(0, eq) == name) {
+      return std::string(pair.substr(eq + 1));
+    }
+    if (amp == std::string_view::npos) break;
+    rest = rest.substr(amp + 1);
+  }
+  return {};
+}
+
+std::string_view path_of(std::string_view target) {
+  return target.substr(0, target.find('?'));
+}
+
+// Compares without stopping at the first difference (the token is a secret).
+bool same_secret(const std::string& a, const std::string& b) {
+  if (a.size() != b.size()) return false;
+  unsigned char diff = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+  }
+  return diff == 0;
+}
+
+}  // namespace
+
+class WsSession;
+
+struct WebServer::Impl {
+  Impl(const WebOptions& o, const config::CraneConfig& crane)
+      : options(o),
+        crane_text(crane_json(crane, o.frame_rate_hz)),
+        scene(crane.model),
+        token(o.token.empty() ? random_token() : o.token),
+        acceptor(ioc),
+        timer(ioc) {}
+
+  // The loop's side.
+  class Observer : public control::CycleObserver {
+   public:
+    explicit Observer(Impl& impl) : impl_(impl) {}
+    void on_cycle(const control::CycleRecord& cycle) noexcept override {
+      if (impl_.row_mutex.try_lock()) {
+        impl_.row = cycle.row;
+        ++impl_.row_seq;
+        impl_.row_mutex.unlock();
+      }
+    }
+
+   private:
+    Impl& impl_;
+  };
+
+  void start();
+  void tick();
+  void broadcast(const std::shared_ptr<const std::string>& message);
+  void on_pad(WsSession& from, std::string_view text);
+  void on_closed(WsSession& session);
+  void publish_disconnected();
+  void shutdown();
+
+  WebOptions options;
+  std::string crane_text;
+  SceneBuilder scene;
+  std::string token;
+  net::io_context ioc{1};
+  tcp::acceptor acceptor;
+  net::steady_timer timer;
+  std::thread thread;
+  std::promise<void> stopped;
+
+  // Loop -> I/O thread.
+  std::mutex row_mutex;
+  control::LogRow row;
+  std::uint64_t row_seq = 0;
+  // I/O thread only.
+  control::LogRow taken;
+  std::uint64_t sent_seq = 0;
+  std::string frame_text;
+  std::vector<std::weak_ptr<WsSession>> sessions;
+  WsSession* holder = nullptr;
+
+  // I/O thread -> loop: the page's stick state (the loop takes it with try_lock, never waits).
+  struct PadState {
+    input::GamepadState pad;
+    double stamp_s = 0.0;    // when it arrived (steady clock, s)
+    bool connected = false;  // a page holds the command
+    bool has_state = false;  // a page has held it
+  };
+  std::mutex pad_mutex;
+  PadState pad_state;
+  void publish(const PadState& s) {
+    std::lock_guard<std::mutex> lock(pad_mutex);
+    pad_state = s;
+  }
+  input::GamepadButton deadman_button = input::GamepadButton::kRightShoulder;
+  std::atomic<bool> pad_source_made{false};
+
+  Observer observer{*this};
+
+  std::atomic<std::uint64_t> http_requests{0}, pages_connected{0}, frames_sent{0},
+      frames_dropped{0}, pad_messages{0}, pad_refused{0}, pad_malformed{0}, command_holders{0};
+};
+
+// One page's WebSocket: frames out (a short queue; a page that falls behind misses frames, it
+// never holds the server up), stick states in.
+class WsSession : public std::enable_shared_from_this<WsSession> {
+ public:
+  WsSession(tcp::socket&& socket, WebServer::Impl& impl, bool may_command)
+      : ws_(std::move(socket)), impl_(impl), may_command_(may_command) {}
+
+  void run(http::request<http::string_body> req) {
+    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    ws_.read_message_max(4096);
+    ws_.async_accept(req, [self = shared_from_this()](beast::error_code ec) {
+      if (ec) return;
+      self->impl_.pages_connected.fetch_add(1);
+      self->impl_.sessions.push_back(self);
+      self->send(
+          std::make_shared<const std::string>(std::string("{\"type\":\"hello\",\"command\":\"") +
+                                              (self->may_command_ ? "available" : "view") + "\"}"));
+      self->read();
+    });
+  }
+
+  // Queues a message; false when the page is behind (the message is dropped).
+  bool send(const std::shared_ptr<const std::string>& message) {
+    if (closed_ || queue_.size() >= 2) return false;
+    queue_.push_back(message);
+    if (queue_.size() == 1) write();
+    return true;
+  }
+
+  void close() {
+    if (closed_) return;
+    closed_ = true;
+    ws_.async_close(websocket::close_code::going_away,
+                    [self = shared_from_this()](beast::error_code) {});
+  }
+
+  bool may_command() const { return may_command_; }
+  bool told_refused = false;
+
+ private:
+  void read() {
+    ws_.async_read(buffer_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+      if (ec) {
+        self->closed_ = true;
+        self->impl_.on_closed(*self);
+        return;
+      }
+      const auto data = self->buffer_.data();
+      self->impl_.on_pad(*self,
+                         std::string_view(static_cast<const char*>(data.data()), data.size()));
+      self->buffer_.consume(self->buffer_.size());
+      self->read();
+    });
+  }
+
+  void write() {
+    ws_.text(true);
+    ws_.async_write(net::buffer(*queue_.front()),
+                    [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                      if (ec) {
+                        self->queue_.clear();
+                        return;
+                      }
+                      self->queue_.pop_front();
+                      if (!self->queue_.empty()) self->write();
+                    });
+  }
+
+  websocket::stream<beast::tcp_stream> ws_;
+  beast::flat_buffer buffer_;
+  std::deque<std::shared_ptr<const std::string>> queue_;
+  WebServer::Impl& impl_;
+  bool may_command_;
+  bool closed_ = false;
+};
+
+namespace {
+
+// One HTTP connection: the page's files, /crane.json, and the upgrade to /ws.
+class HttpSession : public std::enable_shared_from_this<HttpSession> {
+ public:
+  HttpSession(tcp::socket&& socket, WebServer::Impl& impl)
+      : stream_(std::move(socket)), impl_(impl) {}
+
+  void read() {
+    parser_.emplace();
+    parser_->header_limit(8192);
+    parser_->body_limit(8192);
+    stream_.expires_after(std::chrono::seconds(30));
+    http::async_read(stream_, buffer_, *parser_,
+                     [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                       if (ec) {
+                         beast::error_code ignored;
+                         self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+                         return;
+                       }
+                       self->handle(self->parser_->release());
+                     });
+  }
+
+ private:
+  void handle(http::request<http::string_body> req) {
+    impl_.http_requests.fetch_add(1);
+    const std::string_view target(req.target().data(), req.target().size());
+    if (websocket::is_upgrade(req) && path_of(target) == "/ws") {
+      beast::error_code ec;
+      const auto peer = stream_.socket().remote_endpoint(ec);
+      const bool local = !ec && peer.address().is_loopback();
+      const bool may_command = impl_.options.commands &&
+                               same_secret(query_value(target, "token"), impl_.token) &&
+                               (local || impl_.options.remote_commands);
+      stream_.expires_never();
+      std::make_shared<WsSession>(stream_.release_socket(), impl_, may_command)
+          ->run(std::move(req));
+      return;
+    }
+    auto res = std::make_shared<http::response<http::string_body>>();
+    res->version(req.version());
+    res->keep_alive(req.keep_alive());
+    res->set(http::field::server, "craneassist");
+    res->set(http::field::cache_control, "no-store");
+    res->set("X-Content-Type-Options", "nosniff");
+    const std::string_view path = path_of(target);
+    if (req.method() != http::verb::get && req.method() != http::verb::head) {
+      res->result(http::status::method_not_allowed);
+      res->set(http::field::content_type, "text/plain");
+      res->body() = "only GET\n";
+    } else if (path == "/" || path == "/index.html") {
+      res->set(http::field::content_type, "text/html; charset=utf-8");
+      res->body() = asset(craneassist_web_index_html, craneassist_web_index_html_end);
+    } else if (path == "/app.js") {
+      res->set(http::field::content_type, "text/javascript; charset=utf-8");
+      res->body() = asset(craneassist_web_app_js, craneassist_web_app_js_end);
+    } else if (path == "/crane.json") {
+      res->set(http::field::content_type, "application/json");
+      res->body() = impl_.crane_text;
+    } else {
+      res->result(http::status::not_found);
+      res->set(http::field::content_type, "text/plain");
+      res->body() = "not found\n";
+    }
+    res->prepare_payload();
+    if (req.method() == http::verb::head) res->body().clear();
+    http::async_write(stream_, *res,
+                      [self = shared_from_this(), res](beast::error_code ec, std::size_t) {
+                        if (ec || !res->keep_alive()) {
+                          beast::error_code ignored;
+                          self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+                          return;
+                        }
+                        self->read();
+                      });
+  }
+
+  beast::tcp_stream stream_;
+  beast::flat_buffer buffer_;
+  std::optional<http::request_parser<http::string_body>> parser_;
+  WebServer::Impl& impl_;
+};
+
+void accept(WebServer::Impl& impl) {
+  impl.acceptor.async_accept([&impl](beast::error_code ec, tcp::socket socket) {
+    if (ec == net::error::operation_aborted) return;
+    if (!ec) std::make_shared<HttpSession>(std::move(socket), impl)->read();
+    accept(impl);
+  });
+}
+
+}  // namespace
+
+void WebServer::Impl::start() {
+  beast::error_code ec;
+  const auto address = net::ip::make_address(options.address, ec);
+  if (ec) throw std::runtime_error("web: bad listen address '" + options.address + "'");
+  const tcp::endpoint endpoint(address, options.port);
+  auto fail = [&](const char* what) {
+    throw std::runtime_error("web: cannot listen on " + options.address + ":" +
+                             std::to_string(options.port) + ": " + what + ": " + ec.message());
+  };
+  acceptor.open(endpoint.protocol(), ec);
+  if (ec) fail("open");
+  acceptor.set_option(net::socket_base::reuse_address(true), ec);
+  acceptor.bind(endpoint, ec);
+  if (ec) fail("bind");
+  acceptor.listen(net::socket_base::max_listen_connections, ec);
+  if (ec) fail("listen");
+  accept(*this);
+  tick();
+  thread = std::thread([this] {
+    // A handler that throws (out of memory) must not end the process: log and go on.
+    for (;;) {
+      try {
+        ioc.run();
+        break;
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "craneassist: web: %s\n", e.what());
+      }
+    }
+    stopped.set_value();
+  });
+}
+
+void WebServer::Impl::tick() {
+  bool fresh = false;
+  {
+    std::lock_guard<std::mutex> lock(row_mutex);
+    if (row_seq != sent_seq) {
+      taken = row;
+      sent_seq = row_seq;
+      fresh = true;
+    }
+  }
+  if (fresh) {
+    scene.frame_json(taken, sent_seq, frame_text);
+    broadcast(std::make_shared<const std::string>(frame_text));
+  }
+  const double rate = options.frame_rate_hz > 0.0 ? options.frame_rate_hz : 30.0;
+  timer.expires_after(std::chrono::microseconds(static_cast<long>(1e6 / rate)));
+  timer.async_wait([this](beast::error_code ec) {
+    if (!ec) tick();
+  });
+}
+
+void WebServer::Impl::broadcast(const std::shared_ptr<const std::string>& message) {
+  std::size_t live = 0;
+  for (auto& weak : sessions) {
+    if (auto s = weak.lock()) {
+      if (s->send(message)) {
+        frames_sent.fetch_add(1);
+      } else {
+        frames_dropped.fetch_add(1);
+      }
+      sessions[live++] = weak;
+    }
+  }
+  sessions.resize(live);
+}
+
+void WebServer::Impl::on_pad(WsSession& from, std::string_view text) {
+  auto reply = [&from](const char* state, const char* why) {
+    from.send(std::make_shared<const std::string>(
+        std::string("{\"type\":\"command\",\"state\":\"") + state + "\",\"why\":\"" + why + "\"}"));
+  };
+  if (!pad_source_made.load() || !from.may_command() || (holder != nullptr && holder != &from)) {
+    pad_refused.fetch_add(1);
+    if (!from.told_refused) {
+      from.told_refused = true;
+      reply("refused", !pad_source_made.load() ? "this run does not take commands from the page"
+                       : !from.may_command()
+                           ? "commands need the session token from the local machine"
+                           : "another page holds the command");
+    }
+    return;
+  }
+  PadMessage m;
+  if (!parse_pad_message(text, m)) {
+    pad_malformed.fetch_add(1);  // not published: the last good state goes stale, the crane stops
+    return;
+  }
+  PadState s;
+  for (std::size_t i = 0; i < input::kGamepadAxisCount && i < m.axes.size(); ++i) {
+    s.pad.axes[i] = m.axes[i];
+  }
+  s.pad.set_button(deadman_button, m.deadman);
+  s.stamp_s = input::steady_now_s();
+  s.connected = true;
+  s.has_state = true;
+  if (holder == nullptr) {
+    holder = &from;
+    command_holders.fetch_add(1);
+    reply("yours", "");
+  }
+  pad_messages.fetch_add(1);
+  publish(s);
+}
+
+void WebServer::Impl::on_closed(WsSession& session) {
+  if (holder == &session) {
+    holder = nullptr;
+    publish_disconnected();
+  }
+}
+
+void WebServer::Impl::publish_disconnected() {
+  PadState s;
+  s.connected = false;
+  s.has_state = true;
+  s.stamp_s = input::steady_now_s();
+  publish(s);
+}
+
+void WebServer::Impl::shutdown() {
+  beast::error_code ignored;
+  acceptor.close(ignored);
+  timer.cancel();
+  for (auto& weak : sessions) {
+    if (auto s = weak.lock()) s->close();
+  }
+  sessions.clear();
+}
+
+// The page's virtual joystick, mapped like a physical pad.
+class PadSource : public input::CommandSource {
+ public:
+  PadSource(WebServer::Impl& impl, const input::JoystickMapping& mapping)
+      : impl_(impl), mapper_(mapping) {}
+
+  void begin_cycle(double, const Eigen::Vector3d& tip_m) noexcept override { tip_ = tip_m; }
+  input::SourceState poll(input::OperatorCommand& out) noexcept override {
+    if (impl_.pad_mutex.try_lock()) {
+      taken_ = impl_.pad_state;
+      impl_.pad_mutex.unlock();
+    }
+    if (!taken_.has_state) return input::SourceState::kNoData;
+    if (!taken_.connected) return input::SourceState::kDisconnected;
+    out.v_m_s = mapper_.map(taken_.pad, tip_);
+    out.deadman = mapper_.deadman(taken_.pad);
+    out.stamp_s = taken_.stamp_s;
+    return input::SourceState::kOk;
+  }
+  const char* name() const noexcept override { return "web"; }
+
+ private:
+  WebServer::Impl& impl_;
+  input::JoystickMapper mapper_;
+  WebServer::Impl::PadState taken_;
+  Eigen::Vector3d tip_ = Eigen::Vector3d::UnitX();
+};
+
+WebServer::WebServer(const WebOptions& options, const config::CraneConfig& crane)
+    : impl_(std::make_unique<Impl>(options, crane)) {
+  impl_->start();
+}
+
+WebServer::~WebServer() {
+  net::post(impl_->ioc, [impl = impl_.get()] { impl->shutdown(); });
+  if (impl_->stopped.get_future().wait_for(std::chrono::milliseconds(500)) !=
+      std::future_status::ready) {
+    impl_->ioc.stop();
+  }
+  impl_->thread.join();
+}
+
+unsigned short WebServer::port() const {
+  beast::error_code ec;
+  return impl_->acceptor.local_endpoint(ec).port();
+}
+
+std::string WebServer::url() const {
+  std::string host = impl_->options.address;
+  if (host == "0.0.0.0" || host == "::") host = "127.0.0.1";
+  if (host.find(':') != std::string::npos) host = "[" + host + "]";
+  return "http://" + host + ":" + std::to_string(port()) + "/?token=" + impl_->token;
+}
+
+control::CycleObserver& WebServer::observer() {
+  return impl_->observer;
+}
+
+std::unique_ptr<input::CommandSource> WebServer::make_pad_source(
+    const input::JoystickMapping& mapping) {
+  if (impl_->pad_source_made.exchange(true)) {
+    throw std::logic_error("web: one pad source per server");
+  }
+  impl_->deadman_button = mapping.deadman;
+  return std::make_unique<PadSource>(*impl_, mapping);
+}
+
+WebCounters WebServer::counters() const {
+  const Impl& m = *impl_;
+  WebCounters c;
+  c.http_requests = m.http_requests.load();
+  c.pages_connected = m.pages_connected.load();
+  c.frames_sent = m.frames_sent.load();
+  c.frames_dropped = m.frames_dropped.load();
+  c.pad_messages = m.pad_messages.load();
+  c.pad_refused = m.pad_refused.load();
+  c.pad_malformed = m.pad_malformed.load();
+  c.command_holders = m.command_holders.load();
+  return c;
+}
+
+std::string WebServer::report() const {
+  const WebCounters c = counters();
+  char buf[320];
+  std::snprintf(buf, sizeof buf,
+                "  web: %llu pages, %llu frames sent (%llu dropped: a page behind), stick states "
+                "%llu accepted, %llu refused, %llu malformed; %llu pages took the command",
+                static_cast<unsigned long long>(c.pages_connected),
+                static_cast<unsigned long long>(c.frames_sent),
+                static_cast<unsigned long long>(c.frames_dropped),
+                static_cast<unsigned long long>(c.pad_messages),
+                static_cast<unsigned long long>(c.pad_refused),
+                static_cast<unsigned long long>(c.pad_malformed),
+                static_cast<unsigned long long>(c.command_holders));
+  return buf;
+}
+
+}  // namespace craneassist::web

@@ -1,0 +1,124 @@
+// The web view in a real browser (Debian's Chromium, headless, driven by playwright-core):
+// `craneassist sim --web` serves the page; the page must load and draw the crane, move with the
+// simulator, steer the tip the way the on-screen sticks point, and stop the crane when it closes.
+//
+//   node tests/web/web_page.mjs CRANEASSIST NODE_MODULES [SCREENSHOT.png]
+//
+// Prints the figures (frames per second the page received, stick-to-drawing latency) and exits
+// 0 when every check holds. docs/web.md#tests.
+import { spawn } from 'node:child_process';
+import { createRequire } from 'node:module';
+import { resolve } from 'node:path';
+
+const [craneassist, nodeModules, screenshot] = process.argv.slice(2);
+if (!craneassist || !nodeModules) {
+  console.error('usage: web_page.mjs CRANEASSIST NODE_MODULES [SCREENSHOT.png]');
+  process.exit(2);
+}
+const require = createRequire(resolve(nodeModules) + '/');
+const { chromium } = require('playwright-core');
+
+let failures = 0;
+const check = (ok, what) => {
+  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
+  if (!ok) failures += 1;
+};
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+// The simulator with the web view on any free port; its address from the first line it prints.
+const sim = spawn(craneassist, ['sim', '--web', '--web-listen', '127.0.0.1:0', '--no-telemetry',
+  '--duration', '60'], { stdio: ['ignore', 'pipe', 'pipe'] });
+let output = '';
+sim.stdout.on('data', (d) => { output += d; });
+sim.stderr.on('data', (d) => { output += d; });
+const simExit = new Promise((resolve) => sim.on('exit', (code, signal) => resolve({ code, signal })));
+const url = await new Promise((resolve, reject) => {
+  const timer = setTimeout(() => reject(new Error(`no address printed:\n${output}`)), 15000);
+  const poll = setInterval(() => {
+    const m = output.match(/web: open (http:\S+)/);
+    if (m) { clearInterval(poll); clearTimeout(timer); resolve(m[1]); }
+  }, 50);
+});
+console.log(`page: ${url}`);
+
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
+  args: ['--no-sandbox', '--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+    '--disable-quic', '--no-first-run', '--disable-background-networking',
+    '--disable-component-update', '--disable-sync'],
+});
+const errors = [];
+try {
+  const context = await browser.newContext({ viewport: { width: 1360, height: 1020 } });
+  const page = await context.newPage();
+  page.on('pageerror', (e) => errors.push(e.message));
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  await page.goto(url);
+
+  // 1. The page loads, connects and draws the crane from the stream.
+  await page.waitForFunction(() => window.craneassist.crane && window.craneassist.drawn > 20,
+    null, { timeout: 20000 });
+  const first = await page.evaluate(() => window.craneassist.last);
+  check(first.points && first.points.length === 5, `the crane is drawn from ${first.points.length} joint frames`);
+  const state = await page.evaluate(() => window.craneassist.command);
+  check(state === 'available' || state === 'yours', `the page may command (local, with the token): ${state}`);
+  await sleep(1200);
+  const rate = await page.evaluate(() => window.craneassist.rate_hz);
+  check(rate >= 20 && rate <= 40, `frames received: ${rate} per second (30 streamed)`);
+
+  // 2. Hold the deadman, then push the left stick forward: the tip goes out (radial, +x at slew
+  //    0), and the drawing follows the simulator.
+  await page.evaluate(() => window.craneassist.deadman(true));
+  await sleep(600);  // the deadman must be held 300 ms before commands pass
+  const before = await page.evaluate(() => window.craneassist.last);
+  await page.evaluate(() => window.craneassist.stick('left', 0, 1));
+  await sleep(2000);
+  const out = await page.evaluate(() => window.craneassist.last);
+  const dx = out.tip[0] - before.tip[0], dy = out.tip[1] - before.tip[1], dz = out.tip[2] - before.tip[2];
+  check(dx > 0.3, `left stick forward: the tip went out ${dx.toFixed(2)} m`);
+  check(Math.abs(dz) < 0.1 * dx && Math.abs(dy) < 0.2 * dx,
+    `... and not sideways or up (${dz.toFixed(3)} m, ${dy.toFixed(3)} m)`);
+  const moved = Math.hypot(...out.points[4].map((v, i) => v - before.points[4][i]));
+  check(moved > 0.3, `the drawn boom end moved ${moved.toFixed(2)} m`);
+  const latency = await page.evaluate(() => window.craneassist.latency_ms);
+  check(latency.length > 0, `stick to drawing: ${latency.map((v) => v.toFixed(0)).join(', ')} ms`);
+
+  // 3. The right stick up: the tip rises.
+  await page.evaluate(() => { window.craneassist.stick('left', 0, 0); window.craneassist.stick('right', 0, 1); });
+  await sleep(300);
+  const low = await page.evaluate(() => window.craneassist.last);
+  await sleep(1500);
+  const high = await page.evaluate(() => window.craneassist.last);
+  check(high.tip[1] - low.tip[1] > 0.2, `right stick up: the tip rose ${(high.tip[1] - low.tip[1]).toFixed(2)} m (${high.status}${high.stop_reason ? ": " + high.stop_reason : ""})`);
+
+  if (screenshot) {  // the picture in README and docs/web.md: out and to the side
+    await page.evaluate(() => { window.craneassist.stick('right', 0, 0); window.craneassist.stick('left', 0.6, 0.7); });
+    await sleep(1500);
+    await page.screenshot({ path: screenshot });
+    console.log(`screenshot: ${screenshot}`);
+  }
+
+  // 4. Close the page while the crane moves: the connection is lost, the crane stops.
+  await page.evaluate(() => window.craneassist.stick('left', 0.8, 0.6));
+  await sleep(800);
+  const moving = await page.evaluate(() => window.craneassist.last);
+  check(Math.hypot(...moving.tip_v) > 0.1, `moving before the page closes: ${Math.hypot(...moving.tip_v).toFixed(2)} m/s`);
+  await page.close();
+  await sleep(2500);
+  const watcher = await context.newPage();
+  await watcher.goto(url.replace(/\?token=.*/, ''));  // no token: a view only
+  await watcher.waitForFunction(() => window.craneassist.frames > 5, null, { timeout: 10000 });
+  const after = await watcher.evaluate(() => window.craneassist.last);
+  check((await watcher.evaluate(() => window.craneassist.command)) === 'view', 'a page without the token is a view only');
+  check(Math.hypot(...after.tip_v) < 0.01, `after the page closed the crane is at rest (${Math.hypot(...after.tip_v).toFixed(3)} m/s, ${after.status}: ${after.stop_reason})`);
+  check(errors.length === 0, `no errors in the page${errors.length ? ': ' + errors.join('; ') : ''}`);
+} finally {
+  await browser.close();
+  sim.kill('SIGINT');
+}
+const { code } = await simExit;
+check(code === 0, `sim ended with exit ${code}`);
+check(/input device disconnected: stopping/.test(output), 'sim reported the lost page as a disconnected input');
+const report = output.match(/ {2}web: .*/);
+console.log(report ? report[0] : output);
+process.exit(failures === 0 ? 0 : 1);
