@@ -13,8 +13,9 @@
 
 The limits default to the K70M reference crane's (config/cranes/k70m.yaml: 35 kW prime mover,
 325 L/min pump); give another crane's with --max-power-kw and --max-flow-lpm. The direction
-error is taken over the cycles where both the command and the measured tip speed are above
-0.05 m/s, as `craneassist replay` reports it. Needs python3-matplotlib (Debian package).
+error is taken over every cycle where both the command and the measured tip speed are above
+0.05 m/s (the summary of `craneassist replay` also waits for the command to be steady for 0.5 s,
+so its figure leaves out the turns). Needs python3-matplotlib (Debian package).
 """
 import argparse
 import math
