@@ -20,6 +20,7 @@
 #include "replay_command.hpp"
 #include "sim_command.hpp"
 #include "suite_command.hpp"
+#include "urdf_command.hpp"
 #if CRANEASSIST_WITH_DDS
 #include "dds_commands.hpp"
 #include "remote_command.hpp"
@@ -61,6 +62,7 @@ int main(int argc, char** argv) {
   add(commands, cli, add_sim_command, run_sim_command);
   add(commands, cli, add_suite_command, run_suite_command);
   add(commands, cli, add_bound_command, run_bound_command);
+  add(commands, cli, add_urdf_command, run_urdf_command);
 #if CRANEASSIST_WITH_DDS  // a build without DDS (CRANEASSIST_DDS=OFF) has none of these
   add(commands, cli, add_remote_command, run_remote_command);
   add(commands, cli, add_echo_command, run_echo_command);
