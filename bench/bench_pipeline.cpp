@@ -13,6 +13,16 @@ using namespace craneassist;
 
 namespace {
 
+// The crane standing still at the configuration's start pose, as the controller reads it.
+valves::MachineState still_at_start(const config::CraneConfig& cfg) {
+  valves::MachineState s;
+  s.q = cfg.simulation.q_initial;
+  s.qdot = dynamics::JointVector::Zero(4);
+  s.load_pressure_pa = dynamics::JointVector::Zero(4);
+  s.valid = true;
+  return s;
+}
+
 // One control period (10 ms) of the simulated reference crane moving with every section open:
 // the cost of the simulator per control cycle. real_time_factor = simulated / computer time.
 void BM_SimulatorControlPeriod(benchmark::State& state) {
@@ -39,11 +49,7 @@ BENCHMARK(BM_SimulatorControlPeriod)->Unit(benchmark::kMicrosecond);
 void BM_ControllerUpdate(benchmark::State& state) {
   const auto cfg = config::default_crane_config();
   control::Controller controller(cfg, {});
-  valves::MachineState start;
-  start.q = cfg.simulation.q_initial;
-  start.qdot = dynamics::JointVector::Zero(4);
-  start.load_pressure_pa = dynamics::JointVector::Zero(4);
-  start.valid = true;
+  const valves::MachineState start = still_at_start(cfg);
   valves::MachineState s = start;
   controller.reset(s);
   control::ControllerOutput out;
@@ -68,11 +74,7 @@ BENCHMARK(BM_ControllerUpdate)->Unit(benchmark::kMicrosecond);
 void BM_ControllerUpdateAtWorkspaceEnd(benchmark::State& state) {
   const auto cfg = config::default_crane_config();
   control::Controller controller(cfg, {});
-  valves::MachineState s;
-  s.q = cfg.simulation.q_initial;
-  s.qdot = dynamics::JointVector::Zero(4);
-  s.load_pressure_pa = dynamics::JointVector::Zero(4);
-  s.valid = true;
+  valves::MachineState s = still_at_start(cfg);
   controller.reset(s);
   control::ControllerOutput out;
   const Eigen::Vector3d v(0.3, 0.2, 0.4);

@@ -59,11 +59,85 @@ struct Rig {
   FakeCanBus bus;
   FakeCanTransport backend_end{bus}, sensors{bus};
   double q[4] = {0.1, 0.2, -0.3, 1.0};
-  Rig() {
+  // wall_clock_step_us: FakeCanBus's, set before a backend (and its watchdog thread) exists.
+  explicit Rig(std::int64_t wall_clock_step_us = 0) {
+    bus.wall_clock_step_us = wall_clock_step_us;
     bus.attach(&backend_end);
     bus.attach(&sensors);
   }
+  // One round of the position frames of every joint.
+  void feedback() { send_feedback(sensors, map, q); }
+  // Every valve frame on the bus since the last clear_log() is block.
+  void expect_only_block_on_the_bus() {
+    for (const auto& rx : bus.log()) {
+      for (const auto& j : map.joints) {
+        if (is_valve_frame(j.valve, rx.frame)) {
+          EXPECT_TRUE(is_block(j, rx.frame));
+        }
+      }
+    }
+  }
+  // The bus log holds block for every section at once, then a heartbeat in state disabled.
+  void expect_all_blocked_and_disabled_heartbeat() {
+    const auto log = bus.log();
+    ASSERT_EQ(log.size(), 5u);
+    for (std::size_t j = 0; j < 4; ++j) EXPECT_TRUE(is_block(map.joints[j], log[j].frame)) << j;
+    Heartbeat hb;
+    ASSERT_TRUE(decode_heartbeat(*map.heartbeat, log[4].frame, hb));
+    EXPECT_EQ(hb.state, HeartbeatState::kDisabled);
+  }
 };
+
+// Where most cases start: a backend on the rig that has read the feedback once and is enabled.
+struct EnabledRig : Rig {
+  CanBackend backend;
+  valves::MachineState state;
+  valves::BackendStatus first_read;
+  explicit EnabledRig(std::int64_t wall_clock_step_us = 0)
+      : Rig(wall_clock_step_us), backend(map, cfg.model, backend_end) {
+    feedback();
+    first_read = backend.read(state);
+    backend.enable();
+  }
+  // The kernel reports a controller/bus error to the backend's socket.
+  void bus_error(std::uint32_t flags) {
+    Received err;
+    err.kind = ReceiveKind::kBusError;
+    err.bus_error = flags;
+    err.timestamp_us = realtime_now_us();
+    backend_end.deliver(err);
+  }
+  // n control cycles at 100 Hz, each with fresh feedback, a read and a write of cmd.
+  void run_cycles(int n, const valves::ValveCommand& cmd) { run_cycles(n, n, cmd); }
+  // The same, but the sensors fall silent after the first `fed` cycles (the reads before are
+  // kOk). Returns how long after the last feedback the backend had latched its fault.
+  std::chrono::steady_clock::duration run_cycles(int n, int fed, const valves::ValveCommand& cmd) {
+    const auto t0 = std::chrono::steady_clock::now();
+    auto last_feedback = t0;
+    std::chrono::steady_clock::time_point faulted_at{};
+    for (int k = 0; k < n; ++k) {
+      if (k < fed) {
+        feedback();
+        last_feedback = std::chrono::steady_clock::now();
+        EXPECT_EQ(backend.read(state), valves::BackendStatus::kOk) << "fresh while frames come";
+      } else {
+        backend.read(state);
+      }
+      backend.write(cmd);
+      if (backend.faulted() && faulted_at == std::chrono::steady_clock::time_point{}) {
+        faulted_at = std::chrono::steady_clock::now();
+      }
+      std::this_thread::sleep_until(t0 + (k + 1) * 10ms);
+    }
+    return faulted_at - last_feedback;
+  }
+};
+
+valves::ValveCommand spool_command(double spool) {
+  valves::ValveCommand cmd;
+  cmd.spool = dynamics::JointVector::Constant(4, spool);
+  return cmd;
+}
 
 TEST(ValveFrames, AvcAndCurrentCommandsFromTheSpool) {
   const auto map = k70m_mapping();
@@ -102,7 +176,7 @@ TEST(CanBackend, DecodesFeedbackInSiAndDisabledSendsBlock) {
   valves::MachineState state;
   EXPECT_EQ(backend.read(state), valves::BackendStatus::kNoData);
   EXPECT_FALSE(state.valid);
-  send_feedback(r.sensors, r.map, r.q);
+  r.feedback();
   CanFrame p;
   p.id = 0x302;
   p.dlc = 4;
@@ -120,32 +194,14 @@ TEST(CanBackend, DecodesFeedbackInSiAndDisabledSendsBlock) {
   valves::ValveCommand cmd;
   cmd.spool = dynamics::JointVector::Constant(4, 0.5);
   backend.write(cmd);  // not enabled yet: block, and the heartbeat says disabled
-  auto log = r.bus.log();
-  ASSERT_EQ(log.size(), 5u);
-  for (std::size_t j = 0; j < 4; ++j) EXPECT_TRUE(is_block(r.map.joints[j], log[j].frame)) << j;
-  Heartbeat hb;
-  ASSERT_TRUE(decode_heartbeat(*r.map.heartbeat, log[4].frame, hb));
-  EXPECT_EQ(hb.state, HeartbeatState::kDisabled);
+  r.expect_all_blocked_and_disabled_heartbeat();
   EXPECT_FALSE(backend.faulted());
 }
 
 TEST(CanBackend, SendsAtTheMappingCycleNotEveryWrite) {
-  Rig r;
-  CanBackend backend(r.map, r.cfg.model, r.backend_end);
-  valves::MachineState state;
-  send_feedback(r.sensors, r.map, r.q);
-  backend.read(state);
-  backend.enable();
-  valves::ValveCommand cmd;
-  cmd.spool = dynamics::JointVector::Constant(4, 0.3);
+  EnabledRig r;
   r.bus.clear_log();
-  const auto t0 = std::chrono::steady_clock::now();
-  for (int k = 0; k < 10; ++k) {  // 100 ms at 100 Hz, cycle 20 ms: 5 frames per joint
-    send_feedback(r.sensors, r.map, r.q);
-    backend.read(state);
-    backend.write(cmd);
-    std::this_thread::sleep_until(t0 + (k + 1) * 10ms);
-  }
+  r.run_cycles(10, spool_command(0.3));  // 100 ms at 100 Hz, cycle 20 ms: 5 frames per joint
   const auto log = r.bus.log();
   int slew = 0;
   for (const auto& rx : log) {
@@ -156,7 +212,7 @@ TEST(CanBackend, SendsAtTheMappingCycleNotEveryWrite) {
   }
   EXPECT_GE(slew, 4);
   EXPECT_LE(slew, 6);
-  EXPECT_FALSE(backend.faulted());
+  EXPECT_FALSE(r.backend.faulted());
 }
 
 // The valves see a command every 20 ms: the backend says so, and the controller's valve
@@ -170,51 +226,27 @@ TEST(CanBackend, ReportsItsValveCommandPeriod) {
 }
 
 TEST(CanBackend, LostFeedbackLatchesBlockUntilEnable) {
-  Rig r;
-  CanBackend backend(r.map, r.cfg.model, r.backend_end);
-  valves::MachineState state;
-  valves::ValveCommand cmd;
-  cmd.spool = dynamics::JointVector::Constant(4, 0.3);
-  send_feedback(r.sensors, r.map, r.q);
-  backend.read(state);
-  backend.enable();
-  const auto t0 = std::chrono::steady_clock::now();
-  auto last_feedback = t0;
-  std::chrono::steady_clock::time_point first_block_all{};
-  for (int k = 0; k < 20; ++k) {
-    if (k < 5) {
-      send_feedback(r.sensors, r.map, r.q);
-      last_feedback = std::chrono::steady_clock::now();
-    }
-    backend.read(state);
-    backend.write(cmd);
-    if (backend.faulted() && first_block_all == std::chrono::steady_clock::time_point{}) {
-      first_block_all = std::chrono::steady_clock::now();
-    }
-    std::this_thread::sleep_until(t0 + (k + 1) * 10ms);
-  }
+  EnabledRig r;
+  auto& backend = r.backend;
+  auto& state = r.state;
+  const auto cmd = spool_command(0.3);
+  const auto block_all_after = r.run_cycles(20, 5, cmd);
   ASSERT_TRUE(backend.faulted());
   EXPECT_EQ(backend.fault_reason(), FaultReason::kFeedbackLost);
   EXPECT_NE(backend.fault_text().find("no position frame"), std::string::npos);
-  EXPECT_LT(first_block_all - last_feedback, 100ms);
+  EXPECT_LT(block_all_after, 100ms);
   EXPECT_FALSE(state.valid);
   // The last commands on the bus are block, and they stay block with fresh feedback again.
   r.bus.clear_log();
   for (int k = 0; k < 5; ++k) {
-    send_feedback(r.sensors, r.map, r.q);
+    r.feedback();
     EXPECT_EQ(backend.read(state), valves::BackendStatus::kFault);
     backend.write(cmd);
     std::this_thread::sleep_for(10ms);
   }
-  for (const auto& rx : r.bus.log()) {
-    for (const auto& j : r.map.joints) {
-      if (is_valve_frame(j.valve, rx.frame)) {
-        EXPECT_TRUE(is_block(j, rx.frame));
-      }
-    }
-  }
+  r.expect_only_block_on_the_bus();
   backend.enable();  // the deliberate re-enable
-  send_feedback(r.sensors, r.map, r.q);
+  r.feedback();
   EXPECT_EQ(backend.read(state), valves::BackendStatus::kOk);
   EXPECT_TRUE(state.valid);
   EXPECT_EQ(backend.counters().faults, 1u);
@@ -226,48 +258,19 @@ TEST(CanBackend, LostFeedbackLatchesBlockUntilEnable) {
 TEST(CanBackend, LostFeedbackIsTimedOnTheMonotonicClockThroughAWallClockStep) {
   for (const std::int64_t step_us : {std::int64_t{3600000000}, std::int64_t{-3600000000}}) {
     SCOPED_TRACE(step_us);
-    Rig r;
-    r.bus.wall_clock_step_us = step_us;
-    CanBackend backend(r.map, r.cfg.model, r.backend_end);
-    valves::MachineState state;
-    valves::ValveCommand cmd;
-    cmd.spool = dynamics::JointVector::Constant(4, 0.3);
-    send_feedback(r.sensors, r.map, r.q);
-    EXPECT_EQ(backend.read(state), valves::BackendStatus::kOk);
-    backend.enable();
-    const auto t0 = std::chrono::steady_clock::now();
-    auto last_feedback = t0;
-    std::chrono::steady_clock::time_point faulted_at{};
-    for (int k = 0; k < 30; ++k) {
-      if (k < 5) {
-        send_feedback(r.sensors, r.map, r.q);
-        last_feedback = std::chrono::steady_clock::now();
-        EXPECT_EQ(backend.read(state), valves::BackendStatus::kOk) << "fresh while frames come";
-      } else {
-        backend.read(state);
-      }
-      backend.write(cmd);
-      if (backend.faulted() && faulted_at == std::chrono::steady_clock::time_point{}) {
-        faulted_at = std::chrono::steady_clock::now();
-      }
-      std::this_thread::sleep_until(t0 + (k + 1) * 10ms);
-    }
-    ASSERT_TRUE(backend.faulted());
-    EXPECT_EQ(backend.fault_reason(), FaultReason::kFeedbackLost);
-    EXPECT_LT(faulted_at - last_feedback, 100ms);
+    EnabledRig r(step_us);
+    EXPECT_EQ(r.first_read, valves::BackendStatus::kOk);
+    const auto faulted_after = r.run_cycles(30, 5, spool_command(0.3));
+    ASSERT_TRUE(r.backend.faulted());
+    EXPECT_EQ(r.backend.fault_reason(), FaultReason::kFeedbackLost);
+    EXPECT_LT(faulted_after, 100ms);
   }
 }
 
 TEST(CanBackend, WatchdogBlocksEverySectionWhenTheLoopFreezes) {
-  Rig r;
-  CanBackend backend(r.map, r.cfg.model, r.backend_end);
-  valves::MachineState state;
-  valves::ValveCommand cmd;
-  cmd.spool = dynamics::JointVector::Constant(4, -0.4);
-  send_feedback(r.sensors, r.map, r.q);
-  backend.read(state);
-  backend.enable();
-  backend.write(cmd);
+  EnabledRig r;
+  auto& backend = r.backend;
+  backend.write(spool_command(-0.4));
   const auto frozen_at = realtime_now_us();
   r.bus.clear_log();
   std::this_thread::sleep_for(250ms);  // the control loop stops calling write()
@@ -306,22 +309,11 @@ std::vector<Heartbeat> heartbeats(FakeCanBus& bus, const HeartbeatSpec& spec) {
 }
 
 TEST(CanBackend, HeartbeatCountsUpAtItsCycleAndReportsTheState) {
-  Rig r;
-  CanBackend backend(r.map, r.cfg.model, r.backend_end);
-  valves::MachineState state;
-  valves::ValveCommand cmd;
-  cmd.spool = dynamics::JointVector::Constant(4, 0.3);
-  send_feedback(r.sensors, r.map, r.q);
-  backend.read(state);
-  backend.enable();
+  EnabledRig r;
+  auto& backend = r.backend;
+  const auto cmd = spool_command(0.3);
   r.bus.clear_log();
-  const auto t0 = std::chrono::steady_clock::now();
-  for (int k = 0; k < 20; ++k) {  // 200 ms at 100 Hz; heartbeat cycle 20 ms
-    send_feedback(r.sensors, r.map, r.q);
-    backend.read(state);
-    backend.write(cmd);
-    std::this_thread::sleep_until(t0 + (k + 1) * 10ms);
-  }
+  r.run_cycles(20, cmd);  // 200 ms at 100 Hz; heartbeat cycle 20 ms
   auto hbs = heartbeats(r.bus, *r.map.heartbeat);
   ASSERT_GE(hbs.size(), 9u);
   ASSERT_LE(hbs.size(), 11u);
@@ -334,7 +326,7 @@ TEST(CanBackend, HeartbeatCountsUpAtItsCycleAndReportsTheState) {
   // Feedback stops: the fault latches and the heartbeat carries it, with its reason.
   r.bus.clear_log();
   for (int k = 0; k < 12; ++k) {
-    backend.read(state);
+    backend.read(r.state);
     backend.write(cmd);
     std::this_thread::sleep_for(10ms);
   }
@@ -346,31 +338,20 @@ TEST(CanBackend, HeartbeatCountsUpAtItsCycleAndReportsTheState) {
 }
 
 TEST(CanBackend, DisableBlocksEverySectionAtOnceWithoutAFault) {
-  Rig r;
-  CanBackend backend(r.map, r.cfg.model, r.backend_end);
-  valves::MachineState state;
-  valves::ValveCommand cmd;
-  cmd.spool = dynamics::JointVector::Constant(4, 0.5);
-  send_feedback(r.sensors, r.map, r.q);
-  backend.read(state);
-  backend.enable();
+  EnabledRig r;
+  auto& backend = r.backend;
+  const auto cmd = spool_command(0.5);
   backend.write(cmd);
   r.bus.clear_log();
   backend.disable();  // the normal end of a run, 0 ms after the last write
-  auto log = r.bus.log();
-  ASSERT_EQ(log.size(), 5u);
-  for (std::size_t j = 0; j < 4; ++j) EXPECT_TRUE(is_block(r.map.joints[j], log[j].frame)) << j;
-  Heartbeat hb;
-  ASSERT_TRUE(decode_heartbeat(*r.map.heartbeat, log[4].frame, hb));
-  EXPECT_EQ(hb.state, HeartbeatState::kDisabled);
+  r.expect_all_blocked_and_disabled_heartbeat();
   EXPECT_FALSE(backend.enabled());
   // No more writes: not a frozen loop (no fault), but the watchdog keeps every section blocked.
   r.bus.clear_log();
   std::this_thread::sleep_for(150ms);
   EXPECT_FALSE(backend.faulted());
-  log = r.bus.log();
   int blocks = 0;
-  for (const auto& rx : log) {
+  for (const auto& rx : r.bus.log()) {
     for (const auto& j : r.map.joints) {
       if (is_valve_frame(j.valve, rx.frame)) {
         EXPECT_TRUE(is_block(j, rx.frame));
@@ -383,13 +364,7 @@ TEST(CanBackend, DisableBlocksEverySectionAtOnceWithoutAFault) {
   r.bus.clear_log();
   std::this_thread::sleep_for(25ms);
   backend.write(cmd);
-  for (const auto& rx : r.bus.log()) {
-    for (const auto& j : r.map.joints) {
-      if (is_valve_frame(j.valve, rx.frame)) {
-        EXPECT_TRUE(is_block(j, rx.frame));
-      }
-    }
-  }
+  r.expect_only_block_on_the_bus();
 }
 
 TEST(CanBackend, RejectsAMappingThatDoesNotFitTheCrane) {
@@ -419,7 +394,7 @@ TEST(CanBackend, PumpPressureAndFlowFromTheBus) {
   ASSERT_TRUE(r.map.pump.pressure && r.map.pump.flow);
   CanBackend backend(r.map, r.cfg.model, r.backend_end);
   valves::MachineState state;
-  send_feedback(r.sensors, r.map, r.q);
+  r.feedback();
   backend.read(state);
   EXPECT_EQ(state.pump.flow_m3_s, 0.0);  // no pump frame yet: unmeasured
   CanFrame f;
@@ -429,7 +404,7 @@ TEST(CanBackend, PumpPressureAndFlowFromTheBus) {
   ASSERT_EQ(encode(*r.map.pump.flow, 90e-3 / 60.0, f), SignalStatus::kOk);  // 90 L/min
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < 10; ++k) {
-    send_feedback(r.sensors, r.map, r.q);
+    r.feedback();
     r.sensors.send(f);
     backend.read(state);
     std::this_thread::sleep_until(t0 + (k + 1) * 10ms);
@@ -445,7 +420,7 @@ TEST(CanBackend, PumpPressureAndFlowFromTheBus) {
   // The pump frames stop: unmeasured again after the feedback timeout, the energy is kept.
   const double energy = state.pump.energy_j;
   std::this_thread::sleep_for(60ms);
-  send_feedback(r.sensors, r.map, r.q);
+  r.feedback();
   backend.read(state);
   EXPECT_EQ(state.pump.flow_m3_s, 0.0);
   EXPECT_EQ(state.pump.energy_j, energy);
@@ -501,19 +476,16 @@ TEST(HeartbeatMonitor, AliveOnlyWhileTheCounterAdvancesInStateEnabled) {
 }
 
 TEST(CanBackend, WrongDlcOnFeedbackLatchesAndUnknownFramesAreOnlyCounted) {
-  Rig r;
-  CanBackend backend(r.map, r.cfg.model, r.backend_end);
-  valves::MachineState state;
-  send_feedback(r.sensors, r.map, r.q);
-  backend.read(state);
-  backend.enable();
+  EnabledRig r;
+  auto& backend = r.backend;
+  auto& state = r.state;
   CanFrame junk;
   junk.id = 0x555;
   junk.dlc = 3;
   r.sensors.send(junk);
   junk.id = 0x7FF;
   r.sensors.send(junk);
-  send_feedback(r.sensors, r.map, r.q);
+  r.feedback();
   EXPECT_EQ(backend.read(state), valves::BackendStatus::kOk);
   EXPECT_EQ(backend.counters().unknown_frames, 2u);
   CanFrame bad;
@@ -534,59 +506,34 @@ TEST(CanBackend, BusOffErrorPassiveAndControllerRestartLatch) {
       {kControllerRestarted, FaultReason::kControllerRestarted},
       {kBusOff | kControllerRestarted, FaultReason::kBusOff}};
   for (const auto& [flag, reason] : cases) {
-    Rig r;
-    CanBackend backend(r.map, r.cfg.model, r.backend_end);
-    valves::MachineState state;
-    send_feedback(r.sensors, r.map, r.q);
-    backend.read(state);
-    backend.enable();
-    Received err;
-    err.kind = ReceiveKind::kBusError;
-    err.bus_error = flag;
-    err.timestamp_us = realtime_now_us();
-    r.backend_end.deliver(err);
-    send_feedback(r.sensors, r.map, r.q);
-    EXPECT_EQ(backend.read(state), valves::BackendStatus::kFault) << flag;
-    EXPECT_EQ(backend.fault_reason(), reason) << flag;
-    EXPECT_EQ(backend.counters().bus_error_frames, 1u);
+    EnabledRig r;
+    r.bus_error(flag);
+    r.feedback();
+    EXPECT_EQ(r.backend.read(r.state), valves::BackendStatus::kFault) << flag;
+    EXPECT_EQ(r.backend.fault_reason(), reason) << flag;
+    EXPECT_EQ(r.backend.counters().bus_error_frames, 1u);
   }
 }
 
 TEST(CanBackend, AckProtocolAndWarningErrorsAreOnlyCounted) {
-  Rig r;
-  CanBackend backend(r.map, r.cfg.model, r.backend_end);
-  valves::MachineState state;
-  send_feedback(r.sensors, r.map, r.q);
-  backend.read(state);
-  backend.enable();
+  EnabledRig r;
   for (std::uint32_t flag : {std::uint32_t{kBusErrorOther}, std::uint32_t{kErrorWarning},
                              std::uint32_t{kBusErrorOther | kErrorWarning}}) {
-    Received err;
-    err.kind = ReceiveKind::kBusError;
-    err.bus_error = flag;
-    err.timestamp_us = realtime_now_us();
-    r.backend_end.deliver(err);
+    r.bus_error(flag);
   }
-  send_feedback(r.sensors, r.map, r.q);
-  EXPECT_EQ(backend.read(state), valves::BackendStatus::kOk);
-  EXPECT_FALSE(backend.faulted());
-  EXPECT_EQ(backend.counters().bus_error_frames, 3u);
+  r.feedback();
+  EXPECT_EQ(r.backend.read(r.state), valves::BackendStatus::kOk);
+  EXPECT_FALSE(r.backend.faulted());
+  EXPECT_EQ(r.backend.counters().bus_error_frames, 3u);
 }
 
 TEST(CanBackend, ConsecutiveSendErrorsLatch) {
-  Rig r;
-  CanBackend backend(r.map, r.cfg.model, r.backend_end);
-  valves::MachineState state;
-  valves::ValveCommand cmd;
-  cmd.spool = dynamics::JointVector::Constant(4, 0.1);
-  send_feedback(r.sensors, r.map, r.q);
-  backend.read(state);
-  backend.enable();
+  EnabledRig r;
   r.backend_end.next_send_status = SendStatus::kQueueFull;
-  backend.write(cmd);  // 4 sections and the heartbeat, 5 failed sends, no waiting
-  EXPECT_TRUE(backend.faulted());
-  EXPECT_EQ(backend.fault_reason(), FaultReason::kSendError);
-  EXPECT_EQ(backend.counters().send_queue_full, 5u);
+  r.backend.write(spool_command(0.1));  // 4 sections and the heartbeat, 5 failed sends, no waiting
+  EXPECT_TRUE(r.backend.faulted());
+  EXPECT_EQ(r.backend.fault_reason(), FaultReason::kSendError);
+  EXPECT_EQ(r.backend.counters().send_queue_full, 5u);
 }
 
 TEST(CanBackend, CandumpLogHoldsSentAndReceivedFrames) {
@@ -597,7 +544,7 @@ TEST(CanBackend, CandumpLogHoldsSentAndReceivedFrames) {
     options.candump_log = path;
     CanBackend backend(r.map, r.cfg.model, r.backend_end, options);
     valves::MachineState state;
-    send_feedback(r.sensors, r.map, r.q);
+    r.feedback();
     backend.read(state);
     valves::ValveCommand cmd;
     cmd.spool = dynamics::JointVector::Zero(4);

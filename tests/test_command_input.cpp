@@ -18,6 +18,7 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <tuple>
 
 #include "craneassist/config/config_error.hpp"
 #include "craneassist/config/telemetry_config.hpp"
@@ -379,15 +380,56 @@ void arm_and_move(RawOperator& op, MonitoredSource& crane, const std::array<doub
   }
 }
 
+// Waits (the first operator sending) until the source has matched two writers.
+void wait_for_two_writers(dds::DdsCommandSource& source, RawOperator& first, MonitoredSource& crane,
+                          const std::array<double, 3>& v) {
+  const double end = input::steady_now_s() + 10.0;
+  while (source.stats().peak_matched_writers < 2 && input::steady_now_s() < end) {
+    first.send(v, true);
+    crane.cycle();
+  }
+  ASSERT_EQ(source.stats().peak_matched_writers, 2);
+}
+
+// The crane's command input on `domain`, its input monitor (the given stale timeout) and an
+// operator armed and moving at v.
+struct ArmedOperator {
+  ArmedOperator(int domain, const std::array<double, 3>& v, std::string sender = "raw-operator",
+                double stale_timeout_s = input::InputMonitorSettings{}.stale_timeout_s)
+      : monitor(monitor_settings(stale_timeout_s)),
+        source(settings_of("crane", domain), stale_timeout_s),
+        first(domain, std::move(sender)),
+        crane(source, monitor) {
+    arm_and_move(first, crane, v);
+  }
+  static input::InputMonitorSettings monitor_settings(double stale_timeout_s) {
+    input::InputMonitorSettings m;
+    m.stale_timeout_s = stale_timeout_s;
+    return m;
+  }
+  input::InputMonitorSettings monitor;
+  dds::DdsCommandSource source;
+  RawOperator first;
+  MonitoredSource crane;
+};
+
+// The same with the first operator "first", then a second operator ("second") whose writer the
+// input has matched too.
+struct TwoOperators : ArmedOperator {
+  TwoOperators(int domain, double stale_timeout_s, const std::array<double, 3>& v)
+      : ArmedOperator(domain, v, "first", stale_timeout_s), second(domain, "second") {
+    wait_for_two_writers(source, first, crane, v);
+  }
+  RawOperator second;
+};
+
 // A malformed OperatorCommand (a bool byte of 2, a bad encapsulation: Fast CDR throws on Fast
 // DDS's thread; a cut-off body: Fast DDS 2.9 would hand over the part it read) is dropped and
 // counted, never passed on: while only such samples arrive, the input goes stale and the
 // monitor stops the crane. The source survives and takes the next good sample.
 TEST(DdsCommandSource, MalformedSamplesAreDroppedCountedAndGoStale) {
-  dds::DdsCommandSource source(settings_of("crane", 185));
-  RawOperator op(185);
-  MonitoredSource crane(source);
-  arm_and_move(op, crane, {0.3, 0.0, 0.0});
+  ArmedOperator armed(185, {0.3, 0.0, 0.0});
+  auto [source, op, crane] = std::tie(armed.source, armed.first, armed.crane);
   ASSERT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
   const std::uint64_t good = source.stats().samples;
 
@@ -427,10 +469,8 @@ TEST(DdsCommandSource, MalformedSamplesAreDroppedCountedAndGoStale) {
 // A sample whose seq is not above what its writer sent before (an old sample replayed, or the
 // latest repeated) is dropped and counted, per writer: another writer's seq starts afresh.
 TEST(DdsCommandSource, ReplayedSamplesAreDroppedPerWriter) {
-  dds::DdsCommandSource source(settings_of("crane", 186));
-  RawOperator op(186);
-  MonitoredSource crane(source);
-  arm_and_move(op, crane, {0.3, 0.0, 0.0});
+  ArmedOperator armed(186, {0.3, 0.0, 0.0});
+  auto [source, op, crane] = std::tie(armed.source, armed.first, armed.crane);
   ASSERT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
   const std::uint64_t latest = op.seq();
   ASSERT_GT(latest, 40u);
@@ -482,30 +522,13 @@ TEST(DdsCommandSource, ReplayedSamplesAreDroppedPerWriter) {
   EXPECT_EQ(source.stats().replayed, replayed_before + 1);
 }
 
-// Waits (the first operator sending) until the source has matched two writers.
-void wait_for_two_writers(dds::DdsCommandSource& source, RawOperator& first, MonitoredSource& crane,
-                          const std::array<double, 3>& v) {
-  const double end = input::steady_now_s() + 10.0;
-  while (source.stats().peak_matched_writers < 2 && input::steady_now_s() < end) {
-    first.send(v, true);
-    crane.cycle();
-  }
-  ASSERT_EQ(source.stats().peak_matched_writers, 2);
-}
-
 // With a stale timeout longer than the old fixed 0.5 s: the second operator, sending with its
 // deadman held all along, takes the command over only after the first has been silent for longer
 // than the stale timeout, and its command passes only after it has released and pressed the
 // deadman.
 TEST(DdsCommandSource, TakeoverOnlyAfterTheStaleTimeoutAndWithReArm) {
-  input::InputMonitorSettings monitor;
-  monitor.stale_timeout_s = 1.0;
-  dds::DdsCommandSource source(settings_of("crane", 187), monitor.stale_timeout_s);
-  RawOperator first(187, "first");
-  MonitoredSource crane(source, monitor);
-  arm_and_move(first, crane, {0.3, 0.0, 0.0});
-  RawOperator second(187, "second");
-  wait_for_two_writers(source, first, crane, {0.3, 0.0, 0.0});
+  TwoOperators ops(187, 1.0, {0.3, 0.0, 0.0});
+  auto [source, first, crane, second] = std::tie(ops.source, ops.first, ops.crane, ops.second);
   ASSERT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
 
   // The first falls silent; the second sends, deadman held, moving the other way.
@@ -547,14 +570,9 @@ TEST(DdsCommandSource, TakeoverOnlyAfterTheStaleTimeoutAndWithReArm) {
 // Two operators both sending: the first keeps the command every cycle, the second's samples
 // are dropped; ownership never alternates.
 TEST(DdsCommandSource, FightingOperatorsNeverAlternate) {
-  input::InputMonitorSettings monitor;
-  monitor.stale_timeout_s = 0.3;  // margin for a test thread descheduled on a loaded machine
-  dds::DdsCommandSource source(settings_of("crane", 188), monitor.stale_timeout_s);
-  RawOperator first(188, "first");
-  MonitoredSource crane(source, monitor);
-  arm_and_move(first, crane, {0.1, 0.0, 0.0});
-  RawOperator second(188, "second");
-  wait_for_two_writers(source, first, crane, {0.1, 0.0, 0.0});
+  // Stale timeout 0.3 s: margin for a test thread descheduled on a loaded machine.
+  TwoOperators ops(188, 0.3, {0.1, 0.0, 0.0});
+  auto [source, first, crane, second] = std::tie(ops.source, ops.first, ops.crane, ops.second);
   ASSERT_TRUE(crane.out.enabled) << input::to_string(crane.out.fault);
   int cycles = 0, first_held = 0;
   for (int i = 0; i < 200; ++i) {

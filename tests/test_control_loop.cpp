@@ -128,6 +128,25 @@ class StopAt final : public control::CycleObserver {
   long at_;
 };
 
+// The loop's options for a run of at most max_cycles cycles, the rest their defaults.
+control::LoopOptions run_of(long max_cycles) {
+  control::LoopOptions options;
+  options.max_cycles = max_cycles;
+  return options;
+}
+
+// With a task that never comes to rest, the loop gives the stop 0.5 s: then it safe-stops the
+// machine, once, and the run has `cycles` cycles.
+void expect_safe_stop_after_half_a_second(control::LoopOptions options, long cycles) {
+  CountingMachine machine;
+  StoppingTask never(100000);
+  options.stop_settle_max_s = 0.5;
+  const auto s = control::run_control_loop(never, machine, options);
+  EXPECT_TRUE(s.safe_stopped);
+  EXPECT_EQ(machine.safe_stops, 1);
+  EXPECT_EQ(s.cycles, cycles);
+}
+
 }  // namespace
 
 TEST(ControlLoop, RunsEveryCycleOnMachineTimeAndTellsEveryObserverInOrder) {
@@ -165,9 +184,7 @@ TEST(ControlLoop, RunsEveryCycleOnMachineTimeAndTellsEveryObserverInOrder) {
 TEST(ControlLoop, TheEndOfARunStopsTheMachineBeforeItEnds) {
   CountingMachine machine;
   StoppingTask task(30);  // 0.3 s to come to rest
-  control::LoopOptions options;
-  options.max_cycles = 100;
-  const auto s = control::run_control_loop(task, machine, options);
+  const auto s = control::run_control_loop(task, machine, run_of(100));
   EXPECT_TRUE(s.end_stop);
   EXPECT_FALSE(s.stop_requested);
   EXPECT_EQ(task.cause, "end of run");
@@ -175,14 +192,7 @@ TEST(ControlLoop, TheEndOfARunStopsTheMachineBeforeItEnds) {
   EXPECT_EQ(s.cycles, 131) << "cycles 100..130 stopping, 130 reports kStopped";
   EXPECT_EQ(s.stop_cycles, 31);
   EXPECT_FALSE(s.safe_stopped);
-
-  CountingMachine slow_machine;
-  StoppingTask never(100000);
-  options.stop_settle_max_s = 0.5;
-  const auto slow = control::run_control_loop(never, slow_machine, options);
-  EXPECT_TRUE(slow.safe_stopped);
-  EXPECT_EQ(slow_machine.safe_stops, 1);
-  EXPECT_EQ(slow.cycles, 151);
+  expect_safe_stop_after_half_a_second(run_of(100), 151);
 }
 
 // A run whose machine is already stopped (e.g. by a stale input) just ends; a study segment
@@ -191,9 +201,7 @@ TEST(ControlLoop, ARunAlreadyStoppedOrASegmentEndsAtItsLength) {
   CountingMachine machine;
   StoppingTask task(30);
   task.idle_from = 5;
-  control::LoopOptions options;
-  options.max_cycles = 20;
-  const auto stopped = control::run_control_loop(task, machine, options);
+  const auto stopped = control::run_control_loop(task, machine, run_of(20));
   EXPECT_EQ(stopped.cycles, 20);
   EXPECT_FALSE(stopped.end_stop);
   EXPECT_EQ(task.stop_seen_at, -1);
@@ -247,25 +255,16 @@ TEST(ControlLoop, AStopRequestEndsTheRunOnlyOnceTheTaskIsAtRest) {
 }
 
 TEST(ControlLoop, AStopThatTakesTooLongSafeStopsTheMachine) {
-  CountingMachine machine;
-  StoppingTask task(100000);  // never at rest
   std::atomic<bool> stop{true};
-  control::LoopOptions options;
-  options.max_cycles = 100000;
+  control::LoopOptions options = run_of(100000);
   options.stop = &stop;
-  options.stop_settle_max_s = 0.5;
-  const auto s = control::run_control_loop(task, machine, options);
-  EXPECT_TRUE(s.safe_stopped);
-  EXPECT_EQ(machine.safe_stops, 1);
-  EXPECT_EQ(s.cycles, 51);
+  expect_safe_stop_after_half_a_second(options, 51);
 }
 
 TEST(ControlLoop, AMachineFaultIsAStopRequestWithItsReason) {
   CountingMachine machine(20);
   StoppingTask task(5);
-  control::LoopOptions options;
-  options.max_cycles = 1000;
-  const auto s = control::run_control_loop(task, machine, options);
+  const auto s = control::run_control_loop(task, machine, run_of(1000));
   EXPECT_TRUE(s.machine_fault);
   EXPECT_TRUE(s.stop_requested);
   EXPECT_EQ(task.cause, "machine fault");

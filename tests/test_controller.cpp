@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <new>
 #include <utility>
 #include <vector>
@@ -34,15 +35,77 @@ double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
 }
 
+constexpr dynamics::Resolution kAllResolutions[] = {
+    dynamics::Resolution::kPinvJoint, dynamics::Resolution::kPinvActuator,
+    dynamics::Resolution::kMinFlow, dynamics::Resolution::kMinLsPower};
+
+using AdjustConfig = std::function<void(config::CraneConfig&)>;
+
+config::CraneConfig default_config_adjusted(const AdjustConfig& adjust) {
+  auto cfg = config::default_crane_config();
+  if (adjust) adjust(cfg);
+  return cfg;
+}
+
+// A controller on the default configuration (changed by adjust), reset to the initial pose with
+// the machine standing still there.
+struct Rig {
+  config::CraneConfig cfg;
+  control::Controller controller;
+  valves::MachineState state;
+  control::ControllerOutput out;
+
+  explicit Rig(control::ScalingMode mode, const AdjustConfig& adjust = nullptr)
+      : cfg(default_config_adjusted(adjust)), controller(cfg, {mode}), state(still_state(cfg)) {
+    controller.reset(state);
+  }
+
+  // `cycles` cycles of the command v, each running, with a machine that follows the reference
+  // one valve delay (transport delay plus lag) late, as the real one does; the tracking-error
+  // slow-down measures against that delayed reference.
+  void follow_one_valve_delay_late(const Eigen::Vector3d& v, std::size_t cycles) {
+    const auto lag = static_cast<std::size_t>(std::lround(
+        (cfg.model.valves.delay_s + cfg.model.valves.time_constant_s) / controller.period_s()));
+    std::vector<dynamics::JointVector> history(lag, state.q);
+    for (std::size_t k = 0; k < cycles; ++k) {
+      ASSERT_EQ(controller.update(state, v, out), control::ControllerStatus::kRunning);
+      history[k % lag] = out.q_ref;
+      state.q = history[(k + 1) % lag];
+    }
+  }
+
+  // Cycles of the command v, with a machine that follows the reference, until the controller
+  // reports kStopped (at most 500): check(status, out) holds in each, and the path acceleration
+  // steps within the jerk bound. The stop takes more than 10 cycles and ends at rest with neutral
+  // valves.
+  template <class Check>
+  void expect_jerk_limited_stop(const Eigen::Vector3d& v, Check check) {
+    double prev_sddot = out.sddot;
+    int stopping = 0;
+    control::ControllerStatus status = control::ControllerStatus::kRunning;
+    for (int k = 0; k < 500 && status != control::ControllerStatus::kStopped; ++k) {
+      status = controller.update(state, v, out);
+      check(status, out);
+      EXPECT_LE(std::abs(out.sddot - prev_sddot),
+                cfg.scaling.jerk_max_m_s3 * controller.period_s() * (1 + 1e-9));
+      prev_sddot = out.sddot;
+      stopping += status == control::ControllerStatus::kStopping;
+      state.q = out.q_ref;
+    }
+    EXPECT_EQ(status, control::ControllerStatus::kStopped);
+    EXPECT_GT(stopping, 10) << "a stop from speed takes time, not one cycle";
+    EXPECT_EQ(out.sdot, 0.0);
+    EXPECT_EQ(out.valves.spool.cwiseAbs().maxCoeff(), 0.0);
+  }
+};
+
 }  // namespace
 
 TEST(Controller, ReferenceKeepsTheCommandedDirection) {
-  auto cfg = config::default_crane_config();
-  cfg.model.pump.max_flow_m3_s = 50e-3 / 60.0;  // make the flow limit bind
-  control::Controller controller(cfg, {control::ScalingMode::kFlowOnly});
-  auto state = still_state(cfg);
-  controller.reset(state);
-  control::ControllerOutput out;
+  Rig rig(control::ScalingMode::kFlowOnly, [](config::CraneConfig& c) {
+    c.model.pump.max_flow_m3_s = 50e-3 / 60.0;  // make the flow limit bind
+  });
+  auto& [cfg, controller, state, out] = rig;
   const Eigen::Vector3d v(0.6, 0.8, 1.2);
   int flow_limited = 0;
   for (int k = 0; k < 100; ++k) {
@@ -60,11 +123,8 @@ TEST(Controller, ReferenceKeepsTheCommandedDirection) {
 }
 
 TEST(Controller, InvalidInputStopsWithNeutralValves) {
-  const auto cfg = config::default_crane_config();
-  control::Controller controller(cfg, {control::ScalingMode::kFlowOnly});
-  auto state = still_state(cfg);
-  controller.reset(state);
-  control::ControllerOutput out;
+  Rig rig(control::ScalingMode::kFlowOnly);
+  auto& [cfg, controller, state, out] = rig;
   controller.update(state, Eigen::Vector3d(0.3, 0, 0), out);
   ASSERT_GT(out.valves.spool.cwiseAbs().maxCoeff(), 0.0);
   EXPECT_NE(controller.update(state, Eigen::Vector3d(NAN, 0, 0), out),
@@ -82,11 +142,8 @@ TEST(Controller, InvalidInputStopsWithNeutralValves) {
 }
 
 TEST(Controller, CycleDoesNotAllocate) {
-  const auto cfg = config::default_crane_config();
-  control::Controller controller(cfg, {control::ScalingMode::kFull});
-  auto state = still_state(cfg);
-  controller.reset(state);
-  control::ControllerOutput out;
+  Rig rig(control::ScalingMode::kFull);
+  auto& [cfg, controller, state, out] = rig;
   controller.update(state, Eigen::Vector3d(0.1, 0.1, 0.1), out);  // first call sizes the output
   const long before = craneassist::test::heap_allocations();
   for (int k = 0; k < 200; ++k) {
@@ -102,13 +159,11 @@ TEST(Controller, CycleDoesNotAllocate) {
 }
 
 TEST(Controller, CycleWithAConstantPressurePumpDoesNotAllocate) {
-  auto cfg = config::default_crane_config();
-  cfg.model.pump.mode = dynamics::PumpMode::kConstantPressure;
-  cfg.model.pump.prime_mover_power_w = 10e3;  // make the p_s Q bound bind
-  control::Controller controller(cfg, {control::ScalingMode::kFull});
-  auto state = still_state(cfg);
-  controller.reset(state);
-  control::ControllerOutput out;
+  Rig rig(control::ScalingMode::kFull, [](config::CraneConfig& c) {
+    c.model.pump.mode = dynamics::PumpMode::kConstantPressure;
+    c.model.pump.prime_mover_power_w = 10e3;  // make the p_s Q bound bind
+  });
+  auto& [cfg, controller, state, out] = rig;
   controller.update(state, Eigen::Vector3d(0.1, 0.1, 0.1), out);  // first call sizes the output
   int power_limited = 0;
   const long before = craneassist::test::heap_allocations();
@@ -122,12 +177,9 @@ TEST(Controller, CycleWithAConstantPressurePumpDoesNotAllocate) {
 }
 
 TEST(Controller, FullScalingKeepsDirectionAndJerkBound) {
-  auto cfg = config::default_crane_config();
-  config::set_payload_mass(cfg.model, 650.0);
-  control::Controller controller(cfg, {control::ScalingMode::kFull});
-  auto state = still_state(cfg);
-  controller.reset(state);
-  control::ControllerOutput out;
+  Rig rig(control::ScalingMode::kFull,
+          [](config::CraneConfig& c) { config::set_payload_mass(c.model, 650.0); });
+  auto& [cfg, controller, state, out] = rig;
   const Eigen::Vector3d v(0.2, 0.6, 0.5);
   double prev_sddot = 0.0;
   for (int k = 0; k < 300; ++k) {
@@ -146,38 +198,13 @@ TEST(Controller, FullScalingKeepsDirectionAndJerkBound) {
 }
 
 TEST(Controller, FullScalingStaleInputIsAJerkLimitedStop) {
-  const auto cfg = config::default_crane_config();
-  control::Controller controller(cfg, {control::ScalingMode::kFull});
-  auto state = still_state(cfg);
-  controller.reset(state);
-  control::ControllerOutput out;
-  // A machine that follows the reference one valve delay (transport delay plus lag) late, as
-  // the real one does; the tracking-error slow-down measures against that delayed reference.
-  const auto lag = static_cast<std::size_t>(std::lround(
-      (cfg.model.valves.delay_s + cfg.model.valves.time_constant_s) / controller.period_s()));
-  std::vector<dynamics::JointVector> history(lag, state.q);
-  for (std::size_t k = 0; k < 200; ++k) {
-    controller.update(state, Eigen::Vector3d(0.4, 0.0, 0.3), out);
-    history[k % lag] = out.q_ref;
-    state.q = history[(k + 1) % lag];
-  }
-  ASSERT_GT(out.sdot, 0.45);
-  double prev_sddot = out.sddot;
-  int stopping = 0;
-  control::ControllerStatus status = control::ControllerStatus::kRunning;
-  for (int k = 0; k < 500 && status != control::ControllerStatus::kStopped; ++k) {
-    status = controller.update(state, Eigen::Vector3d(NAN, 0.0, 0.0), out);
-    EXPECT_EQ(out.limit, scaling::ActiveLimit::kStaleInput);
-    EXPECT_LE(std::abs(out.sddot - prev_sddot),
-              cfg.scaling.jerk_max_m_s3 * controller.period_s() * (1 + 1e-9));
-    prev_sddot = out.sddot;
-    stopping += status == control::ControllerStatus::kStopping;
-    state.q = out.q_ref;
-  }
-  EXPECT_EQ(status, control::ControllerStatus::kStopped);
-  EXPECT_GT(stopping, 10) << "a stop from speed takes time, not one cycle";
-  EXPECT_EQ(out.sdot, 0.0);
-  EXPECT_EQ(out.valves.spool.cwiseAbs().maxCoeff(), 0.0);
+  Rig r(control::ScalingMode::kFull);
+  r.follow_one_valve_delay_late(Eigen::Vector3d(0.4, 0.0, 0.3), 200);
+  ASSERT_GT(r.out.sdot, 0.45);
+  r.expect_jerk_limited_stop(Eigen::Vector3d(NAN, 0.0, 0.0),
+                             [](control::ControllerStatus, const control::ControllerOutput& out) {
+                               EXPECT_EQ(out.limit, scaling::ActiveLimit::kStaleInput);
+                             });
 }
 
 TEST(Controller, AFailedDynamicsStepStopsInsteadOfThrowing) {
@@ -187,66 +214,41 @@ TEST(Controller, AFailedDynamicsStepStopsInsteadOfThrowing) {
   static_assert(noexcept(std::declval<control::Controller&>().update(
       std::declval<const valves::MachineState&>(), std::declval<const Eigen::Vector3d&>(),
       std::declval<control::ControllerOutput&>())));
-  const auto cfg = config::default_crane_config();
-  control::Controller controller(cfg, {control::ScalingMode::kFull});
-  ASSERT_NE(controller.dynamics_for_testing(), nullptr);
-  auto state = still_state(cfg);
-  controller.reset(state);
-  control::ControllerOutput out;
+  Rig r(control::ScalingMode::kFull);
+  ASSERT_NE(r.controller.dynamics_for_testing(), nullptr);
   const Eigen::Vector3d v(0.4, 0.0, 0.3);
   // A machine one valve delay late (as in FullScalingStaleInputIsAJerkLimitedStop).
-  const auto lag = static_cast<std::size_t>(std::lround(
-      (cfg.model.valves.delay_s + cfg.model.valves.time_constant_s) / controller.period_s()));
-  std::vector<dynamics::JointVector> history(lag, state.q);
-  for (std::size_t k = 0; k < 200; ++k) {
-    ASSERT_EQ(controller.update(state, v, out), control::ControllerStatus::kRunning);
-    history[k % lag] = out.q_ref;
-    state.q = history[(k + 1) % lag];
-  }
-  ASSERT_GT(out.sdot, 0.45);
+  r.follow_one_valve_delay_late(v, 200);
+  ASSERT_GT(r.out.sdot, 0.45);
 
-  controller.dynamics_for_testing()->fail_steps_for_testing(true);
-  double prev_sddot = out.sddot;
-  int stopping = 0;
-  control::ControllerStatus status = control::ControllerStatus::kRunning;
-  for (int k = 0; k < 500 && status != control::ControllerStatus::kStopped; ++k) {
-    status = controller.update(state, v, out);
-    EXPECT_NE(status, control::ControllerStatus::kRunning);
-    EXPECT_EQ(out.limit, scaling::ActiveLimit::kDynamicsFailed);
-    EXPECT_STREQ(scaling::to_string(out.limit), "dynamics_failed");
-    EXPECT_EQ(out.ref_power_w, 0.0);
-    EXPECT_LE(std::abs(out.sddot - prev_sddot),
-              cfg.scaling.jerk_max_m_s3 * controller.period_s() * (1 + 1e-9));
-    prev_sddot = out.sddot;
-    stopping += status == control::ControllerStatus::kStopping;
-    state.q = out.q_ref;
-  }
-  EXPECT_EQ(status, control::ControllerStatus::kStopped);
-  EXPECT_GT(stopping, 10) << "a stop from speed takes time, not one cycle";
-  EXPECT_EQ(out.sdot, 0.0);
-  EXPECT_EQ(out.valves.spool.cwiseAbs().maxCoeff(), 0.0);
-  EXPECT_EQ(controller.update(state, v, out), control::ControllerStatus::kStopped);
+  r.controller.dynamics_for_testing()->fail_steps_for_testing(true);
+  r.expect_jerk_limited_stop(
+      v, [](control::ControllerStatus status, const control::ControllerOutput& out) {
+        EXPECT_NE(status, control::ControllerStatus::kRunning);
+        EXPECT_EQ(out.limit, scaling::ActiveLimit::kDynamicsFailed);
+        EXPECT_STREQ(scaling::to_string(out.limit), "dynamics_failed");
+        EXPECT_EQ(out.ref_power_w, 0.0);
+      });
+  EXPECT_EQ(r.controller.update(r.state, v, r.out), control::ControllerStatus::kStopped);
 
   // The dynamics back: the controller restarts from the measured pose and runs.
-  controller.dynamics_for_testing()->fail_steps_for_testing(false);
+  r.controller.dynamics_for_testing()->fail_steps_for_testing(false);
+  control::ControllerStatus status = control::ControllerStatus::kStopped;
   for (int k = 0; k < 50; ++k) {
-    status = controller.update(state, v, out);
-    state.q = out.q_ref;
+    status = r.controller.update(r.state, v, r.out);
+    r.state.q = r.out.q_ref;
   }
   EXPECT_EQ(status, control::ControllerStatus::kRunning);
-  EXPECT_NE(out.limit, scaling::ActiveLimit::kDynamicsFailed);
-  EXPECT_GT(out.sdot, 0.0);
+  EXPECT_NE(r.out.limit, scaling::ActiveLimit::kDynamicsFailed);
+  EXPECT_GT(r.out.sdot, 0.0);
 }
 
 // Largest joint acceleration of the reference while the operator swings the stick from one
 // direction to a nearly opposite one, for a machine that follows the reference.
 double peak_joint_acceleration_when_swinging(control::ScalingMode mode,
                                              int* turn_cycles = nullptr) {
-  const auto cfg = config::default_crane_config();
-  control::Controller controller(cfg, {mode});
-  auto state = still_state(cfg);
-  controller.reset(state);
-  control::ControllerOutput out;
+  Rig rig(mode);
+  auto& [cfg, controller, state, out] = rig;
   dynamics::JointVector previous = dynamics::JointVector::Zero(4);
   double peak = 0.0;
   for (int k = 0; k < 400; ++k) {
@@ -281,14 +283,10 @@ TEST(Controller, SwingingTheStickKeepsJointAccelerationsBounded) {
 }
 
 TEST(Controller, EveryResolutionDrivesTheReferenceAlongTheCommand) {
-  for (auto r : {dynamics::Resolution::kPinvJoint, dynamics::Resolution::kPinvActuator,
-                 dynamics::Resolution::kMinFlow, dynamics::Resolution::kMinLsPower}) {
-    auto cfg = config::default_crane_config();
-    cfg.redundancy.resolution = r;
-    control::Controller controller(cfg, {control::ScalingMode::kFull});
-    auto state = still_state(cfg);
-    controller.reset(state);
-    control::ControllerOutput out;
+  for (auto r : kAllResolutions) {
+    Rig rig(control::ScalingMode::kFull,
+            [r](config::CraneConfig& c) { c.redundancy.resolution = r; });
+    auto& [cfg, controller, state, out] = rig;
     const Eigen::Vector3d v(0.3, 0.3, 0.4);
     const long before = craneassist::test::heap_allocations();
     for (int k = 0; k < 200; ++k) {
@@ -313,14 +311,10 @@ TEST(Controller, EveryResolutionDrivesTheReferenceAlongTheCommand) {
 // between breakpoints (a cylinder coming to rest), and the switch must not step a cylinder's
 // velocity.
 TEST(Controller, EveryResolutionRespectsCylinderAccelerationLimits) {
-  for (auto r : {dynamics::Resolution::kPinvJoint, dynamics::Resolution::kPinvActuator,
-                 dynamics::Resolution::kMinFlow, dynamics::Resolution::kMinLsPower}) {
-    auto cfg = config::default_crane_config();
-    cfg.redundancy.resolution = r;
-    control::Controller controller(cfg, {control::ScalingMode::kFull});
-    auto state = still_state(cfg);
-    controller.reset(state);
-    control::ControllerOutput out;
+  for (auto r : kAllResolutions) {
+    Rig rig(control::ScalingMode::kFull,
+            [r](config::CraneConfig& c) { c.redundancy.resolution = r; });
+    auto& [cfg, controller, state, out] = rig;
     const std::array<Eigen::Vector3d, 4> moves = {
         Eigen::Vector3d(0.6, 0.0, 0.0), Eigen::Vector3d(0.0, 0.5, 0.3),
         Eigen::Vector3d(-0.5, -0.2, 0.2), Eigen::Vector3d(0.2, -0.4, -0.4)};

@@ -152,12 +152,25 @@ std::vector<std::map<std::string, std::string>> csv_rows(const std::string& text
   return rows;
 }
 
-dds::EchoOptions echo_options(const std::string& topic, int domain, const Captured& io) {
+dds::EchoOptions echo_options(const std::string& topic, int domain, const Captured& io,
+                              dds::EchoFormat format = dds::EchoFormat::kText) {
   dds::EchoOptions o;
   o.topic = topic;
   o.domain_id = domain;
+  o.format = format;
   o.count = 3;
   o.timeout_s = 5.0;
+  o.out = io.out;
+  o.err = io.err;
+  return o;
+}
+
+dds::DashboardOptions dashboard_options(int domain, bool once, double timeout_s,
+                                        const Captured& io) {
+  dds::DashboardOptions o;
+  o.domain_id = domain;
+  o.once = once;
+  o.timeout_s = timeout_s;
   o.out = io.out;
   o.err = io.err;
   return o;
@@ -204,8 +217,7 @@ TEST_F(DdsTools, EchoCsvHeaderAndValuesRoundTrip) {
   });
   {
     Captured io;
-    auto o = echo_options("joints", 151, io);
-    o.format = dds::EchoFormat::kCsv;
+    auto o = echo_options("joints", 151, io, dds::EchoFormat::kCsv);
     ASSERT_EQ(dds::run_echo(o), dds::kToolOk) << io.err_text();
     const auto lines = lines_of(io.out_text());
     ASSERT_EQ(lines.size(), 4u) << io.out_text();
@@ -229,8 +241,7 @@ TEST_F(DdsTools, EchoCsvHeaderAndValuesRoundTrip) {
   }
   {
     Captured io;
-    auto o = echo_options("hydraulics", 151, io);
-    o.format = dds::EchoFormat::kCsv;
+    auto o = echo_options("hydraulics", 151, io, dds::EchoFormat::kCsv);
     ASSERT_EQ(dds::run_echo(o), dds::kToolOk) << io.err_text();
     const auto rows = csv_rows(io.out_text());
     ASSERT_EQ(rows.size(), 3u) << io.out_text();
@@ -240,8 +251,7 @@ TEST_F(DdsTools, EchoCsvHeaderAndValuesRoundTrip) {
   }
   {
     Captured io;
-    auto o = echo_options("status", 151, io);
-    o.format = dds::EchoFormat::kCsv;
+    auto o = echo_options("status", 151, io, dds::EchoFormat::kCsv);
     o.count = 1;
     ASSERT_EQ(dds::run_echo(o), dds::kToolOk) << io.err_text();
     const auto rows = csv_rows(io.out_text());
@@ -270,8 +280,7 @@ TEST_F(DdsTools, EchoPrintsOperatorCommands) {
   Captured text, csv;
   EXPECT_EQ(dds::run_echo(echo_options("operator_command", 157, text)), dds::kToolOk)
       << text.err_text();
-  auto o = echo_options("craneassist/operator_command", 157, csv);
-  o.format = dds::EchoFormat::kCsv;
+  auto o = echo_options("craneassist/operator_command", 157, csv, dds::EchoFormat::kCsv);
   EXPECT_EQ(dds::run_echo(o), dds::kToolOk) << csv.err_text();
   stop.store(true);
   sender.join();
@@ -370,41 +379,31 @@ void expect_test_frame_snapshot(const std::string& out) {
   EXPECT_EQ(out.find("q or Ctrl-C quits"), std::string::npos);
 }
 
-TEST_F(DdsTools, DashboardOnceShowsThePublishedFrame) {
-  BackgroundPublisher publisher(154);
+// The dashboard on `domain` with the synthetic publisher there shows the test frame; out: what
+// it printed.
+void expect_dashboard_shows_the_test_frame(int domain, bool once, std::string& out) {
+  BackgroundPublisher publisher(domain);
   Captured io;
-  dds::DashboardOptions o;
-  o.domain_id = 154;
-  o.once = true;
-  o.timeout_s = 5.0;
-  o.out = io.out;
-  o.err = io.err;
-  ASSERT_EQ(dds::run_dashboard(o), dds::kToolOk) << io.err_text();
-  expect_test_frame_snapshot(io.out_text());
+  ASSERT_EQ(dds::run_dashboard(dashboard_options(domain, once, 5.0, io)), dds::kToolOk)
+      << io.err_text();
+  out = io.out_text();
+  expect_test_frame_snapshot(out);
+}
+
+TEST_F(DdsTools, DashboardOnceShowsThePublishedFrame) {
+  std::string out;
+  expect_dashboard_shows_the_test_frame(154, true, out);
 }
 
 TEST_F(DdsTools, DashboardNotATerminalPrintsOneSnapshot) {
-  BackgroundPublisher publisher(156);
-  Captured io;
-  dds::DashboardOptions o;  // not --once, but stdout is a file
-  o.domain_id = 156;
-  o.timeout_s = 5.0;
-  o.out = io.out;
-  o.err = io.err;
-  ASSERT_EQ(dds::run_dashboard(o), dds::kToolOk) << io.err_text();
-  expect_test_frame_snapshot(io.out_text());
-  EXPECT_EQ(count_of(io.out_text(), "craneassist dashboard   domain 156"), 1u);
+  std::string out;
+  expect_dashboard_shows_the_test_frame(156, false, out);  // not --once, but stdout is a file
+  EXPECT_EQ(count_of(out, "craneassist dashboard   domain 156"), 1u);
 }
 
 TEST_F(DdsTools, DashboardOnceTimeoutWithoutPublisher) {
   Captured io;
-  dds::DashboardOptions o;
-  o.domain_id = 155;
-  o.once = true;
-  o.timeout_s = 0.5;
-  o.out = io.out;
-  o.err = io.err;
-  EXPECT_EQ(dds::run_dashboard(o), dds::kToolRuntime);
+  EXPECT_EQ(dds::run_dashboard(dashboard_options(155, true, 0.5, io)), dds::kToolRuntime);
   EXPECT_NE(io.err_text().find("no sample on craneassist/status, craneassist/joints, "
                                "craneassist/hydraulics, craneassist/command_path within 0.5 s on "
                                "domain 155; is craneassist sim running with telemetry on?"),
@@ -504,13 +503,8 @@ TEST_F(DdsTools, DashboardDropsMalformedSamplesAndCountsThem) {
     writers.push_back(std::make_unique<MalformedWriter>(159, topic));
   }
   Captured io;
-  dds::DashboardOptions o;
-  o.domain_id = 159;
-  o.once = true;
-  o.timeout_s = 10.0;
-  o.out = io.out;
-  o.err = io.err;
-  ASSERT_EQ(dds::run_dashboard(o), dds::kToolOk) << io.err_text();
+  ASSERT_EQ(dds::run_dashboard(dashboard_options(159, true, 10.0, io)), dds::kToolOk)
+      << io.err_text();
   const std::string out = io.out_text();
   EXPECT_NE(out.find("Raw crane   backend sim"), std::string::npos) << out;
   EXPECT_NE(out.find("\nj3        "), std::string::npos) << out;

@@ -13,6 +13,8 @@ using namespace craneassist::input;
 
 namespace {
 
+const Eigen::Vector3d kMove(0.3, 0.0, 0.0);
+
 // The fault rules alone (deadman_hold and stop_latch 0: the press that arms passes at once);
 // TimedHarness has the shipped timing rules.
 struct Harness {
@@ -33,9 +35,13 @@ struct Harness {
     monitor.update(state, c, now, out);
     return out;
   }
-};
 
-const Eigen::Vector3d kMove(0.3, 0.0, 0.0);
+  // The deadman released for a cycle, then pressed: the pressed cycle's output.
+  MonitorOutput release_and_press() {
+    step(kMove, false);
+    return step(kMove, true);
+  }
+};
 
 }  // namespace
 
@@ -60,14 +66,12 @@ TEST(InputMonitor, DeadmanHeldSinceStartupDoesNotArm) {
     EXPECT_EQ(o.fault, InputFault::kNotArmed);
     EXPECT_TRUE(o.v_m_s.isZero());
   }
-  h.step(kMove, false);
-  EXPECT_TRUE(h.step(kMove, true).enabled);
+  EXPECT_TRUE(h.release_and_press().enabled);
 }
 
 TEST(InputMonitor, StaleInputStopsAndNeedsReArm) {
   Harness h;
-  h.step(kMove, false);
-  ASSERT_TRUE(h.step(kMove, true).enabled);
+  ASSERT_TRUE(h.release_and_press().enabled);
   EXPECT_TRUE(h.step(kMove, true, SourceState::kOk, 0.099).enabled);
   auto o = h.step(kMove, true, SourceState::kOk, 0.112);
   EXPECT_FALSE(o.enabled);
@@ -79,35 +83,30 @@ TEST(InputMonitor, StaleInputStopsAndNeedsReArm) {
   o = h.step(kMove, true);
   EXPECT_FALSE(o.enabled);
   EXPECT_EQ(o.fault, InputFault::kNotArmed);
-  h.step(kMove, false);
-  EXPECT_TRUE(h.step(kMove, true).enabled);
+  EXPECT_TRUE(h.release_and_press().enabled);
 }
 
 TEST(InputMonitor, ReleaseDuringTheFaultDoesNotCount) {
   Harness h;
-  h.step(kMove, false);
-  ASSERT_TRUE(h.step(kMove, true).enabled);
+  ASSERT_TRUE(h.release_and_press().enabled);
   h.step(kMove, false, SourceState::kOk, 0.5);  // stale sample, deadman released: not trusted
   EXPECT_EQ(h.step(kMove, true).fault, InputFault::kNotArmed);
 }
 
 TEST(InputMonitor, NonFiniteAndOutOfRangeCommandsStop) {
   Harness h;
-  h.step(kMove, false);
-  ASSERT_TRUE(h.step(kMove, true).enabled);
+  ASSERT_TRUE(h.release_and_press().enabled);
   auto o = h.step({NAN, 0.0, 0.0}, true);
   EXPECT_EQ(o.fault, InputFault::kNotFinite);
   EXPECT_TRUE(o.v_m_s.allFinite() && o.v_m_s.isZero());
-  h.step(kMove, false);
-  ASSERT_TRUE(h.step(kMove, true).enabled);
+  ASSERT_TRUE(h.release_and_press().enabled);
   o = h.step({0.0, -2.5, 0.0}, true);
   EXPECT_EQ(o.fault, InputFault::kOutOfRange);
   EXPECT_TRUE(o.v_m_s.isZero());
   o = h.step({0.0, 0.0, INFINITY}, true);
   EXPECT_EQ(o.fault, InputFault::kNotFinite);
   // A NaN stamp is stale.
-  h.step(kMove, false);
-  ASSERT_TRUE(h.step(kMove, true).enabled);
+  ASSERT_TRUE(h.release_and_press().enabled);
   OperatorCommand c;
   c.stamp_s = NAN;
   c.v_m_s = kMove;
@@ -121,8 +120,7 @@ TEST(InputMonitor, DisconnectAndReattachAreCountedAndNeedReArm) {
   auto o = h.step(kMove, true, SourceState::kDisconnected);  // absent at start: no event
   EXPECT_EQ(o.fault, InputFault::kDisconnected);
   EXPECT_EQ(h.monitor.disconnects(), 0);
-  h.step(kMove, false);
-  ASSERT_TRUE(h.step(kMove, true).enabled);
+  ASSERT_TRUE(h.release_and_press().enabled);
   o = h.step(kMove, true, SourceState::kDisconnected);
   EXPECT_FALSE(o.enabled);
   EXPECT_STREQ(to_string(o.fault), "device disconnected");
@@ -133,8 +131,7 @@ TEST(InputMonitor, DisconnectAndReattachAreCountedAndNeedReArm) {
   EXPECT_EQ(o.fault, InputFault::kNoData);
   EXPECT_EQ(h.monitor.reconnects(), 1);
   EXPECT_EQ(h.step(kMove, true).fault, InputFault::kNotArmed);
-  h.step(kMove, false);
-  EXPECT_TRUE(h.step(kMove, true).enabled);
+  EXPECT_TRUE(h.release_and_press().enabled);
 }
 
 TEST(InputMonitor, UpdateAllocatesNothing) {
@@ -152,6 +149,18 @@ struct TimedHarness : Harness {
     int passed = 0;
     for (int i = 0; i < n; ++i) passed += step(v, deadman).enabled ? 1 : 0;
     return passed;
+  }
+  // Held from now on: the command passes after the hold time (0.3 s), not before.
+  void expect_passes_after_the_hold() {
+    EXPECT_EQ(run(30, true), 0);
+    EXPECT_TRUE(step(kMove, true).enabled);
+  }
+  // Released for 50 ms, then held past the hold time (0.31 s): whether the command passes now
+  // (it should).
+  bool arm() {
+    run(5, false);
+    run(31, true);
+    return out.enabled;
   }
 };
 
@@ -180,15 +189,12 @@ TEST(InputMonitor, TheCommandPassesOnlyAfterTheDeadmanIsHeldForTheHoldTime) {
   g.run(5, false);
   EXPECT_EQ(g.run(20, true), 0);
   g.run(1, false);
-  EXPECT_EQ(g.run(30, true), 0);
-  EXPECT_TRUE(g.step(kMove, true).enabled);
+  g.expect_passes_after_the_hold();
 }
 
 TEST(InputMonitor, AReleaseLatchesTheStop) {
   TimedHarness h;
-  h.run(5, false);
-  h.run(31, true);
-  ASSERT_TRUE(h.out.enabled);
+  ASSERT_TRUE(h.arm());
   // Released for one cycle, pressed again at once: stopped for 1 s from the release.
   EXPECT_EQ(h.run(1, false), 0);
   int latched = 0;
@@ -202,15 +208,12 @@ TEST(InputMonitor, AReleaseLatchesTheStop) {
   EXPECT_TRUE(h.step(kMove, true).enabled);
   // Released longer than the latch: only the hold delays the command.
   h.run(150, false);
-  EXPECT_EQ(h.run(30, true), 0);
-  EXPECT_TRUE(h.step(kMove, true).enabled);
+  h.expect_passes_after_the_hold();
 }
 
 TEST(InputMonitor, AFaultLatchesTheStopToo) {
   TimedHarness h;
-  h.run(5, false);
-  h.run(31, true);
-  ASSERT_TRUE(h.out.enabled);
+  ASSERT_TRUE(h.arm());
   EXPECT_EQ(h.step(kMove, true, SourceState::kOk, 0.2).fault, InputFault::kStale);
   h.run(1, false);  // re-arm at once
   int passed = 0;
@@ -225,9 +228,7 @@ TEST(InputMonitor, AFaultLatchesTheStopToo) {
 TEST(InputMonitor, AChatteringDeadmanKeepsTheCommandStopped) {
   for (int period : {1, 2, 5, 29}) {
     TimedHarness h;
-    h.run(5, false);
-    h.run(31, true);
-    ASSERT_TRUE(h.out.enabled);
+    ASSERT_TRUE(h.arm());
     int passed = 0;
     for (int i = 0; i < 1000; ++i) {
       passed += h.step(kMove, (i / period) % 2 == 1).enabled ? 1 : 0;
@@ -238,8 +239,7 @@ TEST(InputMonitor, AChatteringDeadmanKeepsTheCommandStopped) {
   // Held for longer than the hold between releases: the latch keeps the stop 1 s after each,
   // so the command passes in at most a few short bursts.
   TimedHarness h;
-  h.run(5, false);
-  h.run(31, true);
+  h.arm();
   int passed = 0;
   for (int i = 0; i < 1000; ++i) passed += h.step(kMove, i % 40 != 0).enabled ? 1 : 0;
   EXPECT_LT(passed, 1000 / 10);
@@ -247,8 +247,6 @@ TEST(InputMonitor, AChatteringDeadmanKeepsTheCommandStopped) {
 
 TEST(InputMonitor, ZeroHoldAndLatchArmAtThePress) {
   Harness h;  // 0 and 0: the monitor before the timing rules
-  h.step(kMove, false);
-  ASSERT_TRUE(h.step(kMove, true).enabled);
-  h.step(kMove, false);
-  EXPECT_TRUE(h.step(kMove, true).enabled);
+  ASSERT_TRUE(h.release_and_press().enabled);
+  EXPECT_TRUE(h.release_and_press().enabled);
 }

@@ -19,14 +19,33 @@ void expect_bytes(const CanFrame& f, std::array<std::uint8_t, 8> expected) {
   }
 }
 
+AuxValveCommand command(std::uint8_t valve, double flow, ValveState state,
+                        FailSafeMode fail_safe = AuxValveCommand{}.fail_safe) {
+  AuxValveCommand c;
+  c.valve = valve;
+  c.flow = flow;
+  c.state = state;
+  c.fail_safe = fail_safe;
+  return c;
+}
+
+// A flow message from source address 0x10 (priority 3) is the frame `id` with the bytes
+// `expected` (out: f), and that frame decodes (into d) from 0x10 again.
+template <class Message>
+void expect_known_vector(const Message& m, std::uint32_t id, std::array<std::uint8_t, 8> expected,
+                         CanFrame& f, Message& d) {
+  ASSERT_EQ(encode(m, 0x10, 3, f), CodecStatus::kOk);
+  EXPECT_EQ(f.id, id);
+  expect_bytes(f, expected);
+  std::uint8_t sa = 0;
+  ASSERT_EQ(decode(f, d, sa), CodecStatus::kOk);
+  EXPECT_EQ(sa, 0x10);
+}
+
 }  // namespace
 
 TEST(AuxValveCommand, KnownVectorHalfFlowExtend) {
-  AuxValveCommand c;
-  c.valve = 0;
-  c.flow = 0.5;
-  c.state = ValveState::kExtend;
-  c.fail_safe = FailSafeMode::kBlock;
+  const AuxValveCommand c = command(0, 0.5, ValveState::kExtend, FailSafeMode::kBlock);
   CanFrame f;
   ASSERT_EQ(encode(c, 0x80, 3, f), CodecStatus::kOk);
   EXPECT_TRUE(f.extended);
@@ -37,11 +56,7 @@ TEST(AuxValveCommand, KnownVectorHalfFlowExtend) {
 }
 
 TEST(AuxValveCommand, KnownVectorFullRetractFloatStandardOnly) {
-  AuxValveCommand c;
-  c.valve = 15;
-  c.flow = 1.0;
-  c.state = ValveState::kRetract;
-  c.fail_safe = FailSafeMode::kFloat;
+  AuxValveCommand c = command(15, 1.0, ValveState::kRetract, FailSafeMode::kFloat);
   c.extended_resolution = false;
   CanFrame f;
   ASSERT_EQ(encode(c, 0x27, 3, f), CodecStatus::kOk);
@@ -51,10 +66,7 @@ TEST(AuxValveCommand, KnownVectorFullRetractFloatStandardOnly) {
 
 TEST(AuxValveCommand, BlockAndFloatAndDontCare) {
   CanFrame f;
-  AuxValveCommand c;
-  c.valve = 3;
-  c.flow = 0.0;
-  c.state = ValveState::kBlock;
+  AuxValveCommand c = command(3, 0.0, ValveState::kBlock);
   ASSERT_EQ(encode(c, 0x80, 6, f), CodecStatus::kOk);
   EXPECT_EQ(f.id, 0x18FE3380u);
   expect_bytes(f, {0x00, 0xFD, 0x30, 0x00, 0x00, 0xFF, 0xFF, 0xFF});
@@ -118,11 +130,7 @@ TEST(AuxValveCommand, RoundTripsEveryValveStateAndMode) {
       for (FailSafeMode fs :
            {FailSafeMode::kBlock, FailSafeMode::kFloat, FailSafeMode::kDontCare}) {
         for (bool ext : {true, false}) {
-          AuxValveCommand c;
-          c.valve = valve;
-          c.flow = 0.01 * valve * 6.0 + 0.0123;
-          c.state = state;
-          c.fail_safe = fs;
+          AuxValveCommand c = command(valve, 0.01 * valve * 6.0 + 0.0123, state, fs);
           c.extended_resolution = ext;
           CanFrame f;
           ASSERT_EQ(encode(c, 0x81, 3, f), CodecStatus::kOk);
@@ -200,14 +208,9 @@ TEST(AuxValveMeasuredFlow, KnownVectorAndRoundTrip) {
   m.return_pressure_pa = 0.32e6;  // 20
   m.limit = LimitStatus::kNotLimited;
   CanFrame f;
-  ASSERT_EQ(encode(m, 0x10, 3, f), CodecStatus::kOk);
-  EXPECT_EQ(f.id, 0x0CFE2910u);  // PGN 65065
-  expect_bytes(f, {0xAF, 0x4B, 0xA0, 0x0F, 0xC8, 0x00, 0x14, 0x1F});
-
   AuxValveMeasuredFlow d;
-  std::uint8_t sa = 0;
-  ASSERT_EQ(decode(f, d, sa), CodecStatus::kOk);
-  EXPECT_EQ(sa, 0x10);
+  expect_known_vector(m, 0x0CFE2910u /* PGN 65065 */,
+                      {0xAF, 0x4B, 0xA0, 0x0F, 0xC8, 0x00, 0x14, 0x1F}, f, d);
   EXPECT_EQ(d.valve, 9);
   EXPECT_DOUBLE_EQ(d.extend_flow, 0.5);
   EXPECT_DOUBLE_EQ(d.retract_flow, -0.5);
@@ -250,12 +253,10 @@ TEST(AuxValveEstimatedFlow, KnownVectorAndRoundTrip) {
   m.fail_safe = FailSafeMode::kFloat;
   m.limit = LimitStatus::kLimitedHigh;
   CanFrame f;
-  ASSERT_EQ(encode(m, 0x10, 3, f), CodecStatus::kOk);
-  EXPECT_EQ(f.id, 0x0CFE1110u);  // PGN 65041
-  expect_bytes(f, {0x96, 0xFF, 0x71, 0x5F, 0xFF, 0xFF, 0xFF, 0xFF});
   AuxValveEstimatedFlow d;
+  expect_known_vector(m, 0x0CFE1110u /* PGN 65041 */,
+                      {0x96, 0xFF, 0x71, 0x5F, 0xFF, 0xFF, 0xFF, 0xFF}, f, d);
   std::uint8_t sa = 0;
-  ASSERT_EQ(decode(f, d, sa), CodecStatus::kOk);
   EXPECT_EQ(d.valve, 1);
   EXPECT_DOUBLE_EQ(d.extend_flow, 0.25);
   EXPECT_TRUE(std::isnan(d.retract_flow));

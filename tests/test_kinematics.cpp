@@ -27,6 +27,20 @@ JointVector random_q(const CraneModel& m, std::mt19937& rng) {
   return q;
 }
 
+// check(q, jac, data) at `trials` random poses q of m (the generator seeded with seed), jac the tip
+// Jacobian there; data for further kinematics.
+template <class Check>
+void at_random_poses(const CraneModel& m, unsigned seed, int trials, Check check) {
+  std::mt19937 rng(seed);
+  KinematicsData data;
+  TaskJacobian jac;
+  for (int trial = 0; trial < trials; ++trial) {
+    const JointVector q = random_q(m, rng);
+    tip_jacobian(m, data, q, jac);
+    check(q, jac, data);
+  }
+}
+
 }  // namespace
 
 TEST(Kinematics, TipMatchesPaperClosedForm) {
@@ -66,22 +80,18 @@ TEST(Kinematics, ReachAtFullExtensionIsAbout9_1m) {
 TEST(Kinematics, JacobianMatchesFiniteDifferences) {
   for (const auto* model : {&k70m()}) {
     const auto& m = *model;
-    std::mt19937 rng(2);
-    KinematicsData data;
-    TaskJacobian jac;
-    for (int trial = 0; trial < 30; ++trial) {
-      const JointVector q = random_q(m, rng);
-      tip_jacobian(m, data, q, jac);
-      for (int i = 0; i < m.dof(); ++i) {
-        const double h = 1e-6;
-        JointVector qp = q, qm = q;
-        qp[i] += h;
-        qm[i] -= h;
-        const Eigen::Vector3d fd =
-            (tip_position(m, data, qp) - tip_position(m, data, qm)) / (2 * h);
-        EXPECT_LT((jac.col(i) - fd).norm(), 1e-7) << "joint " << i;
-      }
-    }
+    at_random_poses(m, 2, 30,
+                    [&](const JointVector& q, const TaskJacobian& jac, KinematicsData& data) {
+                      for (int i = 0; i < m.dof(); ++i) {
+                        const double h = 1e-6;
+                        JointVector qp = q, qm = q;
+                        qp[i] += h;
+                        qm[i] -= h;
+                        const Eigen::Vector3d fd =
+                            (tip_position(m, data, qp) - tip_position(m, data, qm)) / (2 * h);
+                        EXPECT_LT((jac.col(i) - fd).norm(), 1e-7) << "joint " << i;
+                      }
+                    });
   }
 }
 
@@ -187,17 +197,11 @@ TEST(InverseKinematics, RecoversJointsGivenExtension) {
 }
 
 TEST(InverseKinematics, RatesGivenExtensionMeetTheTipVelocity) {
-  const auto& m = k70m();
-  std::mt19937 rng(5);
-  KinematicsData data;
-  TaskJacobian jac;
-  for (int trial = 0; trial < 50; ++trial) {
-    const JointVector q = random_q(m, rng);
-    tip_jacobian(m, data, q, jac);
+  at_random_poses(k70m(), 5, 50, [](const JointVector&, const TaskJacobian& jac, KinematicsData&) {
     const Eigen::Vector3d v(0.3, -0.2, 0.1);
     JointVector qdot;
-    if (resolve_rates_given_extension(jac, v, 0.05, qdot) != IkStatus::kOk) continue;
+    if (resolve_rates_given_extension(jac, v, 0.05, qdot) != IkStatus::kOk) return;
     EXPECT_LT((jac * qdot - v).norm(), 1e-10);
     EXPECT_DOUBLE_EQ(qdot[3], 0.05);
-  }
+  });
 }

@@ -6,13 +6,12 @@
 
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "allocation_counter.hpp"
-#include "craneassist/config/crane_config.hpp"
-#include "craneassist/dynamics/cylinders.hpp"
-#include "craneassist/dynamics/kinematics.hpp"
 #include "craneassist/dynamics/null_space_resolution.hpp"
 #include "craneassist/dynamics/resolutions.hpp"
+#include "random_tip_task.hpp"
 
 using namespace craneassist::dynamics;
 
@@ -20,40 +19,39 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-const CraneModel& k70m() {
-  static const CraneModel model = craneassist::config::default_crane_config().model;
-  return model;
-}
+using craneassist::test::k70m;
 
-struct Case {
-  JointVector q;
-  TaskJacobian jacobian;
+// The task's tip velocity as a unit direction u, and the solution line of J f = u.
+struct Case : craneassist::test::RandomTipTask {
   Eigen::Vector3d u;
-  JointVector arms, force;
   SolutionLine line;
 };
 
 Case random_case(std::mt19937& rng) {
-  const auto& m = k70m();
   Case c;
-  c.q.resize(4);
-  for (int i = 0; i < 4; ++i) {
-    std::uniform_real_distribution<double> d(m.joints[i].q_min + 0.05, m.joints[i].q_max - 0.05);
-    c.q[i] = d(rng);
-  }
-  KinematicsData kin;
-  tip_jacobian(m, kin, c.q, c.jacobian);
-  std::normal_distribution<double> nd(0.0, 1.0);
-  c.u = Eigen::Vector3d(nd(rng), nd(rng), nd(rng)).normalized();
-  cylinder_arms(m, c.q, c.arms);
-  std::normal_distribution<double> force(0.0, 5e4);
-  c.force.resize(4);
-  for (int i = 0; i < 4; ++i) c.force[i] = force(rng);
+  static_cast<craneassist::test::RandomTipTask&>(c) = craneassist::test::random_tip_task(rng, 1.0);
+  c.u = c.v.normalized();
   return c;
 }
 
+// Every joint rate within [-bound, bound].
+JointRateBounds box(double bound) {
+  return {JointVector::Constant(4, -bound), JointVector::Constant(4, bound)};
+}
+
+// `trials` random cases drawn from a generator seeded with seed, each with its solution line.
+std::vector<Case> cases_on_their_lines(unsigned seed, int trials) {
+  std::mt19937 rng(seed);
+  std::vector<Case> out;
+  for (int trial = 0; trial < trials; ++trial) {
+    out.push_back(random_case(rng));
+    EXPECT_TRUE(solution_line(out.back().jacobian, out.back().u, out.back().line)) << trial;
+  }
+  return out;
+}
+
 JointRateBounds unbounded() {
-  return {JointVector::Constant(4, -kInf), JointVector::Constant(4, kInf)};
+  return box(kInf);
 }
 
 NullSpaceProblem problem_for(const Case& c) {
@@ -69,15 +67,50 @@ NullSpaceProblem problem_for(const Case& c) {
 constexpr Resolution kAll[] = {Resolution::kPinvJoint, Resolution::kPinvActuator,
                                Resolution::kMinFlow, Resolution::kMinLsPower};
 
-// The cost of each resolution along a fine sweep of tau over [lo, hi], its minimum.
-double swept_minimum(Resolution r, const Case& c, double lo, double hi) {
+// The smallest value of measure(f) over the solutions f = p + tau n of a fine sweep of tau over
+// [lo, hi] in `steps` steps.
+template <class Measure>
+double swept_minimum(const Case& c, double lo, double hi, int steps, Measure measure) {
   double best = kInf;
-  for (int k = 0; k <= 20000; ++k) {
-    const double tau = lo + (hi - lo) * k / 20000.0;
-    const JointVector f = c.line.p + tau * c.line.n;
-    best = std::min(best, resolution_cost(k70m(), r, f, c.arms, &c.force));
+  for (int k = 0; k <= steps; ++k) {
+    const double tau = lo + (hi - lo) * k / static_cast<double>(steps);
+    best = std::min(best, measure(JointVector(c.line.p + tau * c.line.n)));
   }
   return best;
+}
+
+// The cost of each resolution along a fine sweep of tau over [lo, hi], its minimum.
+double swept_minimum(Resolution r, const Case& c, double lo, double hi) {
+  return swept_minimum(c, lo, hi, 20000, [&](const JointVector& f) {
+    return resolution_cost(k70m(), r, f, c.arms, &c.force);
+  });
+}
+
+// The largest share of its position bound a joint rate takes.
+double position_share(const JointRateBounds& position, const JointVector& f) {
+  double share = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    share = std::max(share, f[i] > 0 ? f[i] / position.upper[i] : f[i] / position.lower[i]);
+  }
+  return share;
+}
+
+// f meets the task: J f = u.
+void expect_meets_the_task(const Case& c, const JointVector& f) {
+  EXPECT_LT((c.jacobian * f - c.u).norm(), 1e-9 * (1.0 + f.norm()));
+}
+
+NullSpaceResult resolve(Resolution r, const NullSpaceProblem& p) {
+  NullSpaceResult out;
+  resolve_null_space(k70m(), r, p, out);
+  return out;
+}
+
+// The problem with a symmetric hydraulic box and no other bounds.
+NullSpaceProblem problem_for(const Case& c, double hydraulic_bound) {
+  NullSpaceProblem p = problem_for(c);
+  p.hydraulic = box(hydraulic_bound);
+  return p;
 }
 
 }  // namespace
@@ -112,19 +145,16 @@ TEST(SolutionLine, RankDeficientJacobianIsRefused) {
 }
 
 TEST(NullSpaceResolution, WithoutBoundsEachResolutionIsItsOptimum) {
-  std::mt19937 rng(2);
   int compared = 0;
-  for (int trial = 0; trial < 100; ++trial) {
-    Case c = random_case(rng);
-    ASSERT_TRUE(solution_line(c.jacobian, c.u, c.line));
+  const auto cases = cases_on_their_lines(2, 100);
+  for (std::size_t trial = 0; trial < cases.size(); ++trial) {
+    const Case& c = cases[trial];
     // A finite hydraulic box keeps the problem bounded (as the controller's always is).
-    NullSpaceProblem p = problem_for(c);
-    p.hydraulic = {JointVector::Constant(4, -20.0), JointVector::Constant(4, 20.0)};
+    NullSpaceProblem p = problem_for(c, 20.0);
     for (Resolution r : kAll) {
-      NullSpaceResult out;
-      resolve_null_space(k70m(), r, p, out);
+      const NullSpaceResult out = resolve(r, p);
       ASSERT_EQ(out.status, NullSpaceStatus::kOptimal);
-      EXPECT_LT((c.jacobian * out.f - c.u).norm(), 1e-9 * (1.0 + out.f.norm()));
+      expect_meets_the_task(c, out.f);
       const double sweep = swept_minimum(r, c, out.hard_lo, out.hard_hi);
       EXPECT_LE(out.cost, sweep * (1 + 1e-6) + 1e-12) << to_string(r) << " trial " << trial;
     }
@@ -136,21 +166,19 @@ TEST(NullSpaceResolution, WithoutBoundsEachResolutionIsItsOptimum) {
     in.v_tip = c.u;
     in.dc_dq = &c.arms;
     in.cylinder_force = &c.force;
-    const JointRateBounds loose{JointVector::Constant(4, -20.0), JointVector::Constant(4, 20.0)};
+    const JointRateBounds loose = box(20.0);
     in.bounds = &loose;
     for (Resolution r :
          {Resolution::kPinvActuator, Resolution::kMinFlow, Resolution::kMinLsPower}) {
       ExtensionResolutionResult ext;
       resolve_by_extension(k70m(), r, in, ext);
-      NullSpaceResult out;
-      resolve_null_space(k70m(), r, p, out);
+      const NullSpaceResult out = resolve(r, p);
       if (!ext.feasible) continue;
       EXPECT_NEAR(out.cost, ext.cost, 1e-7 * (1.0 + std::abs(ext.cost))) << to_string(r);
       ++compared;
     }
     // pinv-joint: the minimum-norm solution itself.
-    NullSpaceResult out;
-    resolve_null_space(k70m(), Resolution::kPinvJoint, p, out);
+    const NullSpaceResult out = resolve(Resolution::kPinvJoint, p);
     EXPECT_LT((out.f - c.line.p).norm(), 1e-9);
   }
   EXPECT_GT(compared, 100);
@@ -163,33 +191,19 @@ TEST(NullSpaceResolution, PositionBoundsHoldWheneverTheyCan) {
   for (int trial = 0; trial < 400; ++trial) {
     Case c = random_case(rng);
     ASSERT_TRUE(solution_line(c.jacobian, c.u, c.line));
-    NullSpaceProblem p = problem_for(c);
-    p.hydraulic = {JointVector::Constant(4, -50.0), JointVector::Constant(4, 50.0)};
+    NullSpaceProblem p = problem_for(c, 50.0);
     for (int i = 0; i < 4; ++i) {
       p.position.upper[i] = width(rng);
       p.position.lower[i] = -width(rng);
     }
     for (Resolution r : kAll) {
-      NullSpaceResult out;
-      resolve_null_space(k70m(), r, p, out);
-      EXPECT_LT((c.jacobian * out.f - c.u).norm(), 1e-9 * (1.0 + out.f.norm()));
+      const NullSpaceResult out = resolve(r, p);
+      expect_meets_the_task(c, out.f);
       // Feasible somewhere on the line (a sweep finds it)?
-      double best_share = kInf;
-      for (int k = 0; k <= 40000; ++k) {
-        const double tau = -50.0 + 100.0 * k / 40000.0;
-        const JointVector f = c.line.p + tau * c.line.n;
-        double share = 0.0;
-        for (int i = 0; i < 4; ++i) {
-          share =
-              std::max(share, f[i] > 0 ? f[i] / p.position.upper[i] : f[i] / p.position.lower[i]);
-        }
-        best_share = std::min(best_share, share);
-      }
-      double share = 0.0;
-      for (int i = 0; i < 4; ++i) {
-        share = std::max(
-            share, out.f[i] > 0 ? out.f[i] / p.position.upper[i] : out.f[i] / p.position.lower[i]);
-      }
+      const double best_share = swept_minimum(c, -50.0, 50.0, 40000, [&](const JointVector& f) {
+        return position_share(p.position, f);
+      });
+      const double share = position_share(p.position, out.f);
       if (best_share <= 1.0 - 1e-6) {
         ++feasible;
         EXPECT_NE(out.status, NullSpaceStatus::kPositionLimit) << to_string(r);
@@ -212,8 +226,7 @@ TEST(NullSpaceResolution, AJointAtItsEndNeverMovesIntoIt) {
   for (int trial = 0; trial < 300; ++trial) {
     Case c = random_case(rng);
     ASSERT_TRUE(solution_line(c.jacobian, c.u, c.line));
-    NullSpaceProblem p = problem_for(c);
-    p.hydraulic = {JointVector::Constant(4, -50.0), JointVector::Constant(4, 50.0)};
+    NullSpaceProblem p = problem_for(c, 50.0);
     const int at_end = static_cast<int>(rng() % 4);
     const bool upper = rng() % 2 == 0;
     (upper ? p.position.upper : p.position.lower)[at_end] = 0.0;
@@ -225,8 +238,7 @@ TEST(NullSpaceResolution, AJointAtItsEndNeverMovesIntoIt) {
     }
     if (std::abs(c.line.n[at_end]) < 1e-6) continue;  // the null space cannot move it
     for (Resolution r : kAll) {
-      NullSpaceResult out;
-      resolve_null_space(k70m(), r, p, out);
+      const NullSpaceResult out = resolve(r, p);
       const double towards = upper ? out.f[at_end] : -out.f[at_end];
       EXPECT_LE(towards, 1e-9) << to_string(r) << " joint " << at_end;
       ++checked;
@@ -236,11 +248,8 @@ TEST(NullSpaceResolution, AJointAtItsEndNeverMovesIntoIt) {
 }
 
 TEST(NullSpaceResolution, HydraulicFallbackMaximisesTheSpeedTheCylindersAllow) {
-  std::mt19937 rng(5);
   int fallbacks = 0;
-  for (int trial = 0; trial < 300; ++trial) {
-    Case c = random_case(rng);
-    ASSERT_TRUE(solution_line(c.jacobian, c.u, c.line));
+  for (const Case& c : cases_on_their_lines(5, 300)) {
     NullSpaceProblem p = problem_for(c);
     // Cylinder-speed bounds of the K70M at a path speed of 2 m/s: often infeasible.
     for (int i = 0; i < 4; ++i) {
@@ -249,8 +258,7 @@ TEST(NullSpaceResolution, HydraulicFallbackMaximisesTheSpeedTheCylindersAllow) {
       p.hydraulic.lower[i] = -rate;
     }
     p.flow_limit_m2 = k70m().pump.max_flow_m3_s / 2.0;
-    NullSpaceResult out;
-    resolve_null_space(k70m(), Resolution::kMinLsPower, p, out);
+    const NullSpaceResult out = resolve(Resolution::kMinLsPower, p);
     if (out.status != NullSpaceStatus::kHydraulicLimit) continue;
     ++fallbacks;
     auto load = [&](const JointVector& f) {
@@ -262,11 +270,7 @@ TEST(NullSpaceResolution, HydraulicFallbackMaximisesTheSpeedTheCylindersAllow) {
       }
       return std::max(worst, flow / p.flow_limit_m2);
     };
-    double best = kInf;
-    for (int k = 0; k <= 40000; ++k) {
-      const double tau = out.hard_lo + (out.hard_hi - out.hard_lo) * k / 40000.0;
-      best = std::min(best, load(c.line.p + tau * c.line.n));
-    }
+    const double best = swept_minimum(c, out.hard_lo, out.hard_hi, 40000, load);
     EXPECT_GT(best, 1.0);
     EXPECT_LE(load(out.f), best * (1 + 1e-4));
   }
@@ -274,16 +278,11 @@ TEST(NullSpaceResolution, HydraulicFallbackMaximisesTheSpeedTheCylindersAllow) {
 }
 
 TEST(NullSpaceResolution, EndAvoidanceHandsMotionToTheOtherJoints) {
-  std::mt19937 rng(6);
   int reduced = 0, trials = 0;
-  for (int trial = 0; trial < 200; ++trial) {
-    Case c = random_case(rng);
-    ASSERT_TRUE(solution_line(c.jacobian, c.u, c.line));
-    NullSpaceProblem p = problem_for(c);
-    p.hydraulic = {JointVector::Constant(4, -20.0), JointVector::Constant(4, 20.0)};
+  for (const Case& c : cases_on_their_lines(6, 200)) {
+    NullSpaceProblem p = problem_for(c, 20.0);
     for (Resolution r : kAll) {
-      NullSpaceResult plain;
-      resolve_null_space(k70m(), r, p, plain);
+      const NullSpaceResult plain = resolve(r, p);
       // The joint the plain optimum moves fastest (that the null space can move), near its end in
       // that direction.
       int i = 1;
@@ -296,12 +295,11 @@ TEST(NullSpaceResolution, EndAvoidanceHandsMotionToTheOtherJoints) {
       avoid.avoid_sign = JointVector::Zero(4);
       avoid.avoid_weight[i] = 10.0;
       avoid.avoid_sign[i] = plain.f[i] > 0 ? 1.0 : -1.0;
-      NullSpaceResult out;
-      resolve_null_space(k70m(), r, avoid, out);
+      const NullSpaceResult out = resolve(r, avoid);
       ++trials;
       EXPECT_LE(std::abs(out.f[i]), std::abs(plain.f[i]) + 1e-12) << to_string(r);
       reduced += std::abs(out.f[i]) < 0.9 * std::abs(plain.f[i]);
-      EXPECT_LT((c.jacobian * out.f - c.u).norm(), 1e-9 * (1.0 + out.f.norm()));
+      expect_meets_the_task(c, out.f);
     }
   }
   EXPECT_GT(trials, 100);
@@ -311,17 +309,12 @@ TEST(NullSpaceResolution, EndAvoidanceHandsMotionToTheOtherJoints) {
 TEST(NullSpaceResolution, HandoverBoundsYieldToTheHardOnes) {
   // Hand-over bounds tighter than anything feasible: the solution stays within the position and
   // hydraulic bounds and says the hand-over bound is exceeded.
-  std::mt19937 rng(7);
   int handovers = 0;
-  for (int trial = 0; trial < 200; ++trial) {
-    Case c = random_case(rng);
-    ASSERT_TRUE(solution_line(c.jacobian, c.u, c.line));
-    NullSpaceProblem p = problem_for(c);
-    p.hydraulic = {JointVector::Constant(4, -20.0), JointVector::Constant(4, 20.0)};
-    p.position = {JointVector::Constant(4, -5.0), JointVector::Constant(4, 5.0)};
-    p.handover = {JointVector::Constant(4, -1e-3), JointVector::Constant(4, 1e-3)};
-    NullSpaceResult out;
-    resolve_null_space(k70m(), Resolution::kMinFlow, p, out);
+  for (const Case& c : cases_on_their_lines(7, 200)) {
+    NullSpaceProblem p = problem_for(c, 20.0);
+    p.position = box(5.0);
+    p.handover = box(1e-3);
+    const NullSpaceResult out = resolve(Resolution::kMinFlow, p);
     if (out.status == NullSpaceStatus::kPositionLimit) continue;
     EXPECT_LE(out.f.cwiseAbs().maxCoeff(), 5.0 + 1e-9);
     handovers += out.status == NullSpaceStatus::kHandover;
@@ -336,10 +329,9 @@ TEST(NullSpaceResolution, ResolvingAllocatesNothing) {
   const long before = craneassist::test::heap_allocations();
   for (int k = 0; k < 50; ++k) {
     ASSERT_TRUE(solution_line(c.jacobian, c.u, c.line));
-    NullSpaceProblem p = problem_for(c);
-    p.hydraulic = {JointVector::Constant(4, -2.0), JointVector::Constant(4, 2.0)};
+    NullSpaceProblem p = problem_for(c, 2.0);
     p.flow_limit_m2 = 1e-3;
-    p.handover = {JointVector::Constant(4, -0.1), JointVector::Constant(4, 0.1)};
+    p.handover = box(0.1);
     p.avoid_weight = JointVector::Constant(4, 1.0);
     p.avoid_sign = JointVector::Constant(4, 1.0);
     for (Resolution r : kAll) resolve_null_space(k70m(), r, p, out);

@@ -49,6 +49,19 @@ class SinePathScaler : public ::testing::Test {
     scaler.update(q_, geometry_, in, out);
   }
 
+  // A path scaler on the fixture's crane with its own dynamics terms, asked for sdot_request.
+  struct Scaler {
+    Scaler(const dynamics::CraneModel& model, const scaling::PathScalerConfig& config,
+           double sdot_request)
+        : terms(model), scaler(model, config, terms) {
+      in.sdot_request = sdot_request;
+    }
+    dynamics::RigidBodyTerms terms;
+    scaling::PathScaler scaler;
+    scaling::PathScalerInput in;
+    scaling::PathScalerOutput out;
+  };
+
   config::CraneConfig cfg_;
   scaling::PathGeometry geometry_;
   dynamics::JointVector q_;
@@ -57,11 +70,8 @@ class SinePathScaler : public ::testing::Test {
 }  // namespace
 
 TEST_F(SinePathScaler, SpeedStaysWithinTheRequestAndItsLimitsAndJerkWithinItsBound) {
-  dynamics::RigidBodyTerms terms(cfg_.model);
-  scaling::PathScaler scaler(cfg_.model, config(scaling::PowerBound::kLoadSensing), terms);
-  scaling::PathScalerInput in;
-  in.sdot_request = 2.0;
-  scaling::PathScalerOutput out;
+  Scaler s(cfg_.model, config(scaling::PowerBound::kLoadSensing), 2.0);
+  auto& [terms, scaler, in, out] = s;
   double peak_sdot = 0.0;
   int limited = 0;
   for (int k = 0; k < 800; ++k) {
@@ -94,11 +104,8 @@ TEST_F(SinePathScaler, LoadSensingBoundKeepsTheModelsPumpPowerWithinPmax) {
   const scaling::PowerBound bounds[2] = {scaling::PowerBound::kLoadSensing,
                                          scaling::PowerBound::kActuatorPowerSum};
   for (int b = 0; b < 2; ++b) {
-    dynamics::RigidBodyTerms terms(cfg_.model);
-    scaling::PathScaler scaler(cfg_.model, config(bounds[b]), terms);
-    scaling::PathScalerInput in;
-    in.sdot_request = 2.0;
-    scaling::PathScalerOutput out;
+    Scaler s(cfg_.model, config(bounds[b]), 2.0);
+    auto& [terms, scaler, in, out] = s;
     for (int k = 0; k < 800; ++k) {
       step(scaler, in, out);
       // The power of the state the scaler chose, with the terms it used this cycle.
@@ -112,11 +119,8 @@ TEST_F(SinePathScaler, LoadSensingBoundKeepsTheModelsPumpPowerWithinPmax) {
 }
 
 TEST_F(SinePathScaler, StaleInputStopsJerkLimitedAndStaysStopped) {
-  dynamics::RigidBodyTerms terms(cfg_.model);
-  scaling::PathScaler scaler(cfg_.model, config(scaling::PowerBound::kLoadSensing), terms);
-  scaling::PathScalerInput in;
-  in.sdot_request = 1.0;
-  scaling::PathScalerOutput out;
+  Scaler s(cfg_.model, config(scaling::PowerBound::kLoadSensing), 1.0);
+  auto& [terms, scaler, in, out] = s;
   for (int k = 0; k < 200; ++k) step(scaler, in, out);
   ASSERT_GT(out.state.sdot, 0.3);
   in.sdot_request = 0.0;
@@ -141,12 +145,10 @@ TEST_F(SinePathScaler, TrackingFactorScalesTheSpeed) {
   double steady[2] = {0.0, 0.0};
   const double factors[2] = {1.0, 0.5};
   for (int f = 0; f < 2; ++f) {
-    dynamics::RigidBodyTerms terms(cfg_.model);
-    scaling::PathScaler scaler(cfg_.model, config(scaling::PowerBound::kNone), terms);
-    scaling::PathScalerInput in;
-    in.sdot_request = 0.3;  // slow enough that no hydraulic limit holds it back
+    // 0.3: slow enough that no hydraulic limit holds it back.
+    Scaler s(cfg_.model, config(scaling::PowerBound::kNone), 0.3);
+    auto& [terms, scaler, in, out] = s;
     in.tracking_factor = factors[f];
-    scaling::PathScalerOutput out;
     for (int k = 0; k < 150; ++k) step(scaler, in, out);
     steady[f] = out.state.sdot;
   }

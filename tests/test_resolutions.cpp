@@ -3,50 +3,36 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <utility>
+#include <vector>
 
-#include "craneassist/config/crane_config.hpp"
-#include "craneassist/dynamics/cylinders.hpp"
-#include "craneassist/dynamics/kinematics.hpp"
 #include "craneassist/dynamics/resolutions.hpp"
+#include "random_tip_task.hpp"
 
 using namespace craneassist::dynamics;
 
 namespace {
 
-const CraneModel& k70m() {
-  static const CraneModel model = craneassist::config::default_crane_config().model;
-  return model;
-}
-
-struct Case {
-  JointVector q;
-  TaskJacobian jacobian;
-  Eigen::Vector3d v;
-  JointVector arms;
-  JointVector force;
-};
+using craneassist::test::k70m;
+using Case = craneassist::test::RandomTipTask;
 
 Case random_case(std::mt19937& rng) {
-  const auto& m = k70m();
-  Case c;
-  c.q.resize(4);
-  for (int i = 0; i < 4; ++i) {
-    std::uniform_real_distribution<double> d(m.joints[i].q_min + 0.05, m.joints[i].q_max - 0.05);
-    c.q[i] = d(rng);
-  }
-  KinematicsData kin;
-  tip_jacobian(m, kin, c.q, c.jacobian);
-  std::normal_distribution<double> nd(0.0, 0.5);
-  c.v = Eigen::Vector3d(nd(rng), nd(rng), nd(rng));
-  cylinder_arms(m, c.q, c.arms);
-  std::normal_distribution<double> force(0.0, 5e4);
-  c.force.resize(4);
-  for (int i = 0; i < 4; ++i) c.force[i] = force(rng);
-  return c;
+  return craneassist::test::random_tip_task(rng, 0.5);
 }
 
 bool well_conditioned(const Case& c) {
   return std::abs(Eigen::Matrix3d(c.jacobian.leftCols<3>()).determinant()) > 1e-2;
+}
+
+// The well-conditioned ones of `trials` random cases drawn from a generator seeded with seed.
+std::vector<Case> well_conditioned_cases(unsigned seed, int trials) {
+  std::mt19937 rng(seed);
+  std::vector<Case> out;
+  for (int trial = 0; trial < trials; ++trial) {
+    Case c = random_case(rng);
+    if (well_conditioned(c)) out.push_back(std::move(c));
+  }
+  return out;
 }
 
 const JointRateBounds kLoose{JointVector::Constant(4, -1e3), JointVector::Constant(4, 1e3)};
@@ -66,11 +52,8 @@ ExtensionResolutionResult solve(Resolution r, const Case& c, const JointRateBoun
 }  // namespace
 
 TEST(Resolutions, EveryResolutionMeetsTheTipTask) {
-  std::mt19937 rng(11);
   int checked = 0;
-  for (int trial = 0; trial < 200; ++trial) {
-    const Case c = random_case(rng);
-    if (!well_conditioned(c)) continue;
+  for (const Case& c : well_conditioned_cases(11, 200)) {
     for (Resolution r :
          {Resolution::kPinvActuator, Resolution::kMinFlow, Resolution::kMinLsPower}) {
       const auto out = solve(r, c, kLoose);
@@ -84,10 +67,7 @@ TEST(Resolutions, EveryResolutionMeetsTheTipTask) {
 }
 
 TEST(Resolutions, PinvActuatorIsTheWeightedPseudoInverse) {
-  std::mt19937 rng(12);
-  for (int trial = 0; trial < 100; ++trial) {
-    const Case c = random_case(rng);
-    if (!well_conditioned(c)) continue;
+  for (const Case& c : well_conditioned_cases(12, 100)) {
     // min |R qdot|^2 subject to J qdot = v: qdot = W^-1 J^T (J W^-1 J^T)^-1 v, W = R^2.
     const Eigen::Vector4d w_inv = c.arms.cwiseProduct(c.arms).cwiseInverse();
     const Eigen::Matrix<double, 3, 4> j = c.jacobian;
@@ -99,11 +79,8 @@ TEST(Resolutions, PinvActuatorIsTheWeightedPseudoInverse) {
 }
 
 TEST(Resolutions, MinFlowAndMinLsPowerAreNeverBeatenByASweep) {
-  std::mt19937 rng(13);
   int checked = 0;
-  for (int trial = 0; trial < 100; ++trial) {
-    const Case c = random_case(rng);
-    if (!well_conditioned(c)) continue;
+  for (const Case& c : well_conditioned_cases(13, 100)) {
     // A box of joint-rate bounds, so the extension-rate interval is finite.
     const JointRateBounds bounds{JointVector::Constant(4, -0.8), JointVector::Constant(4, 0.8)};
     for (Resolution r : {Resolution::kMinFlow, Resolution::kMinLsPower}) {
@@ -132,10 +109,7 @@ TEST(Resolutions, MinFlowAndMinLsPowerAreNeverBeatenByASweep) {
 }
 
 TEST(Resolutions, MinFlowNeedsNoMoreFlowThanThePseudoInverses) {
-  std::mt19937 rng(14);
-  for (int trial = 0; trial < 100; ++trial) {
-    const Case c = random_case(rng);
-    if (!well_conditioned(c)) continue;
+  for (const Case& c : well_conditioned_cases(14, 100)) {
     const auto min_flow = solve(Resolution::kMinFlow, c, kLoose);
     const auto actuator = solve(Resolution::kPinvActuator, c, kLoose);
     EXPECT_LE(

@@ -66,6 +66,17 @@ void expect_data(const CanFrame& f, std::array<std::uint8_t, 8> expected) {
   for (std::size_t i = 0; i < 8; ++i) EXPECT_EQ(f.data[i], expected[i]) << "byte " << i;
 }
 
+// raw inserted into an empty frame gives the bytes `expected`, and extracted from them, raw.
+void expect_round_trip(const SignalSpec& s, std::uint64_t raw,
+                       std::array<std::uint8_t, 8> expected) {
+  CanFrame f = empty_frame();
+  ASSERT_TRUE(insert_raw(s, raw, f));
+  expect_data(f, expected);
+  std::uint64_t back = 0;
+  ASSERT_TRUE(extract_raw(s, f, back));
+  EXPECT_EQ(back, raw);
+}
+
 }  // namespace
 
 TEST(SignalMap, CantoolsMotohawkEncode) {
@@ -111,44 +122,26 @@ TEST(SignalMap, CantoolsMotohawkDecode) {
 
 TEST(SignalMap, IntelLayouts) {
   // 16 bits at 0: 0x1234 -> 34 12.
-  CanFrame f = empty_frame();
-  ASSERT_TRUE(insert_raw(spec(0, 16, kIntel, false), 0x1234, f));
-  expect_data(f, {0x34, 0x12, 0, 0, 0, 0, 0, 0});
+  expect_round_trip(spec(0, 16, kIntel, false), 0x1234, {0x34, 0x12, 0, 0, 0, 0, 0, 0});
   // 12 bits at 4: 0xABC -> byte 0 high nibble C, byte 1 AB; byte 0 low nibble untouched.
-  f = bytes({0x05, 0, 0, 0, 0, 0, 0, 0});
+  CanFrame f = bytes({0x05, 0, 0, 0, 0, 0, 0, 0});
   ASSERT_TRUE(insert_raw(spec(4, 12, kIntel, false), 0xABC, f));
   expect_data(f, {0xC5, 0xAB, 0, 0, 0, 0, 0, 0});
   // 20 bits at 13, across three bytes: 0xABCDE << 13 = 0x1579BC000 -> 00 C0 9B 57 01.
-  f = empty_frame();
-  ASSERT_TRUE(insert_raw(spec(13, 20, kIntel, false), 0xABCDE, f));
-  expect_data(f, {0x00, 0xC0, 0x9B, 0x57, 0x01, 0, 0, 0});
-  std::uint64_t raw = 0;
-  ASSERT_TRUE(extract_raw(spec(13, 20, kIntel, false), f, raw));
-  EXPECT_EQ(raw, 0xABCDEu);
+  expect_round_trip(spec(13, 20, kIntel, false), 0xABCDE, {0x00, 0xC0, 0x9B, 0x57, 0x01, 0, 0, 0});
 }
 
 TEST(SignalMap, MotorolaLayouts) {
   // 16 bits, start (MSB) 7: 0x1234 -> 12 34.
-  CanFrame f = empty_frame();
-  ASSERT_TRUE(insert_raw(spec(7, 16, kMotorola, false), 0x1234, f));
-  expect_data(f, {0x12, 0x34, 0, 0, 0, 0, 0, 0});
+  expect_round_trip(spec(7, 16, kMotorola, false), 0x1234, {0x12, 0x34, 0, 0, 0, 0, 0, 0});
   // 12 bits, start 3: bits 3..0 of byte 0 hold A, byte 1 holds BC.
-  f = empty_frame();
-  ASSERT_TRUE(insert_raw(spec(3, 12, kMotorola, false), 0xABC, f));
-  expect_data(f, {0x0A, 0xBC, 0, 0, 0, 0, 0, 0});
+  expect_round_trip(spec(3, 12, kMotorola, false), 0xABC, {0x0A, 0xBC, 0, 0, 0, 0, 0, 0});
   // 20 bits, start 13 (byte 1 bit 5), across three bytes:
   // 1010 1011 1100 1101 1110 -> byte 1 bits 5..0 = 101010 (0x2A), byte 2 = 11110011 (0xF3),
   // byte 3 bits 7..2 = 011110 (0x78).
-  f = empty_frame();
-  ASSERT_TRUE(insert_raw(spec(13, 20, kMotorola, false), 0xABCDE, f));
-  expect_data(f, {0x00, 0x2A, 0xF3, 0x78, 0, 0, 0, 0});
-  std::uint64_t raw = 0;
-  ASSERT_TRUE(extract_raw(spec(13, 20, kMotorola, false), f, raw));
-  EXPECT_EQ(raw, 0xABCDEu);
+  expect_round_trip(spec(13, 20, kMotorola, false), 0xABCDE, {0x00, 0x2A, 0xF3, 0x78, 0, 0, 0, 0});
   // Ending exactly at byte 7 bit 0: start 55 (byte 6 bit 7), 16 bits.
-  f = empty_frame();
-  ASSERT_TRUE(insert_raw(spec(55, 16, kMotorola, false), 0xBEEF, f));
-  expect_data(f, {0, 0, 0, 0, 0, 0, 0xBE, 0xEF});
+  expect_round_trip(spec(55, 16, kMotorola, false), 0xBEEF, {0, 0, 0, 0, 0, 0, 0xBE, 0xEF});
   EXPECT_EQ(required_dlc(spec(55, 16, kMotorola, false)), 8);
   EXPECT_EQ(required_dlc(spec(7, 16, kMotorola, false)), 2);
   EXPECT_EQ(required_dlc(spec(13, 20, kMotorola, false)), 4);

@@ -31,6 +31,7 @@
 #include "craneassist/dds/telemetry_publisher.hpp"
 #include "craneassist/dds/topics.hpp"
 #include "craneassist_msgs.h"
+#include "dds_test_frames.hpp"
 #include "participant.hpp"
 
 // Heap allocations counted per thread: the publisher thread allocates (sample sequences and
@@ -185,23 +186,16 @@ config::TelemetryConfig settings(int domain) {
 }
 
 cdds::TelemetryInfo info() {
-  cdds::TelemetryInfo i;
+  cdds::TelemetryInfo i = craneassist::test::test_telemetry_info();
   i.crane = "test crane";
-  i.backend = "sim";
-  i.pump_mode = "load-sensing";
-  i.joint_names = {"slew", "lift", "tilt", "extension"};
-  i.joint_prismatic = {false, false, false, true};
   i.flow_limit_m3_s = 325.0 / 60000.0;
-  i.power_limit_w = 35e3;
   return i;
 }
 
-// A frame whose every field is distinct, from cycle k (machine time k * 10 ms).
+// The synthetic frame of cycle k (machine time k * 10 ms) with every numeric field distinct.
 cdds::TelemetryFrame frame(std::uint64_t k) {
-  cdds::TelemetryFrame f;
-  f.cycle = k;
+  cdds::TelemetryFrame f = craneassist::test::test_frame(k);
   f.t_s = 0.01 * static_cast<double>(k);
-  f.dof = 4;
   for (std::size_t i = 0; i < 4; ++i) {
     const double b = static_cast<double>(i) + 0.001 * static_cast<double>(k);
     f.q[i] = 1.0 + b;
@@ -230,15 +224,7 @@ cdds::TelemetryFrame frame(std::uint64_t k) {
   f.sddot_min = -1.0;
   f.sddot_max = 0.8;
   f.tip_error_m = 0.004;
-  f.status = "running";
-  f.stop_reason = "";
-  f.active_limit = "power";
-  f.pump_limit = "none";
   f.input_source = "keyboard";
-  f.deadman = true;
-  f.loop_latency_max_s = 120e-6;
-  f.loop_compute_s = 40e-6;
-  f.loop_overruns = 2;
   return f;
 }
 

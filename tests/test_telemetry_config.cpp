@@ -12,18 +12,21 @@ namespace {
 
 using namespace craneassist::config;
 
+void expect_topic(const TopicSettings& t, double rate_hz, Reliability reliability,
+                  Durability durability) {
+  EXPECT_DOUBLE_EQ(t.rate_hz, rate_hz);
+  EXPECT_EQ(t.reliability, reliability);
+  EXPECT_EQ(t.durability, durability);
+}
+
 TEST(TelemetryConfig, ShippedDefaults) {
   const TelemetryConfig c = default_telemetry_config();
   EXPECT_TRUE(c.enabled);
   EXPECT_EQ(c.domain_id, 0);
   EXPECT_EQ(c.participant_name, "craneassist");
   EXPECT_EQ(c.transport, DdsTransport::kDefault);
-  EXPECT_DOUBLE_EQ(c.status.rate_hz, 10.0);
-  EXPECT_EQ(c.status.reliability, Reliability::kReliable);
-  EXPECT_EQ(c.status.durability, Durability::kTransientLocal);
-  EXPECT_DOUBLE_EQ(c.joints.rate_hz, 50.0);
-  EXPECT_EQ(c.joints.reliability, Reliability::kBestEffort);
-  EXPECT_EQ(c.joints.durability, Durability::kVolatile);
+  expect_topic(c.status, 10.0, Reliability::kReliable, Durability::kTransientLocal);
+  expect_topic(c.joints, 50.0, Reliability::kBestEffort, Durability::kVolatile);
   EXPECT_DOUBLE_EQ(c.hydraulics.rate_hz, 50.0);
   EXPECT_DOUBLE_EQ(c.command_path.rate_hz, 50.0);
   EXPECT_FALSE(c.commands.enabled);
@@ -50,13 +53,9 @@ commands:
   EXPECT_EQ(c.domain_id, 42);
   EXPECT_EQ(c.participant_name, "loader-7");
   EXPECT_EQ(c.transport, DdsTransport::kUdp);
-  EXPECT_DOUBLE_EQ(c.status.rate_hz, 2.0);
-  EXPECT_EQ(c.status.reliability, Reliability::kBestEffort);
-  EXPECT_EQ(c.status.durability, Durability::kVolatile);
+  expect_topic(c.status, 2.0, Reliability::kBestEffort, Durability::kVolatile);
   EXPECT_EQ(c.status.depth, 3);
-  EXPECT_DOUBLE_EQ(c.joints.rate_hz, 100.0);
-  EXPECT_EQ(c.joints.reliability, Reliability::kReliable);
-  EXPECT_EQ(c.joints.durability, Durability::kTransientLocal);
+  expect_topic(c.joints, 100.0, Reliability::kReliable, Durability::kTransientLocal);
   EXPECT_EQ(c.joints.depth, 10);
   EXPECT_DOUBLE_EQ(c.hydraulics.rate_hz, 0.5);
   EXPECT_EQ(c.hydraulics.reliability, Reliability::kBestEffort);  // default kept

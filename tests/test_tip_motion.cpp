@@ -13,6 +13,7 @@
 
 #include "allocation_counter.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/control/controller.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
 #include "craneassist/dynamics/rigid_body_terms.hpp"
@@ -30,8 +31,8 @@ class TipMotion {
   explicit TipMotion(const config::CraneConfig& cfg)
       : cfg_(cfg),
         terms_(cfg_.model),
-        path_(cfg_.model, path_config()),
-        scaler_(cfg_.model, scaler_config(), terms_),
+        path_(cfg_.model, control::tip_path_config(cfg_)),
+        scaler_(cfg_.model, control::tip_scaler_config(cfg_), terms_),
         q(cfg_.simulation.q_initial) {}
 
   // One cycle; returns the reference tip velocity (J(q) qdot_ref) of the cycle.
@@ -42,16 +43,8 @@ class TipMotion {
     in.sdot = scaler_.speed();
     in.intended_speed = stale ? in.sdot : scaler_.intended_speed(command);
     path_.update(q, in, path_out);
-    scaling::TipScalerInput sin;
-    sin.command = command;
-    sin.direction = u;
-    sin.sdot_joint_limit = path_out.sdot_joint_limit;
-    sin.end_distance_m = path_out.end_distance_m;
-    sin.stop_deceleration_m_s2 = path_out.stop_deceleration_m_s2;
-    sin.stop_jerk_m_s3 = path_out.stop_jerk_m_s3;
-    sin.near_singular = path_out.near_singular;
-    sin.stale_input = stale;
-    scaler_.update(q, path_out.geometry, sin, out);
+    scaler_.update(q, path_out.geometry, control::tip_scaler_input(command, u, path_out, stale),
+                   out);
     const auto& g = path_out.geometry;
     for (int i = 0; i < cfg_.model.dof(); ++i) {
       const auto& joint = cfg_.model.joints[static_cast<std::size_t>(i)];
@@ -86,27 +79,6 @@ class TipMotion {
   scaling::TipScalerOutput out;
 
  private:
-  scaling::TipPathConfig path_config() const {
-    scaling::TipPathConfig c;
-    c.period_s = 1.0 / cfg_.control.rate_hz;
-    c.jerk_max = cfg_.scaling.jerk_max_m_s3;
-    c.deceleration_max = cfg_.scaling.deceleration_max_m_s2;
-    c.flow_reserve = cfg_.control.flow_reserve;
-    c.resolution = cfg_.redundancy.resolution;
-    return c;
-  }
-  scaling::TipScalerConfig scaler_config() const {
-    scaling::TipScalerConfig c;
-    c.period_s = 1.0 / cfg_.control.rate_hz;
-    c.jerk_max = cfg_.scaling.jerk_max_m_s3;
-    c.acceleration_max = cfg_.scaling.acceleration_max_m_s2;
-    c.deceleration_max = cfg_.scaling.deceleration_max_m_s2;
-    c.normal_acceleration_max = cfg_.scaling.direction_change_acceleration_m_s2;
-    c.flow_reserve = cfg_.control.flow_reserve;
-    c.power_reserve = cfg_.scaling.power_reserve;
-    return c;
-  }
-
   config::CraneConfig cfg_;
   dynamics::RigidBodyTerms terms_;
   scaling::TipPath path_;
@@ -121,6 +93,20 @@ double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 }
 
 const char* kResolutions[] = {"pinv-joint", "pinv-actuator", "min-flow", "min-ls-power"};
+
+// The outer boom folded back and down (lift 0.3 rad, tilt -2.6 rad) so that the tip is over the
+// slew axis, at the given radius (x, m): the extension found by bisection.
+JointVector tip_over_the_slew_axis(const dynamics::CraneModel& model, double radius) {
+  JointVector q(4);
+  q << 0.0, 0.3, -2.6, 0.0;
+  dynamics::KinematicsData kin;
+  double lo = 0.0, hi = 3.7;
+  for (int k = 0; k < 60; ++k) {
+    q[3] = 0.5 * (lo + hi);
+    (dynamics::tip_position(model, kin, q).x() > radius ? lo : hi) = q[3];
+  }
+  return q;
+}
 
 config::CraneConfig with_resolution(const char* r) {
   auto cfg = config::default_crane_config();
@@ -311,19 +297,8 @@ TEST(TipMotion, SingularPosesSlowSmoothlyAndTheOperatorCanMoveOut) {
     JointVector q;
     Eigen::Vector3d way_out;
   };
-  // Tip over the slew axis: the outer boom folded back and down, the extension set so the tip's
-  // radius is 5 cm (found by bisection).
-  JointVector over_axis(4);
-  over_axis << 0.0, 0.3, -2.6, 0.0;
-  {
-    dynamics::KinematicsData kin;
-    double lo = 0.0, hi = 3.7;
-    for (int k = 0; k < 60; ++k) {
-      over_axis[3] = 0.5 * (lo + hi);
-      const Eigen::Vector3d tip = dynamics::tip_position(model, kin, over_axis);
-      (tip.x() > 0.05 ? lo : hi) = over_axis[3];
-    }
-  }
+  // Tip over the slew axis: its radius 5 cm.
+  const JointVector over_axis = tip_over_the_slew_axis(model, 0.05);
   JointVector stretched(4), telescope_out(4);
   stretched << 0.0, 0.0, -0.2501, 3.6999;
   telescope_out << 0.0, 0.35, -1.2, 3.6999;
@@ -360,15 +335,7 @@ TEST(TipMotion, SingularPosesSlowSmoothlyAndTheOperatorCanMoveOut) {
 
 TEST(TipMotion, LateralMotionAtTheSlewAxisSaysSingularity) {
   auto cfg = config::default_crane_config();
-  JointVector q(4);
-  q << 0.0, 0.3, -2.6, 0.0;
-  dynamics::KinematicsData kin;
-  double lo = 0.0, hi = 3.7;
-  for (int k = 0; k < 60; ++k) {
-    q[3] = 0.5 * (lo + hi);
-    (dynamics::tip_position(cfg.model, kin, q).x() > 0.03 ? lo : hi) = q[3];
-  }
-  cfg.simulation.q_initial = q;
+  cfg.simulation.q_initial = tip_over_the_slew_axis(cfg.model, 0.03);
   TipMotion m(cfg);
   // Sideways along a line that passes 3 cm from the slew axis: the slew must turn at
   // v x / (x^2 + z^2), so the tip crawls while it passes the axis and speeds up beyond.

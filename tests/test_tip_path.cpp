@@ -28,6 +28,18 @@ class TipPathTest : public ::testing::TestWithParam<dynamics::Resolution> {
     return c;
   }
 
+  // What a fresh tip path finds at q for the direction u, heading for intended_speed from rest.
+  scaling::TipPathOutput first_output(const JointVector& q, const Eigen::Vector3d& u,
+                                      double intended_speed) const {
+    scaling::TipPath path(cfg_.model, path_config());
+    scaling::TipPathInput in;
+    in.direction = u;
+    in.intended_speed = intended_speed;
+    scaling::TipPathOutput out;
+    path.update(q, in, out);
+    return out;
+  }
+
   Eigen::Vector3d tip_velocity(const JointVector& q, const JointVector& qdot) {
     dynamics::tip_jacobian(cfg_.model, kin_, q, jac_);
     return jac_ * qdot;
@@ -57,12 +69,7 @@ std::vector<Eigen::Vector3d> directions() {
 TEST_P(TipPathTest, TangentMovesTheTipExactlyAlongTheDirection) {
   const JointVector q = cfg_.simulation.q_initial;
   for (const Eigen::Vector3d& u : directions()) {
-    scaling::TipPath path(cfg_.model, path_config());
-    scaling::TipPathInput in;
-    in.direction = u;
-    in.intended_speed = 0.5;
-    scaling::TipPathOutput out;
-    path.update(q, in, out);
+    const scaling::TipPathOutput out = first_output(q, u, 0.5);
     ASSERT_TRUE(out.geometry.f1.allFinite());
     const Eigen::Vector3d v = tip_velocity(q, out.geometry.f1);
     EXPECT_LT((v - u).norm(), 1e-9) << "u " << u.transpose() << " tip " << v.transpose();
@@ -75,13 +82,9 @@ TEST_P(TipPathTest, SecondDerivativeIsTheChangeOfTheTangentAlongThePath) {
   const JointVector q = cfg_.simulation.q_initial;
   const double h = 1e-3;
   for (const Eigen::Vector3d& u : directions()) {
-    scaling::TipPathInput in;
-    in.direction = u;
-    in.intended_speed = 0.3;
-    scaling::TipPathOutput a, b;
-    scaling::TipPath(cfg_.model, path_config()).update(q, in, a);
+    const scaling::TipPathOutput a = first_output(q, u, 0.3);
     const JointVector q_next = q + a.geometry.f1 * h;
-    scaling::TipPath(cfg_.model, path_config()).update(q_next, in, b);
+    const scaling::TipPathOutput b = first_output(q_next, u, 0.3);
     const JointVector predicted = a.geometry.f1 + a.geometry.f2 * h;
     const double scale = 1.0 + a.geometry.f2.norm();
     EXPECT_LT((b.geometry.f1 - predicted).norm(), 1e-3 * scale) << "u " << u.transpose();
@@ -97,12 +100,7 @@ TEST_P(TipPathTest, AJointAtItsEndIsNeverDrivenIntoIt) {
   q[2] = tilt.q_min;
   int movable = 0;
   for (const Eigen::Vector3d& u : directions()) {
-    scaling::TipPath path(cfg_.model, path_config());
-    scaling::TipPathInput in;
-    in.direction = u;
-    in.intended_speed = 0.5;
-    scaling::TipPathOutput out;
-    path.update(q, in, out);
+    const scaling::TipPathOutput out = first_output(q, u, 0.5);
     if (out.sdot_joint_limit > 0.0) {
       ++movable;
       EXPECT_GE(out.geometry.f1[2], -1e-12) << "u " << u.transpose();

@@ -1,4 +1,5 @@
-"""Reading craneassist's per-cycle CSV logs (docs/log-format.md) for the plotting scripts."""
+"""Reading craneassist's per-cycle CSV logs (docs/log-format.md) for the plotting scripts, and
+what those scripts share in drawing them."""
 import csv
 
 TEXT_COLUMNS = ("active_limit", "pump_limit")
@@ -16,3 +17,28 @@ def load(path):
         if k in rows[0]:
             cols[k] = [r[k] for r in rows]
     return cols
+
+
+def pyplot():
+    """matplotlib's pyplot on the Agg backend: the scripts write PNG files and need no display."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def label(ax, ylabel, title, xlabel=None):
+    """A subplot's y label and title, and its x label when given."""
+    ax.set_ylabel(ylabel)
+    if xlabel:
+        ax.set_xlabel(xlabel)
+    ax.set_title(title)
+
+
+def save(fig, axes, path, dpi, legend_fontsize):
+    """A light grid and a legend (upper right) on every subplot, then the figure as a PNG."""
+    for a in axes:
+        a.grid(True, alpha=0.3)
+        a.legend(loc="upper right", fontsize=legend_fontsize)
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)

@@ -14,12 +14,9 @@ Needs python3-matplotlib (Debian package).
 import argparse
 import math
 
-import matplotlib
+from craneassist_log import label, load, pyplot, save
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from craneassist_log import load  # noqa: E402
+plt = pyplot()
 
 
 def direction_error(c):
@@ -62,21 +59,14 @@ def main():
         ax[2].axhline(args.flow_limit, color="black", linestyle=":", label="pump maximum")
     if args.power_limit:
         ax[3].axhline(args.power_limit, color="black", linestyle=":", label="P_max")
-    ax[0].set_xlabel("lateral tip position z [m]")
-    ax[0].set_ylabel("tip height y [m]")
-    ax[0].set_title("Tip path seen from the front (the command is a straight line)")
-    ax[1].set_ylabel("direction error [deg]")
-    ax[1].set_title("Angle between commanded and measured tip velocity (tip faster than 0.05 m/s)")
-    ax[2].set_ylabel("pump flow [L/min]")
-    ax[2].set_title("Pump flow")
-    ax[3].set_ylabel("pump power [kW]")
-    ax[3].set_xlabel("time [s]")
-    ax[3].set_title("Pump power")
-    for a in ax:
-        a.grid(True, alpha=0.3)
-        a.legend(loc="upper right", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(args.output, dpi=100)
+    label(ax[0], "tip height y [m]",
+          "Tip path seen from the front (the command is a straight line)",
+          xlabel="lateral tip position z [m]")
+    label(ax[1], "direction error [deg]",
+          "Angle between commanded and measured tip velocity (tip faster than 0.05 m/s)")
+    label(ax[2], "pump flow [L/min]", "Pump flow")
+    label(ax[3], "pump power [kW]", "Pump power", xlabel="time [s]")
+    save(fig, ax, args.output, dpi=100, legend_fontsize=8)
 
 
 if __name__ == "__main__":

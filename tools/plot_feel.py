@@ -16,12 +16,9 @@ package).
 import argparse
 import math
 
-import matplotlib
+from craneassist_log import load, pyplot
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from craneassist_log import load  # noqa: E402
+plt = pyplot()
 
 WINDOW = 5  # cycles: 50 ms at 100 Hz
 

@@ -11,12 +11,9 @@ Needs python3-matplotlib (Debian package).
 """
 import sys
 
-import matplotlib
+from craneassist_log import label, load, pyplot, save
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from craneassist_log import load  # noqa: E402
+plt = pyplot()
 
 
 def main():
@@ -32,26 +29,18 @@ def main():
         ax[2].plot(c["t"], c["q1_ref"], color=color, label=f"q1, {name}")
         ax[2].plot(c["t"], c["q2_ref"], color=color, linestyle="--", label=f"q2, {name}")
     ax[0].axhline(p_max / 1e3, color="black", linestyle=":", label="P_max")
-    ax[0].set_ylabel("pump power [kW]")
-    ax[0].set_title("Power measured at the simulated load-sensing pump")
-    ax[1].set_ylabel("path speed sdot [1/s]")
-    ax[1].set_title("Path speed after scaling")
-    ax[2].set_ylabel("joint reference [rad]")
-    ax[2].set_title("Joint references f(s)")
+    label(ax[0], "pump power [kW]", "Power measured at the simulated load-sensing pump")
+    label(ax[1], "path speed sdot [1/s]", "Path speed after scaling")
+    label(ax[2], "joint reference [rad]", "Joint references f(s)")
     ax[3].plot(ls["t"], ls["sddot"], color="tab:blue", label="sddot (load-sensing bound)")
     ax[3].plot(ls["t"], ls["sddot_max"], color="tab:green", linewidth=0.8, label="upper bound")
     ax[3].plot(ls["t"], ls["sddot_min"], color="tab:purple", linewidth=0.8, label="lower bound")
     lo = min(ls["sddot"]) - 1.0
     hi = max(ls["sddot"]) + 1.0
     ax[3].set_ylim(lo, hi)
-    ax[3].set_ylabel("path acceleration [1/s^2]")
-    ax[3].set_xlabel("time [s]")
-    ax[3].set_title("Path acceleration and its power bounds (load-sensing run)")
-    for a in ax:
-        a.grid(True, alpha=0.3)
-        a.legend(loc="upper right", fontsize=7)
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
+    label(ax[3], "path acceleration [1/s^2]",
+          "Path acceleration and its power bounds (load-sensing run)", xlabel="time [s]")
+    save(fig, ax, out, dpi=110, legend_fontsize=7)
 
 
 if __name__ == "__main__":

@@ -50,6 +50,14 @@ void add_common_options(CLI::App& app, int& domain_id, double& timeout_s, std::s
       ->capture_default_str();
 }
 
+// The values of the options add_common_options() added, into the tool's options.
+template <class ToolOptions, class Args>
+void apply_common_options(ToolOptions& o, const Args& args) {
+  o.domain_id = args.domain_id;
+  o.timeout_s = args.timeout_s;
+  o.transport = config::parse_dds_transport(args.transport).value();
+}
+
 }  // namespace
 
 CLI::App* add_echo_command(CLI::App& cli, EchoArgs& args) {
@@ -74,11 +82,9 @@ CLI::App* add_echo_command(CLI::App& cli, EchoArgs& args) {
 int run_echo_command(const EchoArgs& args) {
   dds::EchoOptions o;
   o.topic = args.topic;
-  o.domain_id = args.domain_id;
   o.count = args.count;
-  o.timeout_s = args.timeout_s;
   o.format = args.format == "csv" ? dds::EchoFormat::kCsv : dds::EchoFormat::kText;
-  o.transport = config::parse_dds_transport(args.transport).value();
+  apply_common_options(o, args);
   StopOnSignal stop;
   return dds::run_echo(o);
 }
@@ -97,10 +103,8 @@ CLI::App* add_dashboard_command(CLI::App& cli, DashboardArgs& args) {
 
 int run_dashboard_command(const DashboardArgs& args) {
   dds::DashboardOptions o;
-  o.domain_id = args.domain_id;
   o.once = args.once;
-  o.timeout_s = args.timeout_s;
-  o.transport = config::parse_dds_transport(args.transport).value();
+  apply_common_options(o, args);
   StopOnSignal stop;
   return dds::run_dashboard(o);
 }

@@ -40,6 +40,17 @@ fail() {
   exit 1
 }
 
+# expect_usage_error NAME PATTERN ARGS...: craneassist ARGS must exit 2 (a usage error) and its
+# output ($work/NAME.out) match the grep PATTERN.
+expect_usage_error() {
+  name=$1 pattern=$2
+  shift 2
+  rc=0
+  "$bin" "$@" >"$work/$name.out" 2>&1 || rc=$?
+  [ "$rc" -eq 2 ] || fail "$name: craneassist $* exited $rc"
+  grep -q "$pattern" "$work/$name.out" || fail "message: $name"
+}
+
 # sim_remote REMOTE_YAML_OR_--insecure [REMOTE_EXIT]: runs the crane for $duration s with the DDS
 # input and the remote with the replay against it; REMOTE_EXIT is the remote's expected exit code.
 # The remote waits at most $wait s for the crane's reader before it plays the replay anyway
@@ -204,36 +215,25 @@ EOF
     ;;
   usage)
     "$make_certs" "$work/certs" >/dev/null
-    rc=0
-    "$bin" sim --input dds --duration 1 >"$work/default.out" 2>&1 || rc=$?
-    [ "$rc" -eq 2 ] || fail "sim --input dds with the default settings exited $rc"
-    grep -q "commands.enabled is not true" "$work/default.out" || fail "message: default"
+    # The default settings (commands.enabled false).
+    expect_usage_error default "commands.enabled is not true" sim --input dds --duration 1
     grep -q "docs/remote-commands.md" "$work/default.out" || fail "no pointer to the docs"
     sed 's/enabled: true/enabled: false/' "$work/certs/crane.yaml" >"$work/certs/disabled.yaml"
-    rc=0
-    "$bin" sim --input dds --telemetry-config "$work/certs/disabled.yaml" --duration 1 \
-      >"$work/disabled.out" 2>&1 || rc=$?
-    [ "$rc" -eq 2 ] || fail "sim --input dds with commands.enabled false exited $rc"
-    grep -q "commands.enabled is not true" "$work/disabled.out" || fail "message: disabled"
+    expect_usage_error disabled "commands.enabled is not true" \
+      sim --input dds --telemetry-config "$work/certs/disabled.yaml" --duration 1
+    # A security file missing.
     grep -v "permissions:" "$work/certs/crane.yaml" >"$work/certs/partial.yaml"
-    rc=0
-    "$bin" sim --input dds --telemetry-config "$work/certs/partial.yaml" --duration 1 \
-      >"$work/partial.out" 2>&1 || rc=$?
-    [ "$rc" -eq 2 ] || fail "sim --input dds with a security file missing exited $rc"
-    grep -q "partial.yaml:[0-9]*: field 'commands.security': give every file" \
-      "$work/partial.out" || fail "message: partial"
+    expect_usage_error partial "partial.yaml:[0-9]*: field 'commands.security': give every file" \
+      sim --input dds --telemetry-config "$work/certs/partial.yaml" --duration 1
+    # No security files at all.
     sed -e 's/^  security:$/  security: {}/' -e '/^    /d' "$work/certs/crane.yaml" \
       >"$work/certs/nosecurity.yaml"
-    rc=0
-    "$bin" sim --input dds --telemetry-config "$work/certs/nosecurity.yaml" --duration 1 \
-      >"$work/nosecurity.out" 2>&1 || rc=$?
-    [ "$rc" -eq 2 ] || fail "sim --input dds without security files exited $rc"
-    grep -q "nosecurity.yaml:[0-9]*: field 'commands.enabled': the DDS command input needs DDS Security" \
-      "$work/nosecurity.out" || fail "message: no security"
-    rc=0
-    "$bin" remote --replay "$replay" --domain "$domain" >"$work/remote.out" 2>&1 || rc=$?
-    [ "$rc" -eq 2 ] || fail "remote without an identity exited $rc"
-    grep -q "needs the operator's DDS Security identity" "$work/remote.out" || fail "message: remote"
+    expect_usage_error nosecurity \
+      "nosecurity.yaml:[0-9]*: field 'commands.enabled': the DDS command input needs DDS Security" \
+      sim --input dds --telemetry-config "$work/certs/nosecurity.yaml" --duration 1
+    # The remote without an identity.
+    expect_usage_error remote "needs the operator's DDS Security identity" \
+      remote --replay "$replay" --domain "$domain"
     ;;
   *)
     echo "unknown case $case_name" >&2

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 
 // FUZZ_CHECK(condition, "what went wrong"): abort with the message when condition is false.
 #define FUZZ_CHECK(condition, message)                                                         \
@@ -14,3 +15,8 @@
       std::abort();                                                                            \
     }                                                                                          \
   } while (false)
+
+// The same double to the bit (a round trip must keep NaN payloads and the sign of zero).
+inline bool same_bits(double a, double b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -19,10 +18,6 @@ using craneassist::input::ReplayCursor;
 using craneassist::input::ReplayRow;
 
 namespace {
-
-bool same_bits(double a, double b) {
-  return std::memcmp(&a, &b, sizeof a) == 0;
-}
 
 bool same_rows(const ReplayRow& a, const ReplayRow& b) {
   return same_bits(a.t_s, b.t_s) && same_bits(a.v_m_s.x(), b.v_m_s.x()) &&

@@ -19,6 +19,44 @@ const char* to_string(ScalingMode mode) {
   return "?";
 }
 
+scaling::TipPathConfig tip_path_config(const config::CraneConfig& config) {
+  scaling::TipPathConfig path;
+  path.period_s = 1.0 / config.control.rate_hz;
+  path.jerk_max = config.scaling.jerk_max_m_s3;
+  path.deceleration_max = config.scaling.deceleration_max_m_s2;
+  path.flow_reserve = config.control.flow_reserve;
+  path.resolution = config.redundancy.resolution;
+  return path;
+}
+
+scaling::TipScalerConfig tip_scaler_config(const config::CraneConfig& config) {
+  const auto& sc = config.scaling;
+  scaling::TipScalerConfig scaler;
+  scaler.period_s = 1.0 / config.control.rate_hz;
+  scaler.jerk_max = sc.jerk_max_m_s3;
+  scaler.acceleration_max = sc.acceleration_max_m_s2;
+  scaler.deceleration_max = sc.deceleration_max_m_s2;
+  scaler.normal_acceleration_max = sc.direction_change_acceleration_m_s2;
+  scaler.flow_reserve = config.control.flow_reserve;
+  scaler.power_bound = sc.power_bound;
+  scaler.power_reserve = sc.power_reserve;
+  return scaler;
+}
+
+scaling::TipScalerInput tip_scaler_input(const Eigen::Vector3d& command, const Eigen::Vector3d& u,
+                                         const scaling::TipPathOutput& path, bool stale) {
+  scaling::TipScalerInput in;
+  in.command = command;
+  in.direction = u;
+  in.sdot_joint_limit = path.sdot_joint_limit;
+  in.end_distance_m = path.end_distance_m;
+  in.stop_deceleration_m_s2 = path.stop_deceleration_m_s2;
+  in.stop_jerk_m_s3 = path.stop_jerk_m_s3;
+  in.near_singular = path.near_singular;
+  in.stale_input = stale;
+  return in;
+}
+
 Controller::Controller(const config::CraneConfig& config, const ControllerOptions& options)
     : model_(config.model),
       options_(options),
@@ -36,25 +74,9 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
   dc_dq_.setZero(n);
   qddot_max_.setZero(n);
   if (options_.mode == ScalingMode::kFull) {
-    const auto& sc = config.scaling;
     terms_ = std::make_unique<dynamics::RigidBodyTerms>(model_);
-    scaling::TipPathConfig path;
-    path.period_s = period_s_;
-    path.jerk_max = sc.jerk_max_m_s3;
-    path.deceleration_max = sc.deceleration_max_m_s2;
-    path.flow_reserve = flow_reserve_;
-    path.resolution = config.redundancy.resolution;
-    tip_path_ = std::make_unique<scaling::TipPath>(model_, path);
-    scaling::TipScalerConfig scaler;
-    scaler.period_s = period_s_;
-    scaler.jerk_max = sc.jerk_max_m_s3;
-    scaler.acceleration_max = sc.acceleration_max_m_s2;
-    scaler.deceleration_max = sc.deceleration_max_m_s2;
-    scaler.normal_acceleration_max = sc.direction_change_acceleration_m_s2;
-    scaler.flow_reserve = flow_reserve_;
-    scaler.power_bound = sc.power_bound;
-    scaler.power_reserve = sc.power_reserve;
-    scaler_ = std::make_unique<scaling::TipScaler>(model_, scaler, *terms_);
+    tip_path_ = std::make_unique<scaling::TipPath>(model_, tip_path_config(config));
+    scaler_ = std::make_unique<scaling::TipScaler>(model_, tip_scaler_config(config), *terms_);
   }
 }
 
@@ -141,16 +163,8 @@ void Controller::update_full(const valves::MachineState& state, const Eigen::Vec
     path_in.cylinder_force = scaler_out_.terms.b.cwiseQuotient(dc_dq_);
   }
   tip_path_->update(q_ref_, path_in, tip_out_);
-  scaling::TipScalerInput in;
-  in.command = v_cmd;
-  in.direction = u;
+  scaling::TipScalerInput in = tip_scaler_input(v_cmd, u, tip_out_, stale);
   in.tracking_factor = scaling::tracking_factor(tip_error_filtered_m_, tracking_error_ok_m_);
-  in.sdot_joint_limit = tip_out_.sdot_joint_limit;
-  in.end_distance_m = tip_out_.end_distance_m;
-  in.stop_deceleration_m_s2 = tip_out_.stop_deceleration_m_s2;
-  in.stop_jerk_m_s3 = tip_out_.stop_jerk_m_s3;
-  in.near_singular = tip_out_.near_singular;
-  in.stale_input = stale;
   scaler_->update(q_ref_, tip_out_.geometry, in, scaler_out_);
 
   // The reference moves along u by the tip displacement of this cycle.

@@ -434,19 +434,11 @@ int run_dashboard(const DashboardOptions& o) {
     return kToolUsage;
   }
   LatestSamples latest;
-  ParticipantOptions po;
-  po.domain_id = o.domain_id;
-  po.name = "craneassist-dashboard";
-  po.transport = o.transport;
-  std::unique_ptr<SubscriberSession> session;
-  try {
-    session = std::make_unique<SubscriberSession>(
-        po, std::vector<Topic>(std::begin(kTelemetry), std::end(kTelemetry)),
-        [&latest](Topic topic, fdds::DataReader& reader) { latest.take(topic, reader); });
-  } catch (const std::exception& e) {
-    std::fprintf(o.err, "craneassist: error: %s\n", e.what());
-    return kToolRuntime;
-  }
+  const auto session = open_tool_session(
+      "craneassist-dashboard", o.domain_id, o.transport,
+      std::vector<Topic>(std::begin(kTelemetry), std::end(kTelemetry)), o.err,
+      [&latest](Topic topic, fdds::DataReader& reader) { latest.take(topic, reader); });
+  if (!session) return kToolRuntime;
   auto snapshot = [&] {
     Snapshot s = latest.copy();
     for (int i = 0; i < kTelemetryTopics; ++i) {

@@ -299,17 +299,9 @@ class CsvWriter : public FieldVisitor {
 
 template <typename T>
 int echo_topic(const TopicInfo& topic, const EchoOptions& o) {
-  ParticipantOptions po;
-  po.domain_id = o.domain_id;
-  po.name = "craneassist-echo";
-  po.transport = o.transport;
-  std::unique_ptr<SubscriberSession> session;
-  try {
-    session = std::make_unique<SubscriberSession>(po, std::vector<Topic>{topic.topic});
-  } catch (const std::exception& e) {
-    std::fprintf(o.err, "craneassist: error: %s\n", e.what());
-    return kToolRuntime;
-  }
+  const auto session = open_tool_session("craneassist-echo", o.domain_id, o.transport,
+                                         std::vector<Topic>{topic.topic}, o.err);
+  if (!session) return kToolRuntime;
   TopicReader& reader = session->reader(topic.topic);
   TextWriter text(o.out);
   CsvWriter csv(o.out);

@@ -125,14 +125,15 @@ fdds::Topic* get_topic(fdds::DomainParticipant& p, Topic topic) {
   return t;
 }
 
-fdds::DataWriterQos writer_qos(const config::TopicSettings& s) {
-  fdds::DataWriterQos q = fdds::DATAWRITER_QOS_DEFAULT;
+namespace {
+
+// The reliability, durability and history depth of a topic's settings, on a writer's or a
+// reader's QoS.
+template <class Qos>
+Qos with_topic_settings(Qos q, const config::TopicSettings& s) {
   q.reliability().kind = s.reliability == config::Reliability::kReliable
                              ? fdds::RELIABLE_RELIABILITY_QOS
                              : fdds::BEST_EFFORT_RELIABILITY_QOS;
-  // A reliable writer whose history is full waits at most this long (on the publisher thread,
-  // never the control loop), then the sample is counted as an error.
-  q.reliability().max_blocking_time = eprosima::fastrtps::Duration_t(0, 10000000);
   q.durability().kind = s.durability == config::Durability::kTransientLocal
                             ? fdds::TRANSIENT_LOCAL_DURABILITY_QOS
                             : fdds::VOLATILE_DURABILITY_QOS;
@@ -141,17 +142,18 @@ fdds::DataWriterQos writer_qos(const config::TopicSettings& s) {
   return q;
 }
 
-fdds::DataReaderQos reader_qos(const config::TopicSettings& s) {
-  fdds::DataReaderQos q = fdds::DATAREADER_QOS_DEFAULT;
-  q.reliability().kind = s.reliability == config::Reliability::kReliable
-                             ? fdds::RELIABLE_RELIABILITY_QOS
-                             : fdds::BEST_EFFORT_RELIABILITY_QOS;
-  q.durability().kind = s.durability == config::Durability::kTransientLocal
-                            ? fdds::TRANSIENT_LOCAL_DURABILITY_QOS
-                            : fdds::VOLATILE_DURABILITY_QOS;
-  q.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
-  q.history().depth = s.depth;
+}  // namespace
+
+fdds::DataWriterQos writer_qos(const config::TopicSettings& s) {
+  fdds::DataWriterQos q = with_topic_settings(fdds::DATAWRITER_QOS_DEFAULT, s);
+  // A reliable writer whose history is full waits at most this long (on the publisher thread,
+  // never the control loop), then the sample is counted as an error.
+  q.reliability().max_blocking_time = eprosima::fastrtps::Duration_t(0, 10000000);
   return q;
+}
+
+fdds::DataReaderQos reader_qos(const config::TopicSettings& s) {
+  return with_topic_settings(fdds::DATAREADER_QOS_DEFAULT, s);
 }
 
 config::TopicSettings default_reader_settings(Topic topic) {

@@ -4,6 +4,7 @@
 #include <fastdds/dds/subscriber/qos/SubscriberQos.hpp>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "craneassist/dds/telemetry_publisher.hpp"
 #include "craneassist/dds/tools.hpp"
@@ -106,6 +107,22 @@ TopicReader& SubscriberSession::reader(Topic topic) {
 
 double SubscriberSession::elapsed_s() const {
   return static_cast<double>(monotonic_ns() - start_ns_) * 1e-9;
+}
+
+std::unique_ptr<SubscriberSession> open_tool_session(const std::string& name, int domain_id,
+                                                     config::DdsTransport transport,
+                                                     const std::vector<Topic>& topics,
+                                                     std::FILE* err, DataCallback on_data) {
+  ParticipantOptions po;
+  po.domain_id = domain_id;
+  po.name = name;
+  po.transport = transport;
+  try {
+    return std::make_unique<SubscriberSession>(po, topics, std::move(on_data));
+  } catch (const std::exception& e) {
+    std::fprintf(err, "craneassist: error: %s\n", e.what());
+    return nullptr;
+  }
 }
 
 }  // namespace craneassist::dds

@@ -6,12 +6,14 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <cstdio>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <vector>
 
 #include "craneassist/dds/topics.hpp"
@@ -80,5 +82,13 @@ class SubscriberSession {
   std::vector<std::unique_ptr<TopicReader>> readers_;
   ParticipantPtr participant_;  // declared last: deleted (with its readers) before the listeners
 };
+
+// The session of a tool (echo, dashboard): its participant `name` on the domain and transport
+// and the readers of topics. nullptr when DDS cannot be set up, after saying why on err.
+std::unique_ptr<SubscriberSession> open_tool_session(const std::string& name, int domain_id,
+                                                     config::DdsTransport transport,
+                                                     const std::vector<Topic>& topics,
+                                                     std::FILE* err,
+                                                     DataCallback on_data = nullptr);
 
 }  // namespace craneassist::dds

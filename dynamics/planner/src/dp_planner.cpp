@@ -20,8 +20,15 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+// The plan's point of stage k at (c, v) with the control a, and the stage cost of a (none at the
+// last point, which has no stage after it).
 void fill_point(const StageModel& stages, int k, double c, double v, double a,
                 const PositionTerms& pos, const VelocityTerms& vel, PlanPoint& out) {
+  if (k < stages.stages()) {
+    const StageCost sc = stages.cost(vel, a);
+    out.cost = sc.cost;
+    out.penalty = sc.penalty;
+  }
   out.t_s = k * stages.dt();
   out.c_m = c;
   out.v_m_s = v;
@@ -287,15 +294,11 @@ struct DpSolution::Impl {
       stages.position_terms(k, c, terms, pos);
       stages.velocity_terms(pos, v, vel);
       double a = 0.0;
-      auto& point = plan.points[static_cast<std::size_t>(k)];
       if (k < n_stages) {
         double best = 0.0;
         a = refine_control(k, c, v, vel, best_control(k, c, v, vel, totals, best));
-        const StageCost sc = stages.cost(vel, a);
-        point.cost = sc.cost;
-        point.penalty = sc.penalty;
       }
-      fill_point(stages, k, c, v, a, pos, vel, point);
+      fill_point(stages, k, c, v, a, pos, vel, plan.points[static_cast<std::size_t>(k)]);
       c += v * dt + 0.5 * a * dt * dt;
       v += a * dt;
     }
@@ -422,13 +425,7 @@ Plan plan_online(const StageModel& stages, dynamics::Resolution resolution, doub
       }
       a = std::clamp((v_target - v) / dt, -stages.a_max(), stages.a_max());
     }
-    auto& point = plan.points[static_cast<std::size_t>(k)];
-    if (k < n_stages) {
-      const StageCost sc = stages.cost(vel, a);
-      point.cost = sc.cost;
-      point.penalty = sc.penalty;
-    }
-    fill_point(stages, k, c, v, a, pos, vel, point);
+    fill_point(stages, k, c, v, a, pos, vel, plan.points[static_cast<std::size_t>(k)]);
     c += v * dt + 0.5 * a * dt * dt;
     v += a * dt;
     a_prev = a;

@@ -77,6 +77,16 @@ struct ControllerOutput {
 // The controller's status is the cycle status of the loop (control_loop.hpp).
 using ControllerStatus = CycleStatus;
 
+// The settings of the full scaling's tip path and tip scaler from a crane config: the
+// controller's, and those of tests that run the two parts on their own.
+scaling::TipPathConfig tip_path_config(const config::CraneConfig& config);
+scaling::TipScalerConfig tip_scaler_config(const config::CraneConfig& config);
+// The tip scaler's input of a cycle (tracking factor 1): the command, its direction u, what the
+// tip path found for u (end damping, the stop a joint end leaves room for, a singular pose), and
+// whether the input is stale.
+scaling::TipScalerInput tip_scaler_input(const Eigen::Vector3d& command, const Eigen::Vector3d& u,
+                                         const scaling::TipPathOutput& path, bool stale);
+
 class Controller {
  public:
   Controller(const config::CraneConfig& config, const ControllerOptions& options);
