@@ -3,16 +3,17 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string_view>
 
 #include "craneassist/dynamics/cylinders.hpp"
 
 namespace craneassist::web {
 namespace {
 
-// Appends printf-style text (numbers: %.4g keeps the messages short and exact enough to draw).
+// Appends printf-style text (numbers: %.5g keeps the messages short and exact enough to draw).
 template <typename... Args>
 void put(std::string& out, const char* fmt, Args... args) {
-  char buf[256];
+  char buf[64];
   const int n = std::snprintf(buf, sizeof buf, fmt, args...);
   if (n > 0) out.append(buf, static_cast<std::size_t>(std::min<int>(n, sizeof buf - 1)));
 }
@@ -26,17 +27,7 @@ void number(std::string& out, double v) {
   }
 }
 
-void vec3(std::string& out, const Eigen::Vector3d& v) {
-  out += '[';
-  number(out, v.x());
-  out += ',';
-  number(out, v.y());
-  out += ',';
-  number(out, v.z());
-  out += ']';
-}
-
-void array(std::string& out, const double* v, int n) {
+void numbers(std::string& out, const double* v, int n) {
   out += '[';
   for (int i = 0; i < n; ++i) {
     if (i > 0) out += ',';
@@ -47,7 +38,7 @@ void array(std::string& out, const double* v, int n) {
 
 // A JSON string from text the project controls (names from the config): quotes and control
 // characters escaped.
-void string(std::string& out, const std::string& s) {
+void quoted(std::string& out, std::string_view s) {
   out += '"';
   for (const char c : s) {
     if (c == '"' || c == '\\') {
@@ -62,45 +53,90 @@ void string(std::string& out, const std::string& s) {
   out += '"';
 }
 
+// One JSON object, field by field, appended to a string.
+class Object {
+ public:
+  explicit Object(std::string& out) : out_(out) { out_ += '{'; }
+  Object& number(const char* name, double v) {
+    key(name);
+    web::number(out_, v);
+    return *this;
+  }
+  Object& integer(const char* name, long long v) {
+    key(name);
+    put(out_, "%lld", v);
+    return *this;
+  }
+  Object& numbers(const char* name, const double* v, int n) {
+    key(name);
+    web::numbers(out_, v, n);
+    return *this;
+  }
+  Object& vec3(const char* name, const Eigen::Vector3d& v) { return numbers(name, v.data(), 3); }
+  Object& text(const char* name, std::string_view s) {
+    key(name);
+    quoted(out_, s);
+    return *this;
+  }
+  Object& flag(const char* name, bool v) {
+    key(name);
+    out_ += v ? "true" : "false";
+    return *this;
+  }
+  // A nested value the caller appends next (an object or an array).
+  std::string& nested(const char* name) {
+    key(name);
+    return out_;
+  }
+  void close() { out_ += '}'; }
+
+ private:
+  void key(const char* name) {
+    if (!first_) out_ += ',';
+    first_ = false;
+    quoted(out_, name);
+    out_ += ':';
+  }
+  std::string& out_;
+  bool first_ = true;
+};
+
 }  // namespace
 
 std::string crane_json(const config::CraneConfig& crane, double frame_rate_hz) {
   const dynamics::CraneModel& m = crane.model;
-  std::string out = "{\"name\":";
-  string(out, m.name);
-  out += ",\"joints\":[";
-  for (int i = 0; i < m.dof(); ++i) {
-    const auto& j = m.joints[static_cast<std::size_t>(i)];
-    if (i > 0) out += ',';
-    out += "{\"name\":";
-    string(out, j.name);
-    put(out,
-        ",\"prismatic\":%s,\"min\":", j.type == dynamics::JointType::kPrismatic ? "true" : "false");
-    number(out, j.q_min);
-    out += ",\"max\":";
-    number(out, j.q_max);
-    out += '}';
+  std::string out;
+  Object root(out);
+  root.text("name", m.name);
+  std::string& joints = root.nested("joints");
+  joints += '[';
+  for (std::size_t i = 0; i < m.joints.size(); ++i) {
+    if (i > 0) joints += ',';
+    const auto& j = m.joints[i];
+    Object(joints)
+        .text("name", j.name)
+        .flag("prismatic", j.type == dynamics::JointType::kPrismatic)
+        .number("min", j.q_min)
+        .number("max", j.q_max)
+        .close();
   }
-  out += "],\"cylinders\":[";
+  joints += ']';
+  std::string& cylinders = root.nested("cylinders");
+  cylinders += '[';
   for (std::size_t i = 0; i < m.cylinders.size(); ++i) {
-    if (i > 0) out += ',';
-    out += "{\"name\":";
-    string(out, m.cylinders[i].name);
-    out += ",\"bore_m\":";
-    number(out, 2.0 * std::sqrt(m.cylinders[i].area_a_m2 / M_PI));
-    out += '}';
+    if (i > 0) cylinders += ',';
+    Object(cylinders)
+        .text("name", m.cylinders[i].name)
+        .number("bore_m", 2.0 * std::sqrt(m.cylinders[i].area_a_m2 / M_PI))
+        .close();
   }
-  out += "],\"pump\":{\"max_flow_m3s\":";
-  number(out, m.pump.max_flow_m3_s);
-  out += ",\"max_pressure_pa\":";
-  number(out, dynamics::supply_pressure_ceiling_pa(m.pump));
-  out += ",\"max_power_w\":";
-  number(out, m.pump.prime_mover_power_w);
-  out += "},\"rate_hz\":";
-  number(out, crane.control.rate_hz);
-  out += ",\"frame_rate_hz\":";
-  number(out, frame_rate_hz);
-  out += '}';
+  cylinders += ']';
+  Object(root.nested("pump"))
+      .number("max_flow_m3s", m.pump.max_flow_m3_s)
+      .number("max_pressure_pa", dynamics::supply_pressure_ceiling_pa(m.pump))
+      .number("max_power_w", m.pump.prime_mover_power_w)
+      .close();
+  root.number("rate_hz", crane.control.rate_hz).number("frame_rate_hz", frame_rate_hz).close();
   return out;
 }
 
@@ -109,45 +145,31 @@ SceneBuilder::SceneBuilder(const dynamics::CraneModel& model) : model_(model) {}
 void SceneBuilder::frame_json(const control::LogRow& row, std::uint64_t seq, std::string& out) {
   const int n = model_.dof();
   out.clear();
-  put(out, "{\"type\":\"frame\",\"seq\":%llu,\"t\":", static_cast<unsigned long long>(seq));
-  number(out, row.t);
-  out += ",\"status\":";
-  string(out, row.status);
-  out += ",\"stop_reason\":";
-  string(out, row.stop_reason);
-  out += ",\"input\":";
-  string(out, row.input_source);
-  put(out, ",\"deadman\":%s,\"limit\":", row.deadman ? "true" : "false");
-  string(out, row.active_limit);
-  out += ",\"pump_limit\":";
-  string(out, row.pump_limit);
-  out += ",\"scale\":";
-  number(out, row.scale);
-  out += ",\"sdot\":";
-  number(out, row.sdot);
-  out += ",\"cmd\":";
-  array(out, row.cmd.data(), 3);
-  out += ",\"ref\":";
-  array(out, row.ref_v.data(), 3);
-  out += ",\"tip\":";
-  array(out, row.tip.data(), 3);
-  out += ",\"tip_v\":";
-  array(out, row.tip_v.data(), 3);
-  out += ",\"q\":";
-  array(out, row.q.data(), n);
-  out += ",\"p_load\":";
-  array(out, row.load_pressure.data(), n);
-  out += ",\"spool\":";
-  array(out, row.spool.data(), n);
-  out += ",\"pump\":{\"flow\":";
-  number(out, row.pump_flow_m3s);
-  out += ",\"pressure\":";
-  number(out, row.pump_pressure_pa);
-  out += ",\"power\":";
-  number(out, row.pump_power_w);
-  out += ",\"energy\":";
-  number(out, row.energy_j);
-  out += '}';
+  Object f(out);
+  f.text("type", "frame")
+      .integer("seq", static_cast<long long>(seq))
+      .number("t", row.t)
+      .text("status", row.status)
+      .text("stop_reason", row.stop_reason)
+      .text("input", row.input_source)
+      .flag("deadman", row.deadman)
+      .text("limit", row.active_limit)
+      .text("pump_limit", row.pump_limit)
+      .number("scale", row.scale)
+      .number("sdot", row.sdot)
+      .numbers("cmd", row.cmd.data(), 3)
+      .numbers("ref", row.ref_v.data(), 3)
+      .numbers("tip", row.tip.data(), 3)
+      .numbers("tip_v", row.tip_v.data(), 3)
+      .numbers("q", row.q.data(), n)
+      .numbers("p_load", row.load_pressure.data(), n)
+      .numbers("spool", row.spool.data(), n);
+  Object(f.nested("pump"))
+      .number("flow", row.pump_flow_m3s)
+      .number("pressure", row.pump_pressure_pa)
+      .number("power", row.pump_power_w)
+      .number("energy", row.energy_j)
+      .close();
 
   // The drawing: joint frame origins, and each cylinder's ends.
   dynamics::JointVector q(n);
@@ -157,17 +179,23 @@ void SceneBuilder::frame_json(const control::LogRow& row, std::uint64_t seq, std
     finite = finite && std::isfinite(q[i]);
   }
   if (!finite) {
-    out += ",\"points\":null,\"cylinders\":null}";
+    f.nested("points") += "null";
+    f.nested("cylinders") += "null";
+    f.close();
     return;
   }
   dynamics::forward_kinematics(model_, data_, q);
   const Eigen::Matrix3d& r = model_.task_from_base;
-  out += ",\"points\":[";
+  std::string& points = f.nested("points");
+  points += '[';
   for (int i = 0; i <= n; ++i) {
-    if (i > 0) out += ',';
-    vec3(out, r * data_.frames[static_cast<std::size_t>(i)].translation());
+    if (i > 0) points += ',';
+    const Eigen::Vector3d p = r * data_.frames[static_cast<std::size_t>(i)].translation();
+    numbers(points, p.data(), 3);
   }
-  out += "],\"cylinders\":[";
+  points += ']';
+  std::string& cylinders = f.nested("cylinders");
+  cylinders += '[';
   for (int i = 0; i < n; ++i) {
     const auto& c = model_.cylinders[static_cast<std::size_t>(i)];
     const auto k = static_cast<std::size_t>(i);
@@ -201,14 +229,11 @@ void SceneBuilder::frame_json(const control::LogRow& row, std::uint64_t seq, std
     } else {
       continue;  // the slew drive: drawn as the pillar, its pressure in the gauges
     }
-    if (i > 0 && out.back() != '[') out += ',';
-    put(out, "{\"joint\":%d,\"a\":", i);
-    vec3(out, r * a);
-    out += ",\"b\":";
-    vec3(out, r * b);
-    out += '}';
+    if (cylinders.back() != '[') cylinders += ',';
+    Object(cylinders).integer("joint", i).vec3("a", r * a).vec3("b", r * b).close();
   }
-  out += "]}";
+  cylinders += ']';
+  f.close();
 }
 
 }  // namespace craneassist::web

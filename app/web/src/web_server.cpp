@@ -166,8 +166,13 @@ struct WebServer::Impl {
 
   Observer observer{*this};
 
-  std::atomic<std::uint64_t> http_requests{0}, pages_connected{0}, frames_sent{0},
-      frames_dropped{0}, pad_messages{0}, pad_refused{0}, pad_malformed{0}, command_holders{0};
+  // Counted on the I/O thread, read by counters() from any thread.
+  mutable std::mutex counters_mutex;
+  WebCounters counts;
+  void count(std::uint64_t WebCounters::*counter) {
+    std::lock_guard<std::mutex> lock(counters_mutex);
+    ++(counts.*counter);
+  }
 };
 
 // One page's WebSocket: frames out (a short queue; a page that falls behind misses frames, it
@@ -182,7 +187,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     ws_.read_message_max(4096);
     ws_.async_accept(req, [self = shared_from_this()](beast::error_code ec) {
       if (ec) return;
-      self->impl_.pages_connected.fetch_add(1);
+      self->impl_.count(&WebCounters::pages_connected);
       self->impl_.sessions.push_back(self);
       self->send(
           std::make_shared<const std::string>(std::string("{\"type\":\"hello\",\"command\":\"") +
@@ -272,7 +277,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 
  private:
   void handle(http::request<http::string_body> req) {
-    impl_.http_requests.fetch_add(1);
+    impl_.count(&WebCounters::http_requests);
     const std::string_view target(req.target().data(), req.target().size());
     if (websocket::is_upgrade(req) && path_of(target) == "/ws") {
       beast::error_code ec;
@@ -398,9 +403,9 @@ void WebServer::Impl::broadcast(const std::shared_ptr<const std::string>& messag
   for (auto& weak : sessions) {
     if (auto s = weak.lock()) {
       if (s->send(message)) {
-        frames_sent.fetch_add(1);
+        count(&WebCounters::frames_sent);
       } else {
-        frames_dropped.fetch_add(1);
+        count(&WebCounters::frames_dropped);
       }
       sessions[live++] = weak;
     }
@@ -414,7 +419,7 @@ void WebServer::Impl::on_pad(WsSession& from, std::string_view text) {
         std::string("{\"type\":\"command\",\"state\":\"") + state + "\",\"why\":\"" + why + "\"}"));
   };
   if (!pad_source_made.load() || !from.may_command() || (holder != nullptr && holder != &from)) {
-    pad_refused.fetch_add(1);
+    count(&WebCounters::pad_refused);
     if (!from.told_refused) {
       from.told_refused = true;
       reply("refused", !pad_source_made.load() ? "this run does not take commands from the page"
@@ -426,7 +431,8 @@ void WebServer::Impl::on_pad(WsSession& from, std::string_view text) {
   }
   PadMessage m;
   if (!parse_pad_message(text, m)) {
-    pad_malformed.fetch_add(1);  // not published: the last good state goes stale, the crane stops
+    // Not published: the last good state goes stale and the crane stops.
+    count(&WebCounters::pad_malformed);
     return;
   }
   PadState s;
@@ -439,10 +445,10 @@ void WebServer::Impl::on_pad(WsSession& from, std::string_view text) {
   s.has_state = true;
   if (holder == nullptr) {
     holder = &from;
-    command_holders.fetch_add(1);
+    count(&WebCounters::command_holders);
     reply("yours", "");
   }
-  pad_messages.fetch_add(1);
+  count(&WebCounters::pad_messages);
   publish(s);
 }
 
@@ -539,33 +545,18 @@ std::unique_ptr<input::CommandSource> WebServer::make_pad_source(
 }
 
 WebCounters WebServer::counters() const {
-  const Impl& m = *impl_;
-  WebCounters c;
-  c.http_requests = m.http_requests.load();
-  c.pages_connected = m.pages_connected.load();
-  c.frames_sent = m.frames_sent.load();
-  c.frames_dropped = m.frames_dropped.load();
-  c.pad_messages = m.pad_messages.load();
-  c.pad_refused = m.pad_refused.load();
-  c.pad_malformed = m.pad_malformed.load();
-  c.command_holders = m.command_holders.load();
-  return c;
+  std::lock_guard<std::mutex> lock(impl_->counters_mutex);
+  return impl_->counts;
 }
 
 std::string WebServer::report() const {
   const WebCounters c = counters();
-  char buf[320];
-  std::snprintf(buf, sizeof buf,
-                "  web: %llu pages, %llu frames sent (%llu dropped: a page behind), stick states "
-                "%llu accepted, %llu refused, %llu malformed; %llu pages took the command",
-                static_cast<unsigned long long>(c.pages_connected),
-                static_cast<unsigned long long>(c.frames_sent),
-                static_cast<unsigned long long>(c.frames_dropped),
-                static_cast<unsigned long long>(c.pad_messages),
-                static_cast<unsigned long long>(c.pad_refused),
-                static_cast<unsigned long long>(c.pad_malformed),
-                static_cast<unsigned long long>(c.command_holders));
-  return buf;
+  using std::to_string;
+  return "  web: " + to_string(c.pages_connected) + " pages, " + to_string(c.frames_sent) +
+         " frames sent (" + to_string(c.frames_dropped) +
+         " dropped: a page behind), stick states " + to_string(c.pad_messages) + " accepted, " +
+         to_string(c.pad_refused) + " refused, " + to_string(c.pad_malformed) + " malformed; " +
+         to_string(c.command_holders) + " pages took the command";
 }
 
 }  // namespace craneassist::web
