@@ -205,7 +205,7 @@ std::vector<std::string> render(const Snapshot& s, const DashboardOptions& o, st
   auto pair = [](const char* k1, const std::string& v1, const char* k2, const std::string& v2) {
     return fmt("%-10s%-24s%-14s%s", k1, v1.c_str(), k2, v2.c_str());
   };
-  lines.push_back(pair("status", st ? or_dash(s.status.status()) : "-", "stop reason",
+  lines.push_back(pair("status", st ? or_dash(s.status.state()) : "-", "stop reason",
                        st ? or_dash(s.status.stop_reason()) : "-"));
   lines.push_back(pair("input", st ? or_dash(s.status.input_source()) : "-", "deadman",
                        st ? (s.status.deadman() ? "ON" : "off") : "-"));

@@ -56,7 +56,7 @@ void describe(const msg::Status& m, FieldVisitor& v) {
   describe_header(m.header(), v);
   v.text("crane", m.crane());
   v.text("backend", m.backend());
-  v.text("status", m.status());
+  v.text("status", m.state());  // the IDL's `state`; echo's name (and CSV column) is `status`
   v.text("stop_reason", m.stop_reason());
   v.text("active_limit", m.active_limit());
   v.text("pump_limit", m.pump_limit());
