@@ -438,6 +438,7 @@ int run_dashboard(const DashboardOptions& o) {
   po.domain_id = o.domain_id;
   po.name = "craneassist-dashboard";
   po.transport = o.transport;
+  po.type_propagation = o.type_propagation;
   std::unique_ptr<SubscriberSession> session;
   try {
     session = std::make_unique<SubscriberSession>(

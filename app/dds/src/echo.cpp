@@ -303,6 +303,7 @@ int echo_topic(const TopicInfo& topic, const EchoOptions& o) {
   po.domain_id = o.domain_id;
   po.name = "craneassist-echo";
   po.transport = o.transport;
+  po.type_propagation = o.type_propagation;
   std::unique_ptr<SubscriberSession> session;
   try {
     session = std::make_unique<SubscriberSession>(po, std::vector<Topic>{topic.topic});
