@@ -1,7 +1,9 @@
 #include "dds_commands.hpp"
 
 #include <csignal>
+#include <cstdio>
 
+#include "craneassist/config/config_error.hpp"
 #include "craneassist/config/telemetry_config.hpp"
 #include "craneassist/dds/tools.hpp"
 #include "exit_codes.hpp"
@@ -52,14 +54,18 @@ void add_common_options(CLI::App& app, DdsToolArgs& args, const char* timeout_he
       ->check(CLI::IsMember(names_of(config::kDdsTransports)));
 }
 
-// The settings with the options' overrides; nullopt (after saying why) when the file is bad.
+// The settings with the options' overrides; nullopt (after saying why on stderr, with echo's and
+// the dashboard's other errors: stdout is for the samples) when the file is bad.
 std::optional<config::TelemetryConfig> tool_settings(const DdsToolArgs& args) {
   config::TelemetryConfig c;
   try {
     c = args.config_file.empty() ? config::default_telemetry_config()
                                  : config::load_telemetry_config(args.config_file);
-  } catch (...) {
-    input_error_exit("telemetry config");
+  } catch (const config::ConfigError& e) {
+    std::fprintf(stderr, "craneassist: error: config: %s\n", e.what());
+    return std::nullopt;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "craneassist: error: %s\n", e.what());
     return std::nullopt;
   }
   if (args.domain_id) c.domain_id = *args.domain_id;

@@ -312,7 +312,7 @@ std::vector<std::string> waiting_screen(const Snapshot& s, const DashboardOption
   }
   return {fmt("craneassist dashboard: waiting for craneassist on domain %d ...", o.domain_id),
           "",
-          fmt("  %.0f s; writers matched: %s", elapsed_s, matched.c_str()),
+          fmt("  %.0f s; writers discovered: %s", elapsed_s, matched.c_str()),
           "  (craneassist publishes telemetry while it runs: sim, replay)",
           "",
           "q or Ctrl-C quits"};

@@ -72,6 +72,13 @@ void TopicReader::on_subscription_matched(fdds::DataReader* /*reader*/,
   wakeup_.notify();
 }
 
+void TopicReader::on_requested_incompatible_qos(fdds::DataReader* /*reader*/,
+                                                const fdds::RequestedIncompatibleQosStatus& s) {
+  incompatible_.store(static_cast<int>(s.total_count));
+  last_policy_.store(static_cast<std::uint32_t>(s.last_policy_id));
+  wakeup_.notify();
+}
+
 SubscriberSession::SubscriberSession(const ParticipantOptions& options,
                                      const std::vector<Topic>& topics, DataCallback on_data)
     : start_ns_(monotonic_ns()) {
