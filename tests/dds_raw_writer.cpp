@@ -47,7 +47,7 @@ msg::Status status_sample(std::uint64_t cycle) {
   m.header(header_of(cycle));
   m.crane("Raw crane");
   m.backend("sim");
-  m.status("running");
+  m.state("running");
   m.active_limit("none");
   m.pump_limit("none");
   m.input_source("dds");

@@ -249,7 +249,7 @@ TEST(Telemetry, EveryTopicRoundTripsEveryField) {
   EXPECT_GT(s.header().stamp_ns(), 0);
   EXPECT_EQ(s.crane(), "test crane");
   EXPECT_EQ(s.backend(), "sim");
-  EXPECT_EQ(s.status(), "running");
+  EXPECT_EQ(s.state(), "running");
   EXPECT_EQ(s.stop_reason(), "");
   EXPECT_EQ(s.active_limit(), "power");
   EXPECT_EQ(s.pump_limit(), "none");

@@ -25,6 +25,9 @@ TEST(TelemetryConfig, ShippedDefaults) {
   EXPECT_EQ(c.domain_id, 0);
   EXPECT_EQ(c.participant_name, "craneassist");
   EXPECT_EQ(c.transport, DdsTransport::kDefault);
+  // The interoperable choice (docs/telemetry.md#interoperability): no TYPE_INFORMATION.
+  EXPECT_TRUE(c.type_propagation.type_object);
+  EXPECT_FALSE(c.type_propagation.type_information);
   expect_topic(c.status, 10.0, Reliability::kReliable, Durability::kTransientLocal);
   expect_topic(c.joints, 50.0, Reliability::kBestEffort, Durability::kVolatile);
   EXPECT_DOUBLE_EQ(c.hydraulics.rate_hz, 50.0);
@@ -40,6 +43,7 @@ enabled: false
 domain_id: 42
 participant_name: loader-7
 transport: udp
+type_propagation: {type_object: false, type_information: true}
 topics:
   status: {rate: 2 Hz, reliability: best_effort, durability: volatile, depth: 3}
   joints: {rate: 100 Hz, reliability: reliable, durability: transient_local, depth: 10}
@@ -53,6 +57,8 @@ commands:
   EXPECT_EQ(c.domain_id, 42);
   EXPECT_EQ(c.participant_name, "loader-7");
   EXPECT_EQ(c.transport, DdsTransport::kUdp);
+  EXPECT_FALSE(c.type_propagation.type_object);
+  EXPECT_TRUE(c.type_propagation.type_information);
   expect_topic(c.status, 2.0, Reliability::kBestEffort, Durability::kVolatile);
   EXPECT_EQ(c.status.depth, 3);
   expect_topic(c.joints, 100.0, Reliability::kReliable, Durability::kTransientLocal);
@@ -90,6 +96,11 @@ TEST(TelemetryConfig, ErrorsNameFileLineAndField) {
   expect_error("topics:\n  status:\n    depth: 0\n", 4, "topics.status.depth", "1..1000");
   expect_error("topics:\n  jionts:\n    depth: 1\n", 3, "topics.jionts", "unknown field");
   expect_error("enabled: yes\n", 2, "enabled", "true or false");
+  expect_error("type_propagation:\n  type_information: maybe\n", 3,
+               "type_propagation.type_information", "true or false");
+  expect_error("type_propagation:\n  type_objects: true\n", 3, "type_propagation.type_objects",
+               "unknown field (expected one of: type_object, type_information)");
+  expect_error("type_propagation: none\n", 2, "type_propagation", "expected a mapping");
   expect_error("domian_id: 3\n", 2, "domian_id", "unknown field");
   expect_error("domain_id: 3\ndomain_id: 4\n", 3, "domain_id", "duplicate key (first at line 2)");
   expect_error("topics:\n  joints:\n    rate: 50 Hz\n    depth: 2\n    rate: 5 Hz\n", 6,

@@ -10,6 +10,7 @@ packages=(
   qemu-system-x86 busybox-static can-utils cpio  # the SocketCAN test VM (tools/can-vm/)
   libevdev-dev libsdl2-dev tmux  # joysticks; tmux drives the keyboard joystick in tests
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools openssl  # DDS telemetry and security
+  cyclonedds-dev cyclonedds-tools  # Eclipse Cyclone DDS: the interop tests (tests/interop/)
   clang libclang-rt-14-dev llvm  # the clang sanitizer build and libFuzzer (docs/fuzzing.md)
   libboost-dev nlohmann-json3-dev chromium  # the web view (docs/web.md) and its browser test
   liburdfdom-dev liburdfdom-tools  # reads back the URDF of craneassist urdf (docs/ros.md)

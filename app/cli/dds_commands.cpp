@@ -1,7 +1,9 @@
 #include "dds_commands.hpp"
 
 #include <csignal>
+#include <cstdio>
 
+#include "craneassist/config/config_error.hpp"
 #include "craneassist/config/telemetry_config.hpp"
 #include "craneassist/dds/tools.hpp"
 #include "exit_codes.hpp"
@@ -37,25 +39,48 @@ class StopOnSignal {
   StopOnSignal& operator=(const StopOnSignal&) = delete;
 };
 
-void add_common_options(CLI::App& app, int& domain_id, double& timeout_s, std::string& transport,
-                        const char* timeout_help) {
-  domain_id = config::default_telemetry_config().domain_id;
-  app.add_option("--domain", domain_id, "DDS domain id (the telemetry config's domain_id)")
-      ->check(CLI::Range(0, 232))
-      ->capture_default_str();
-  app.add_option("--timeout", timeout_s, timeout_help)->check(FiniteRange(1e-3, 1e6));
-  app.add_option("--transport", transport,
-                 "default (shared memory and UDP), udp (UDPv4 only) or shm (shared memory only)")
-      ->check(CLI::IsMember(names_of(config::kDdsTransports)))
-      ->capture_default_str();
+void add_common_options(CLI::App& app, DdsToolArgs& args, const char* timeout_help) {
+  app.add_option("--telemetry-config", args.config_file,
+                 "DDS settings (docs/telemetry.md): domain_id, transport and type_propagation "
+                 "(default: the embedded config/telemetry/default.yaml)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--domain", args.domain_id,
+                 "DDS domain id (default: the settings' domain_id, 0 in the shipped ones)")
+      ->check(CLI::Range(0, 232));
+  app.add_option("--timeout", args.timeout_s, timeout_help)->check(FiniteRange(1e-3, 1e6));
+  app.add_option("--transport", args.transport,
+                 "default (shared memory and UDP), udp (UDPv4 only) or shm (shared memory only); "
+                 "default: the settings' transport")
+      ->check(CLI::IsMember(names_of(config::kDdsTransports)));
 }
 
-// The values of the options add_common_options() added, into the tool's options.
-template <class ToolOptions, class Args>
-void apply_common_options(ToolOptions& o, const Args& args) {
-  o.domain_id = args.domain_id;
+// The settings with the options' overrides; nullopt (after saying why on stderr, with echo's and
+// the dashboard's other errors: stdout is for the samples) when the file is bad.
+std::optional<config::TelemetryConfig> tool_settings(const DdsToolArgs& args) {
+  config::TelemetryConfig c;
+  try {
+    c = args.config_file.empty() ? config::default_telemetry_config()
+                                 : config::load_telemetry_config(args.config_file);
+  } catch (const config::ConfigError& e) {
+    std::fprintf(stderr, "craneassist: error: config: %s\n", e.what());
+    return std::nullopt;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "craneassist: error: %s\n", e.what());
+    return std::nullopt;
+  }
+  if (args.domain_id) c.domain_id = *args.domain_id;
+  if (!args.transport.empty()) c.transport = config::parse_dds_transport(args.transport).value();
+  return c;
+}
+
+// The settings and the options add_common_options() added, into the tool's options.
+template <class ToolOptions>
+void apply_common_options(ToolOptions& o, const DdsToolArgs& args,
+                          const config::TelemetryConfig& settings) {
+  o.domain_id = settings.domain_id;
   o.timeout_s = args.timeout_s;
-  o.transport = config::parse_dds_transport(args.transport).value();
+  o.transport = settings.transport;
+  o.type_propagation = settings.type_propagation;
 }
 
 }  // namespace
@@ -74,17 +99,18 @@ CLI::App* add_echo_command(CLI::App& cli, EchoArgs& args) {
                    "one row per sample")
       ->check(CLI::IsMember({"text", "csv"}))
       ->capture_default_str();
-  add_common_options(*echo, args.domain_id, args.timeout_s, args.transport,
-                     "Fail (exit 3) when no sample arrives within this many seconds");
+  add_common_options(*echo, args, "Fail (exit 3) when no sample arrives within this many seconds");
   return echo;
 }
 
 int run_echo_command(const EchoArgs& args) {
+  const auto settings = tool_settings(args);
+  if (!settings) return kExitUsage;
   dds::EchoOptions o;
   o.topic = args.topic;
   o.count = args.count;
   o.format = args.format == "csv" ? dds::EchoFormat::kCsv : dds::EchoFormat::kText;
-  apply_common_options(o, args);
+  apply_common_options(o, args, *settings);
   StopOnSignal stop;
   return dds::run_echo(o);
 }
@@ -96,15 +122,17 @@ CLI::App* add_dashboard_command(CLI::App& cli, DashboardArgs& args) {
   dashboard->add_flag("--once", args.once,
                       "Print one plain snapshot once every telemetry topic has a sample, then "
                       "exit (also when stdout is not a terminal)");
-  add_common_options(*dashboard, args.domain_id, args.timeout_s, args.transport,
+  add_common_options(*dashboard, args,
                      "Fail (exit 3) when a telemetry topic has no sample within this many seconds");
   return dashboard;
 }
 
 int run_dashboard_command(const DashboardArgs& args) {
+  const auto settings = tool_settings(args);
+  if (!settings) return kExitUsage;
   dds::DashboardOptions o;
   o.once = args.once;
-  apply_common_options(o, args);
+  apply_common_options(o, args, *settings);
   StopOnSignal stop;
   return dds::run_dashboard(o);
 }

@@ -4,24 +4,28 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
 
 namespace craneassist::cli {
 
-struct EchoArgs {
-  std::string topic;
-  int domain_id = 0;  // default: the shipped telemetry config's
-  long count = 0;     // 0: until Ctrl-C or SIGTERM
+// Both read the DDS settings (domain, transport, type_propagation) from --telemetry-config FILE
+// or the shipped default; --domain and --transport override them.
+struct DdsToolArgs {
+  std::string config_file;
+  std::optional<int> domain_id;
+  std::string transport;  // "": the settings'
   double timeout_s = 0.0;
-  std::string format = "text";
-  std::string transport = "default";
 };
 
-struct DashboardArgs {
-  int domain_id = 0;
+struct EchoArgs : DdsToolArgs {
+  std::string topic;
+  long count = 0;  // 0: until Ctrl-C or SIGTERM
+  std::string format = "text";
+};
+
+struct DashboardArgs : DdsToolArgs {
   bool once = false;
-  double timeout_s = 0.0;
-  std::string transport = "default";
 };
 
 CLI::App* add_echo_command(CLI::App& cli, EchoArgs& args);

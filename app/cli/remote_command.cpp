@@ -134,6 +134,7 @@ int run_remote_command(const RemoteArgs& args) {
   dds::CommandWriterOptions options;
   options.domain_id = tcfg.domain_id;
   options.transport = tcfg.transport;
+  options.type_propagation = tcfg.type_propagation;
   options.topic = tcfg.commands.topic;
   options.insecure = args.insecure;
   if (!args.insecure) options.security = sec;

@@ -103,9 +103,9 @@ TopicSettings read_topic(const Reader& r, const YAML::Node& node, const std::str
 TelemetryConfig read_config(const Reader& r, const YAML::Node& root, std::string_view source) {
   TelemetryConfig c;
   c.source_name = std::string(source);
-  r.check_keys(
-      root, "",
-      {"format", "enabled", "domain_id", "participant_name", "transport", "topics", "commands"});
+  r.check_keys(root, "",
+               {"format", "enabled", "domain_id", "participant_name", "transport",
+                "type_propagation", "topics", "commands"});
   const YAML::Node format = r.child(root, "format", "");
   if (!format.IsScalar() || format.Scalar() != kFormat) {
     r.fail(format, "format", std::string("expected ") + kFormat);
@@ -116,6 +116,13 @@ TelemetryConfig read_config(const Reader& r, const YAML::Node& root, std::string
     c.participant_name = name;
   }
   c.transport = r.choice(root, "transport", "", kDdsTransports, c.transport);
+  if (const YAML::Node tp = root["type_propagation"]; tp.IsDefined() && !tp.IsNull()) {
+    r.check_keys(tp, "type_propagation", {"type_object", "type_information"});
+    c.type_propagation.type_object =
+        r.flag(tp, "type_object", "type_propagation", c.type_propagation.type_object);
+    c.type_propagation.type_information =
+        r.flag(tp, "type_information", "type_propagation", c.type_propagation.type_information);
+  }
   if (const YAML::Node topics = root["topics"]; topics.IsDefined() && !topics.IsNull()) {
     r.check_keys(topics, "topics", {"status", "joints", "hydraulics", "command_path"});
     const std::pair<const char*, TopicSettings*> all[] = {{"status", &c.status},

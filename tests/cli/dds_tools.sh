@@ -62,7 +62,8 @@ echo)
     mv "$work/out$n" "$work/out"
     mv "$work/err$n" "$work/err"
     [ "$(cat "$work/rc$n")" = 0 ] || { cat "$work/out" "$work/err"; fail "$topic: exit $(cat "$work/rc$n")"; }
-    has err "matched 1 writer after"
+    has err "discovered 1 writer after"
+    has err "receiving, first sample after"
     [ $topic = csv ] && break
     [ "$(grep -c '^---$' "$work/out")" = 3 ] || { cat "$work/out"; fail "$topic: not 3 samples"; }
     case $topic in
@@ -78,7 +79,7 @@ echo)
   col=$(head -1 "$work/out" | tr , '\n' | grep -n '^power_w$' | cut -d: -f1)
   [ "$(sed -n 3p "$work/out" | cut -d, -f"$col")" = 12500 ] || fail "csv power_w: $(cat "$work/out")"
   # No diagnostics on stdout: the csv can go straight to a file.
-  grep -q "matched" "$work/out" && fail "discovery message on stdout"
+  grep -q "discovered\|receiving" "$work/out" && fail "discovery message on stdout"
   echo "echo OK"
   ;;
 usage)
@@ -87,6 +88,14 @@ usage)
   expect 2 "$bin" echo status --format xml
   expect 2 "$bin" echo
   expect 2 "$bin" dashboard --domain 300
+  # A bad settings file: file, line and field, exit 2 before DDS starts.
+  printf 'format: craneassist-telemetry/1\ntype_propagation:\n  type_information: maybe\n' \
+    > "$work/bad.yaml"
+  for tool in "echo status" dashboard; do
+    # shellcheck disable=SC2086 # the tool and its topic
+    expect 2 "$bin" $tool --telemetry-config "$work/bad.yaml"
+    has err "bad.yaml:3: field 'type_propagation.type_information': expected true or false"
+  done
   echo "usage OK"
   ;;
 timeout)

@@ -88,6 +88,9 @@ for path in files("config/telemetry/*.yaml"):
 write("fuzz_telemetry_config", "commands.yaml",
       "domain: 7\nrates: {status: 5 Hz}\ncommands:\n  enabled: true\n  security:\n"
       "    ca: ca.pem\n")
+write("fuzz_telemetry_config", "type_propagation.yaml",
+      "format: craneassist-telemetry/1\ntype_propagation: {type_object: false, "
+      "type_information: true}\n")
 for path in files("config/can/*.yaml"):
     write("fuzz_can_mapping", os.path.basename(path), open(path, "rb").read())
 for name, text in (("flow_block.yaml", "[[[[{a: [b, {c: d}]}]]]]\n"),

@@ -31,6 +31,7 @@ struct CommandWriter::Impl : public fdds::DataWriterListener {
     p.domain_id = options.domain_id;
     p.name = options.participant_name;
     p.transport = options.transport;
+    p.type_propagation = options.type_propagation;
     p.security = options.security;
     participant = make_participant(p);
     fdds::Publisher* publisher = participant->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);

@@ -205,7 +205,7 @@ std::vector<std::string> render(const Snapshot& s, const DashboardOptions& o, st
   auto pair = [](const char* k1, const std::string& v1, const char* k2, const std::string& v2) {
     return fmt("%-10s%-24s%-14s%s", k1, v1.c_str(), k2, v2.c_str());
   };
-  lines.push_back(pair("status", st ? or_dash(s.status.status()) : "-", "stop reason",
+  lines.push_back(pair("status", st ? or_dash(s.status.state()) : "-", "stop reason",
                        st ? or_dash(s.status.stop_reason()) : "-"));
   lines.push_back(pair("input", st ? or_dash(s.status.input_source()) : "-", "deadman",
                        st ? (s.status.deadman() ? "ON" : "off") : "-"));
@@ -312,7 +312,7 @@ std::vector<std::string> waiting_screen(const Snapshot& s, const DashboardOption
   }
   return {fmt("craneassist dashboard: waiting for craneassist on domain %d ...", o.domain_id),
           "",
-          fmt("  %.0f s; writers matched: %s", elapsed_s, matched.c_str()),
+          fmt("  %.0f s; writers discovered: %s", elapsed_s, matched.c_str()),
           "  (craneassist publishes telemetry while it runs: sim, replay)",
           "",
           "q or Ctrl-C quits"};
@@ -435,7 +435,7 @@ int run_dashboard(const DashboardOptions& o) {
   }
   LatestSamples latest;
   const auto session = open_tool_session(
-      "craneassist-dashboard", o.domain_id, o.transport,
+      "craneassist-dashboard", o.domain_id, o.transport, o.type_propagation,
       std::vector<Topic>(std::begin(kTelemetry), std::end(kTelemetry)), o.err,
       [&latest](Topic topic, fdds::DataReader& reader) { latest.take(topic, reader); });
   if (!session) return kToolRuntime;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fastdds/dds/core/policy/QosPolicies.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <stdexcept>
 #include <string>
@@ -56,7 +57,7 @@ void describe(const msg::Status& m, FieldVisitor& v) {
   describe_header(m.header(), v);
   v.text("crane", m.crane());
   v.text("backend", m.backend());
-  v.text("status", m.status());
+  v.text("status", m.state());  // the IDL's `state`; echo's name (and CSV column) is `status`
   v.text("stop_reason", m.stop_reason());
   v.text("active_limit", m.active_limit());
   v.text("pump_limit", m.pump_limit());
@@ -127,6 +128,29 @@ void describe(const msg::OperatorCommand& m, FieldVisitor& v) {
   v.text("sender", m.sender());
   v.vector3("v_m_s", m.v_m_s(), "m/s");
   v.flag("deadman", m.deadman());
+}
+
+const char* qos_policy_name(std::uint32_t id) {
+  switch (id) {
+    case fdds::DURABILITY_QOS_POLICY_ID:
+      return "durability";
+    case fdds::DEADLINE_QOS_POLICY_ID:
+      return "deadline";
+    case fdds::OWNERSHIP_QOS_POLICY_ID:
+      return "ownership";
+    case fdds::LIVELINESS_QOS_POLICY_ID:
+      return "liveliness";
+    case fdds::RELIABILITY_QOS_POLICY_ID:
+      return "reliability";
+    case fdds::DESTINATIONORDER_QOS_POLICY_ID:
+      return "destination order";
+    case fdds::DATAREPRESENTATION_QOS_POLICY_ID:
+      return "data representation";
+    case fdds::TYPECONSISTENCYENFORCEMENT_QOS_POLICY_ID:
+      return "type consistency";
+    default:
+      return "another policy";
+  }
 }
 
 std::string format_number(const char* spec, double value) {
@@ -299,8 +323,9 @@ class CsvWriter : public FieldVisitor {
 
 template <typename T>
 int echo_topic(const TopicInfo& topic, const EchoOptions& o) {
-  const auto session = open_tool_session("craneassist-echo", o.domain_id, o.transport,
-                                         std::vector<Topic>{topic.topic}, o.err);
+  const auto session =
+      open_tool_session("craneassist-echo", o.domain_id, o.transport, o.type_propagation,
+                        std::vector<Topic>{topic.topic}, o.err);
   if (!session) return kToolRuntime;
   TopicReader& reader = session->reader(topic.topic);
   TextWriter text(o.out);
@@ -308,16 +333,42 @@ int echo_topic(const TopicInfo& topic, const EchoOptions& o) {
   T sample;
   fdds::SampleInfo info;
   long printed = 0;
+  const std::string name(topic.dds_name);
+  auto plural = [](int n) { return n == 1 ? "" : "s"; };
+  // One line when this reader first matches a writer, and one when the first sample arrives.
+  // Fast DDS matches on this side alone: a writer can be matched here that does not match this
+  // reader (another DDS implementation that rejects our discovery data) and never sends. Only
+  // the first sample shows that samples flow.
   bool discovery_reported = false;
-  // One line when the first writer is matched (before that writer's first sample).
   auto report_discovery = [&] {
     if (discovery_reported || reader.first_match_ns() == 0) return;
     const int writers = reader.matched_writers();
-    std::fprintf(o.err, "craneassist echo: %s: matched %d writer%s after %.2f s (discovery)\n",
-                 std::string(topic.dds_name).c_str(), writers, writers == 1 ? "" : "s",
+    std::fprintf(o.err,
+                 "craneassist echo: %s: discovered %d writer%s after %.2f s; waiting for a "
+                 "sample\n",
+                 name.c_str(), writers, plural(writers),
                  static_cast<double>(reader.first_match_ns() - session->start_ns()) * 1e-9);
     std::fflush(o.err);
     discovery_reported = true;
+  };
+  auto report_flow = [&] {
+    if (printed != 0) return;
+    const int writers = reader.matched_writers();
+    std::fprintf(o.err,
+                 "craneassist echo: %s: receiving, first sample after %.2f s (%d writer%s)\n",
+                 name.c_str(), session->elapsed_s(), writers, plural(writers));
+    std::fflush(o.err);
+  };
+  // Writers whose QoS cannot serve this reader (Fast DDS reports these; echo's best-effort,
+  // volatile reader asks for little, so another implementation's writer is the likely one).
+  int incompatible_reported = 0;
+  auto report_incompatible = [&] {
+    const int n = reader.incompatible_writers();
+    if (n == incompatible_reported) return;
+    std::fprintf(o.err, "craneassist echo: %s: %d writer%s not matched: incompatible QoS (%s)\n",
+                 name.c_str(), n, plural(n), qos_policy_name(reader.last_incompatible_policy()));
+    std::fflush(o.err);
+    incompatible_reported = n;
   };
   // Samples that cannot be deserialized are dropped: said once when the first comes, and the
   // count when echo ends.
@@ -345,9 +396,11 @@ int echo_topic(const TopicInfo& topic, const EchoOptions& o) {
   } report_at_end{o, topic, malformed};
   while (!stop_requested()) {
     report_discovery();
+    report_incompatible();
     while (!stop_requested() && take_next_valid(reader.reader(), &sample, info, malformed)) {
       report_malformed();
       report_discovery();
+      report_flow();
       if (o.format == EchoFormat::kCsv) {
         csv.write(sample);
       } else {
@@ -364,8 +417,11 @@ int echo_topic(const TopicInfo& topic, const EchoOptions& o) {
         const int writers = reader.matched_writers();
         std::string why;
         if (writers > 0) {
-          why = " (" + std::to_string(writers) + " writer" + (writers == 1 ? "" : "s") +
-                " matched, but silent)";
+          why = " (" + std::to_string(writers) + " writer" + plural(writers) +
+                " discovered, but no sample: silent, or another DDS implementation that does "
+                "not match this reader, docs/telemetry.md#interoperability)";
+        } else if (incompatible_reported > 0) {
+          why = " (writers with incompatible QoS only)";
         }
         std::fprintf(o.err,
                      "craneassist: error: no sample on %s within %g s on domain %d%s; is "

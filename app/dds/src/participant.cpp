@@ -22,6 +22,7 @@ ParticipantOptions participant_options(const config::TelemetryConfig& c) {
   o.domain_id = c.domain_id;
   o.name = c.participant_name;
   o.transport = c.transport;
+  o.type_propagation = c.type_propagation;
   return o;
 }
 
@@ -44,11 +45,15 @@ std::string file_uri(const std::string& path) {
   return "file://" + std::filesystem::absolute(path).lexically_normal().string();
 }
 
+// type_object: the legacy TYPE_OBJECT and TYPE_ID discovery parameters (Fast DDS 2.x's
+// dynamic-type readers use them; other implementations ignore them). type_information: the
+// XTypes TYPE_INFORMATION parameter, which Cyclone DDS rejects as invalid in Fast DDS 2.9's form:
+// its endpoints then never match ours (docs/telemetry.md#interoperability).
 template <typename PubSubType>
-void register_type(fdds::DomainParticipant& p) {
+void register_type(fdds::DomainParticipant& p, const config::TypePropagation& propagation) {
   fdds::TypeSupport type(new PubSubType());
-  type->auto_fill_type_object(true);
-  type->auto_fill_type_information(true);
+  type->auto_fill_type_object(propagation.type_object);
+  type->auto_fill_type_information(propagation.type_information);
   if (type.register_type(&p) != ReturnCode_t::RETCODE_OK) {
     throw std::runtime_error("DDS: cannot register type " + std::string(type.get_type_name()));
   }
@@ -62,6 +67,10 @@ ParticipantPtr make_participant(const ParticipantOptions& options) {
 
   fdds::DomainParticipantQos qos = fdds::PARTICIPANT_QOS_DEFAULT;
   qos.name(options.name);
+  // TYPE_INFORMATION names the types; the TypeLookup service answers a remote reader that asks
+  // for them (and for the nested ones) from it.
+  qos.wire_protocol().builtin.typelookup_config.use_server =
+      options.type_propagation.type_information;
   if (options.transport != config::DdsTransport::kDefault) {
     qos.transport().use_builtin_transports = false;
     if (options.transport == config::DdsTransport::kUdp) {
@@ -106,11 +115,12 @@ ParticipantPtr make_participant(const ParticipantOptions& options) {
   if (!options.register_types) return p;
   // Every reader of the participant deserializes with these: a malformed sample is dropped and
   // counted, never an exception on Fast DDS's thread (checked_types.hpp).
-  register_type<CheckedPubSubType<craneassist::msg::StatusPubSubType>>(*p);
-  register_type<CheckedPubSubType<craneassist::msg::JointStatePubSubType>>(*p);
-  register_type<CheckedPubSubType<craneassist::msg::HydraulicsPubSubType>>(*p);
-  register_type<CheckedPubSubType<craneassist::msg::CommandPathPubSubType>>(*p);
-  register_type<CheckedPubSubType<craneassist::msg::OperatorCommandPubSubType>>(*p);
+  const config::TypePropagation& types = options.type_propagation;
+  register_type<CheckedPubSubType<craneassist::msg::StatusPubSubType>>(*p, types);
+  register_type<CheckedPubSubType<craneassist::msg::JointStatePubSubType>>(*p, types);
+  register_type<CheckedPubSubType<craneassist::msg::HydraulicsPubSubType>>(*p, types);
+  register_type<CheckedPubSubType<craneassist::msg::CommandPathPubSubType>>(*p, types);
+  register_type<CheckedPubSubType<craneassist::msg::OperatorCommandPubSubType>>(*p, types);
   return p;
 }
 

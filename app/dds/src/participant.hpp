@@ -18,6 +18,9 @@ struct ParticipantOptions {
   int domain_id = 0;
   std::string name = "craneassist";
   config::DdsTransport transport = config::DdsTransport::kDefault;
+  // What discovery announces about the registered types (the settings' type_propagation;
+  // default: the interoperable one, no TYPE_INFORMATION).
+  config::TypePropagation type_propagation;
   // Non-empty: the participant authenticates with PKI-DH, checks access with signed governance
   // and permissions, and encrypts as governance says (every file must be given).
   config::SecurityFiles security;
@@ -35,8 +38,8 @@ struct ParticipantDeleter {
 using ParticipantPtr =
     std::unique_ptr<eprosima::fastdds::dds::DomainParticipant, ParticipantDeleter>;
 
-// Creates the participant and registers every craneassist type on it (with type objects, so
-// remote tools get the type information), unless options.register_types is false. Throws
+// Creates the participant and registers every craneassist type on it, announcing what
+// options.type_propagation says, unless options.register_types is false. Throws
 // std::runtime_error naming what failed (with security: which file, when Fast DDS says).
 ParticipantPtr make_participant(const ParticipantOptions& options);
 

@@ -73,6 +73,13 @@ void TopicReader::on_subscription_matched(fdds::DataReader* /*reader*/,
   wakeup_.notify();
 }
 
+void TopicReader::on_requested_incompatible_qos(fdds::DataReader* /*reader*/,
+                                                const fdds::RequestedIncompatibleQosStatus& s) {
+  incompatible_.store(static_cast<int>(s.total_count));
+  last_policy_.store(static_cast<std::uint32_t>(s.last_policy_id));
+  wakeup_.notify();
+}
+
 SubscriberSession::SubscriberSession(const ParticipantOptions& options,
                                      const std::vector<Topic>& topics, DataCallback on_data)
     : start_ns_(monotonic_ns()) {
@@ -111,12 +118,14 @@ double SubscriberSession::elapsed_s() const {
 
 std::unique_ptr<SubscriberSession> open_tool_session(const std::string& name, int domain_id,
                                                      config::DdsTransport transport,
+                                                     const config::TypePropagation& propagation,
                                                      const std::vector<Topic>& topics,
                                                      std::FILE* err, DataCallback on_data) {
   ParticipantOptions po;
   po.domain_id = domain_id;
   po.name = name;
   po.transport = transport;
+  po.type_propagation = propagation;
   try {
     return std::make_unique<SubscriberSession>(po, topics, std::move(on_data));
   } catch (const std::exception& e) {

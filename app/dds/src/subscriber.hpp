@@ -45,12 +45,23 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
   void on_data_available(eprosima::fastdds::dds::DataReader* reader) override;
   void on_subscription_matched(eprosima::fastdds::dds::DataReader* reader,
                                const eprosima::fastdds::dds::SubscriptionMatchedStatus& s) override;
+  void on_requested_incompatible_qos(
+      eprosima::fastdds::dds::DataReader* reader,
+      const eprosima::fastdds::dds::RequestedIncompatibleQosStatus& s) override;
 
   Topic topic() const { return topic_; }
   eprosima::fastdds::dds::DataReader& reader() { return *reader_; }
+  // Writers this reader matched. Fast DDS matches on its own side only: a writer of another DDS
+  // implementation that rejects this reader's discovery data (for example Cyclone DDS and Fast
+  // DDS 2.9's TYPE_INFORMATION) counts here and still never sends. Only a sample proves that
+  // both sides matched.
   int matched_writers() const { return matched_.load(); }
   // CLOCK_MONOTONIC of the first match with a writer; 0 while none has matched.
   std::int64_t first_match_ns() const { return first_match_ns_.load(); }
+  // Writers of the topic not matched because their QoS does not satisfy this reader's, and the
+  // last policy at fault (a Fast DDS QosPolicyId_t), so far.
+  int incompatible_writers() const { return incompatible_.load(); }
+  std::uint32_t last_incompatible_policy() const { return last_policy_.load(); }
 
  private:
   friend class SubscriberSession;
@@ -60,6 +71,8 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
   eprosima::fastdds::dds::DataReader* reader_ = nullptr;
   std::atomic<int> matched_{0};
   std::atomic<std::int64_t> first_match_ns_{0};
+  std::atomic<int> incompatible_{0};
+  std::atomic<std::uint32_t> last_policy_{0};
 };
 
 class SubscriberSession {
@@ -87,6 +100,7 @@ class SubscriberSession {
 // and the readers of topics. nullptr when DDS cannot be set up, after saying why on err.
 std::unique_ptr<SubscriberSession> open_tool_session(const std::string& name, int domain_id,
                                                      config::DdsTransport transport,
+                                                     const config::TypePropagation& propagation,
                                                      const std::vector<Topic>& topics,
                                                      std::FILE* err,
                                                      DataCallback on_data = nullptr);

@@ -162,7 +162,7 @@ struct TelemetryPublisher::Impl {
     fill_header(status.header(), f);
     status.crane(info.crane);
     status.backend(info.backend);
-    status.status(f.status);
+    status.state(f.status);
     status.stop_reason(f.stop_reason);
     status.active_limit(f.active_limit);
     status.pump_limit(f.pump_limit);

@@ -93,11 +93,27 @@ struct CommandInputSettings {
   SecurityFiles security;
 };
 
+// What a participant announces about its types in discovery (docs/telemetry.md#interoperability).
+// Every craneassist participant (telemetry, the command input, echo, dashboard, remote) uses the
+// same. The default is the interoperable one: Fast DDS 2.9's XTypes TYPE_INFORMATION record is
+// rejected as invalid by other DDS implementations (Eclipse Cyclone DDS), whose endpoints then
+// never match craneassist's.
+struct TypePropagation {
+  // The type object (the legacy TYPE_OBJECT and TYPE_ID parameters of the endpoint's discovery
+  // data): Fast DDS 2.x's dynamic-type readers build the type from it. Other implementations
+  // ignore it.
+  bool type_object = true;
+  // XTypes 1.3 TYPE_INFORMATION, with Fast DDS's TypeLookup service behind it. Off: Cyclone DDS
+  // and other implementations reject Fast DDS 2.9's record as invalid and match nothing.
+  bool type_information = false;
+};
+
 struct TelemetryConfig {
   bool enabled = true;  // telemetry publishing (open, unauthenticated: read-only data)
   int domain_id = 0;
   std::string participant_name = "craneassist";
   DdsTransport transport = DdsTransport::kDefault;
+  TypePropagation type_propagation;
   TopicSettings status{10.0, Reliability::kReliable, Durability::kTransientLocal, 1};
   TopicSettings joints{50.0, Reliability::kBestEffort, Durability::kVolatile, 1};
   TopicSettings hydraulics{50.0, Reliability::kBestEffort, Durability::kVolatile, 1};

@@ -18,6 +18,7 @@ namespace craneassist::dds {
 struct CommandWriterOptions {
   int domain_id = 0;
   config::DdsTransport transport = config::DdsTransport::kDefault;
+  config::TypePropagation type_propagation;  // the settings' type_propagation
   std::string participant_name = "craneassist-remote";
   config::TopicSettings topic;     // reliability and depth (commands.topic of the settings)
   config::SecurityFiles security;  // every file, or none with `insecure`

@@ -26,8 +26,9 @@ struct EchoOptions {
   double timeout_s = 0.0;  // > 0: fail (kToolRuntime) when no sample arrives this soon
   EchoFormat format = EchoFormat::kText;
   config::DdsTransport transport = config::DdsTransport::kDefault;
-  std::FILE* out = stdout;  // the samples
-  std::FILE* err = stderr;  // discovery and error messages
+  config::TypePropagation type_propagation;  // the settings' type_propagation
+  std::FILE* out = stdout;                   // the samples
+  std::FILE* err = stderr;                   // discovery and error messages
 };
 
 struct DashboardOptions {
@@ -37,7 +38,8 @@ struct DashboardOptions {
   bool once = false;
   double timeout_s = 0.0;  // > 0: fail (kToolRuntime) when a telemetry topic stays silent
   config::DdsTransport transport = config::DdsTransport::kDefault;
-  double refresh_s = 0.1;  // live view: redraw period
+  config::TypePropagation type_propagation;  // the settings' type_propagation
+  double refresh_s = 0.1;                    // live view: redraw period
   std::FILE* out = stdout;
   std::FILE* err = stderr;
 };
