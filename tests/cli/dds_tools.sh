@@ -4,23 +4,11 @@
 # Usage: dds_tools.sh CASE CRANEASSIST DDS_TEST_PUBLISHER DOMAIN
 #   CASE: echo | usage | timeout | dashboard | signal
 set -eu
-# Under AddressSanitizer (CRANEASSIST_SANITIZE): Debian's Fast DDS 2.9 (not instrumented) deletes
-# the statistics part of each DataReader with a mismatched size (new-delete-type-mismatch when a
-# subscriber exits). Not our code; the caller's other options stay. Without the sanitizers this
-# does nothing.
-export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}new_delete_type_mismatch=0"
+. "$(dirname "$0")/test_lib.sh"
 case_name=$1
 bin=$2
 publisher=$3
 domain=$4
-work=$(mktemp -d)
-pub_pid=
-cleanup() {
-  [ -n "$pub_pid" ] && kill -TERM "$pub_pid" 2>/dev/null && wait "$pub_pid" 2>/dev/null
-  rm -rf "$work"
-}
-trap cleanup EXIT
-fail() { echo "FAIL: $*"; exit 1; }
 # expect RC COMMAND...: runs the command, stdout to $work/out, stderr to $work/err.
 expect() {
   want=$1
@@ -29,10 +17,9 @@ expect() {
   "$@" > "$work/out" 2> "$work/err" || rc=$?
   [ "$rc" = "$want" ] || { cat "$work/out" "$work/err"; fail "$*: exit $rc, expected $want"; }
 }
-has() { grep -q -F -- "$2" "$work/$1" || { cat "$work/$1"; fail "no '$2' in $1"; }; }
 start_publisher() {
   "$publisher" "$domain" 20 > "$work/publisher.log" 2>&1 &
-  pub_pid=$!
+  bg_pid=$!
 }
 
 case $case_name in

@@ -8,23 +8,12 @@
 #   type_information: with `type_propagation.type_information: true` (Fast DDS 2.9's
 #     TYPE_INFORMATION record) Cyclone matches nothing: what the setting's default avoids
 set -eu
-# Under AddressSanitizer: Debian's Fast DDS 2.9 deletes the statistics part of each DataReader
-# with a mismatched size (not our code); see tests/cli/dds_tools.sh.
-export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}new_delete_type_mismatch=0"
+. "$(dirname "$0")/../cli/test_lib.sh"
 case_name=$1
 bin=$2
 cyclone=$3
 replay=$4
 domain=$5
-work=$(mktemp -d)
-bg_pid=
-cleanup() {
-  [ -n "$bg_pid" ] && kill -TERM "$bg_pid" 2>/dev/null && wait "$bg_pid" 2>/dev/null
-  rm -rf "$work"
-}
-trap cleanup EXIT
-fail() { echo "FAIL: $*"; exit 1; }
-has() { grep -q -F -- "$2" "$work/$1" || { cat "$work/$1"; fail "no '$2' in $1"; }; }
 
 # Starts cyclone_reader in the background, waits until its readers exist.
 start_reader() {

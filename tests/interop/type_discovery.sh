@@ -6,21 +6,12 @@
 #     top-level type only, so the reader's types lack their nested `header` (the known limit)
 #   type_information: TYPE_INFORMATION and the TypeLookup service: the types come whole
 set -eu
-export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}new_delete_type_mismatch=0"
+. "$(dirname "$0")/../cli/test_lib.sh"
 case_name=$1
 bin=$2
 discovery=$3
 replay=$4
 domain=$5
-work=$(mktemp -d)
-bg_pid=
-cleanup() {
-  [ -n "$bg_pid" ] && kill -TERM "$bg_pid" 2>/dev/null && wait "$bg_pid" 2>/dev/null
-  rm -rf "$work"
-}
-trap cleanup EXIT
-fail() { echo "FAIL: $*"; exit 1; }
-has() { grep -q -F -- "$2" "$work/$1" || { cat "$work/$1"; fail "no '$2' in $1"; }; }
 
 case $case_name in
 type_object) printf 'format: craneassist-telemetry/1\n' > "$work/telemetry.yaml" ;;
