@@ -140,8 +140,12 @@ say "kernel $release ($(basename "$kernel")), initramfs $(du -h "$work/initramfs
 # turns a kernel panic into qemu's exit 0, which is not a pass.
 log="$work/console.log"
 start="$(date +%s.%N)"
+# Two emulated CPUs where the host has two cores (multi-threaded TCG: one host thread each), so
+# the emulator and the control loop in the guest do not take turns on one CPU
+# (CRANEASSIST_CAN_VM_CPUS overrides).
+cpus="${CRANEASSIST_CAN_VM_CPUS:-$(($(nproc) >= 2 ? 2 : 1))}"
 set +e
-timeout --kill-after=10 "$timeout_s" qemu-system-x86_64 -accel tcg -m "$memory" -smp 1 \
+timeout --kill-after=10 "$timeout_s" qemu-system-x86_64 -accel tcg,thread=multi -m "$memory" -smp "$cpus" \
   -nodefaults -no-user-config -no-reboot -display none -serial stdio -nic none \
   -kernel "$kernel" -initrd "$work/initramfs.cpio" \
   -append "console=ttyS0 quiet loglevel=3 panic=-1 rdinit=/init ${CRANEASSIST_CAN_VM_APPEND:-}" \
