@@ -20,6 +20,7 @@
 
 #include "craneassist/input/gamepad.hpp"
 #include "craneassist/input/joystick_mapping.hpp"
+#include "craneassist/input/latest_pad.hpp"
 #include "pad_message.hpp"
 #include "scene.hpp"
 
@@ -149,18 +150,8 @@ struct WebServer::Impl {
   WsSession* holder = nullptr;
 
   // I/O thread -> loop: the page's stick state (the loop takes it with try_lock, never waits).
-  struct PadState {
-    input::GamepadState pad;
-    double stamp_s = 0.0;    // when it arrived (steady clock, s)
-    bool connected = false;  // a page holds the command
-    bool has_state = false;  // a page has held it
-  };
-  std::mutex pad_mutex;
-  PadState pad_state;
-  void publish(const PadState& s) {
-    std::lock_guard<std::mutex> lock(pad_mutex);
-    pad_state = s;
-  }
+  // `connected`: a page holds the command; `has_state`: a page has held it.
+  input::LatestPad pad;
   input::GamepadButton deadman_button = input::GamepadButton::kRightShoulder;
   std::atomic<bool> pad_source_made{false};
 
@@ -435,7 +426,7 @@ void WebServer::Impl::on_pad(WsSession& from, std::string_view text) {
     count(&WebCounters::pad_malformed);
     return;
   }
-  PadState s;
+  input::PadSnapshot s;
   for (std::size_t i = 0; i < input::kGamepadAxisCount && i < m.axes.size(); ++i) {
     s.pad.axes[i] = m.axes[i];
   }
@@ -449,7 +440,7 @@ void WebServer::Impl::on_pad(WsSession& from, std::string_view text) {
     reply("yours", "");
   }
   count(&WebCounters::pad_messages);
-  publish(s);
+  pad.publish(s);
 }
 
 void WebServer::Impl::on_closed(WsSession& session) {
@@ -460,11 +451,11 @@ void WebServer::Impl::on_closed(WsSession& session) {
 }
 
 void WebServer::Impl::publish_disconnected() {
-  PadState s;
+  input::PadSnapshot s;
   s.connected = false;
   s.has_state = true;
   s.stamp_s = input::steady_now_s();
-  publish(s);
+  pad.publish(s);
 }
 
 void WebServer::Impl::shutdown() {
@@ -485,10 +476,7 @@ class PadSource : public input::CommandSource {
 
   void begin_cycle(double, const Eigen::Vector3d& tip_m) noexcept override { tip_ = tip_m; }
   input::SourceState poll(input::OperatorCommand& out) noexcept override {
-    if (impl_.pad_mutex.try_lock()) {
-      taken_ = impl_.pad_state;
-      impl_.pad_mutex.unlock();
-    }
+    impl_.pad.try_take(taken_);
     if (!taken_.has_state) return input::SourceState::kNoData;
     if (!taken_.connected) return input::SourceState::kDisconnected;
     out.v_m_s = mapper_.map(taken_.pad, tip_);
@@ -501,7 +489,7 @@ class PadSource : public input::CommandSource {
  private:
   WebServer::Impl& impl_;
   input::JoystickMapper mapper_;
-  WebServer::Impl::PadState taken_;
+  input::PadSnapshot taken_;
   Eigen::Vector3d tip_ = Eigen::Vector3d::UnitX();
 };
 
