@@ -19,6 +19,7 @@
 #include <time.h>
 
 #include "craneassist_msgs.h"
+#include "cyclone_common.h"
 #include "dds/dds.h"
 
 enum { kStatus, kJoints, kHydraulics, kCommandPath, kTopics };
@@ -36,12 +37,6 @@ static long g_errors = 0;
       }                                                         \
     }                                                           \
   } while (0)
-
-static int64_t monotonic_ns(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
 
 struct TopicState {
   long count;
@@ -197,21 +192,10 @@ static void check_command_path(const craneassist_msg_CommandPath* m) {
 
 static dds_entity_t make_reader(dds_entity_t pp, const dds_topic_descriptor_t* desc,
                                 const char* name, bool reliable) {
-  const dds_entity_t topic = dds_create_topic(pp, desc, name, NULL, NULL);
-  if (topic < 0) {
-    fprintf(stderr, "cyclone reader: dds_create_topic %s: %s\n", name, dds_strretcode(-topic));
-    exit(3);
-  }
-  dds_qos_t* qos = dds_create_qos();
+  const dds_entity_t topic = create_topic_or_exit(pp, desc, name, "cyclone reader");
   /* status: reliable and transient local like craneassist's status writer (the last status
    * comes on matching); the others best effort and volatile like craneassist's writers. */
-  if (reliable) {
-    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-    dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
-  } else {
-    dds_qset_reliability(qos, DDS_RELIABILITY_BEST_EFFORT, 0);
-  }
-  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 256);
+  dds_qos_t* qos = craneassist_qos(reliable, DDS_SECS(1), 256);
   const dds_entity_t reader = dds_create_reader(pp, topic, qos, NULL);
   dds_delete_qos(qos);
   if (reader < 0) {

@@ -15,6 +15,7 @@
 #include <time.h>
 
 #include "craneassist_msgs.h"
+#include "cyclone_common.h"
 #include "dds/dds.h"
 
 static volatile sig_atomic_t g_stop = 0;
@@ -23,28 +24,10 @@ static void on_signal(int sig) {
   g_stop = 1;
 }
 
-static int64_t monotonic_ns(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
-
 static dds_entity_t make_writer(dds_entity_t pp, const dds_topic_descriptor_t* desc,
                                 const char* name, bool reliable) {
-  const dds_entity_t topic = dds_create_topic(pp, desc, name, NULL, NULL);
-  if (topic < 0) {
-    fprintf(stderr, "cyclone writer: dds_create_topic %s: %s\n", name, dds_strretcode(-topic));
-    exit(3);
-  }
-  dds_qos_t* qos = dds_create_qos();
-  /* craneassist's default QoS: status reliable and transient local, the others best effort. */
-  if (reliable) {
-    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(10));
-    dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
-  } else {
-    dds_qset_reliability(qos, DDS_RELIABILITY_BEST_EFFORT, 0);
-  }
-  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
+  const dds_entity_t topic = create_topic_or_exit(pp, desc, name, "cyclone writer");
+  dds_qos_t* qos = craneassist_qos(reliable, DDS_MSECS(10), 1);
   const dds_entity_t writer = dds_create_writer(pp, topic, qos, NULL);
   dds_delete_qos(qos);
   if (writer < 0) {
