@@ -20,12 +20,7 @@ so its figure leaves out the turns). Needs python3-matplotlib (Debian package).
 import argparse
 import math
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from craneassist_log import load  # noqa: E402
+from craneassist_log import load, pyplot
 
 MOVING_M_S = 0.05
 
@@ -57,6 +52,7 @@ def main():
     t = log["t"]
     n = len(t)
 
+    plt = pyplot()
     fig = plt.figure(figsize=(11, 12), constrained_layout=True)
     grid = fig.add_gridspec(4, 2, height_ratios=[1.3, 1, 1, 0.8])
     top, side = fig.add_subplot(grid[0, 0]), fig.add_subplot(grid[0, 1])

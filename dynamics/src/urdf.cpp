@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <vector>
 
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
@@ -58,7 +57,6 @@ struct Inertial {
 // The bodies on one DH frame, moved into a link frame by `link_from_frame`, combined.
 Inertial combine(const CraneModel& model, int frame, const Eigen::Isometry3d& link_from_frame) {
   Inertial out;
-  std::vector<std::pair<double, Eigen::Vector3d>> parts;
   for (const Body& b : model.bodies) {
     if (b.frame != frame || b.mass_kg <= 0.0) continue;
     out.mass += b.mass_kg;

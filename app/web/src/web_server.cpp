@@ -378,7 +378,7 @@ void WebServer::Impl::tick() {
       fresh = true;
     }
   }
-  if (fresh) {
+  if (fresh && !sessions.empty()) {  // no page: no drawing to compute
     scene.frame_json(taken, sent_seq, frame_text);
     broadcast(std::make_shared<const std::string>(frame_text));
   }
