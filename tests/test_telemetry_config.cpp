@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
 
 #include "craneassist/config/config_error.hpp"
 #include "craneassist/config/telemetry_config.hpp"
@@ -34,7 +35,47 @@ TEST(TelemetryConfig, ShippedDefaults) {
   EXPECT_DOUBLE_EQ(c.command_path.rate_hz, 50.0);
   EXPECT_FALSE(c.commands.enabled);
   EXPECT_TRUE(c.commands.security.empty());
+  // ROS 2 topics off; when on, ROS 2's default QoS (reliable, volatile) at 50 Hz.
+  EXPECT_FALSE(c.ros2.enabled);
+  EXPECT_EQ(c.ros2.ros_namespace, "");
+  expect_topic(c.ros2.joint_states, 50.0, Reliability::kReliable, Durability::kVolatile);
+  expect_topic(c.ros2.tip_velocity, 50.0, Reliability::kReliable, Durability::kVolatile);
+  EXPECT_EQ(c.ros2.dds_topic("joint_states"), "rt/joint_states");
   EXPECT_EQ(c.source_name, "<embedded config/telemetry/default.yaml>");
+}
+
+TEST(TelemetryConfig, Ros2Settings) {
+  const TelemetryConfig c = parse_telemetry_config(R"(format: craneassist-telemetry/1
+ros2:
+  enabled: true
+  namespace: /site_3/loader7
+  joint_states: {rate: 20 Hz, reliability: best_effort}
+  tip_velocity: {rate: 5 Hz, depth: 4}
+)",
+                                                   "r.yaml");
+  EXPECT_TRUE(c.ros2.enabled);
+  EXPECT_EQ(c.ros2.dds_topic("joint_states"), "rt/site_3/loader7/joint_states");
+  expect_topic(c.ros2.joint_states, 20.0, Reliability::kBestEffort, Durability::kVolatile);
+  expect_topic(c.ros2.tip_velocity, 5.0, Reliability::kReliable, Durability::kVolatile);
+  EXPECT_EQ(c.ros2.tip_velocity.depth, 4);
+}
+
+TEST(TelemetryConfig, Ros2NamespaceRules) {
+  for (const char* good : {"", "/a", "/crane1", "/_x/y_2/Z"}) {
+    EXPECT_EQ(ros_namespace_error(good), "") << good;
+  }
+  const std::pair<const char*, const char*> bad[] = {{"crane1", "start with '/'"},
+                                                     {"/crane1/", "end with '/'"},
+                                                     {"/", "end with '/'"},
+                                                     {"/a//b", "empty segment"},
+                                                     {"/a b", "letters, digits"},
+                                                     {"/kran-1", "letters, digits"},
+                                                     {"/1crane", "may not start with a digit"},
+                                                     {"/a/2b", "may not start with a digit"}};
+  for (const auto& [text, why] : bad) {
+    EXPECT_NE(ros_namespace_error(text).find(why), std::string::npos)
+        << text << ": " << ros_namespace_error(text);
+  }
 }
 
 TEST(TelemetryConfig, EveryFieldIsRead) {
@@ -102,6 +143,11 @@ TEST(TelemetryConfig, ErrorsNameFileLineAndField) {
                "unknown field (expected one of: type_object, type_information)");
   expect_error("type_propagation: none\n", 2, "type_propagation", "expected a mapping");
   expect_error("domian_id: 3\n", 2, "domian_id", "unknown field");
+  expect_error("ros2:\n  namespace: crane1\n", 3, "ros2.namespace", "must start with '/'");
+  expect_error("ros2:\n  enabled: on\n", 3, "ros2.enabled", "true or false");
+  expect_error("ros2:\n  joint_states:\n    rate: 2000 Hz\n", 4, "ros2.joint_states.rate",
+               "(0, 1000]");
+  expect_error("ros2:\n  jointstates: {}\n", 3, "ros2.jointstates", "unknown field");
   expect_error("domain_id: 3\ndomain_id: 4\n", 3, "domain_id", "duplicate key (first at line 2)");
   expect_error("topics:\n  joints:\n    rate: 50 Hz\n    depth: 2\n    rate: 5 Hz\n", 6,
                "topics.joints.rate", "duplicate key (first at line 4)");

@@ -269,7 +269,7 @@ int run_replay_command(const ReplayArgs& args) {
     if (const int rc = machines.open(cfg, args.machine, machine_inputs); rc != kExitOk) return rc;
     valves::MachineInterface& machine = machines.get();
     Telemetry telemetry;
-    const bool telemetry_wanted = args.telemetry.on || !args.telemetry.config_file.empty();
+    const bool telemetry_wanted = args.telemetry.asked();
     if (const int rc = telemetry.open(telemetry_settings, telemetry_wanted, cfg, machine.name());
         rc != kExitOk) {
       return rc;

@@ -16,6 +16,7 @@ struct Telemetry::Publishing {
   std::unique_ptr<dds::TelemetryPublisher> publisher;
   std::optional<TelemetryObserver> observer;
   int domain = 0;
+  bool ros2 = false;
 };
 
 Telemetry::Telemetry() = default;
@@ -44,6 +45,14 @@ int Telemetry::open(const config::TelemetryConfig& settings, bool wanted,
       "{:g} Hz, command_path {:g} Hz ({})",
       settings.domain_id, settings.status.rate_hz, settings.joints.rate_hz,
       settings.hydraulics.rate_hz, settings.command_path.rate_hz, settings.source_name);
+  if (settings.ros2.enabled) {
+    spdlog::info(
+        "telemetry: ROS 2 topics {0}/joint_states {1:g} Hz, {0}/craneassist/tip_velocity/command "
+        "and .../reference {2:g} Hz (DDS names rt{0}/...; docs/ros.md)",
+        settings.ros2.ros_namespace, settings.ros2.joint_states.rate_hz,
+        settings.ros2.tip_velocity.rate_hz);
+  }
+  publishing_->ros2 = settings.ros2.enabled;
   return kExitOk;
 }
 
@@ -62,6 +71,14 @@ void Telemetry::finish() {
       static_cast<unsigned long long>(s.samples_written[3]),
       static_cast<unsigned long long>(s.frames_dropped),
       static_cast<unsigned long long>(s.write_errors));
+  if (publishing_->ros2) {
+    std::printf(
+        "  telemetry ros2: samples joint_states %llu, tip_velocity/command %llu, "
+        "tip_velocity/reference %llu\n",
+        static_cast<unsigned long long>(s.ros2_samples_written[0]),
+        static_cast<unsigned long long>(s.ros2_samples_written[1]),
+        static_cast<unsigned long long>(s.ros2_samples_written[2]));
+  }
   publishing_.reset();
 }
 

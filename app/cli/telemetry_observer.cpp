@@ -65,6 +65,12 @@ dds::TelemetryInfo telemetry_info(const config::CraneConfig& config, const char*
   }
   info.flow_limit_m3_s = m.pump.max_flow_m3_s;
   info.power_limit_w = m.pump.prime_mover_power_w;
+  // crane_from_base is orthonormal: its inverse is its transpose.
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      info.base_from_crane[static_cast<std::size_t>(3 * r + c)] = m.task_from_base(c, r);
+    }
+  }
   return info;
 }
 

@@ -16,6 +16,10 @@ void add_telemetry_options(CLI::App& command, TelemetryArgs& args, bool on_by_de
       ->check(CLI::ExistingFile);
   command.add_option("--domain", args.domain, "DDS domain id (overrides the settings file)")
       ->check(CLI::Range(0, 232));
+  command.add_flag("--ros2", args.ros2,
+                   std::string("Also publish the standard ROS 2 topics /joint_states and "
+                               "/craneassist/tip_velocity/{command,reference} (docs/ros.md)") +
+                       (on_by_default ? "" : "; implies --telemetry"));
 }
 
 config::TelemetryConfig load_telemetry_settings(const TelemetryArgs& args) {
@@ -23,6 +27,7 @@ config::TelemetryConfig load_telemetry_settings(const TelemetryArgs& args) {
                                   ? config::default_telemetry_config()
                                   : config::load_telemetry_config(args.config_file);
   if (args.domain) c.domain_id = *args.domain;
+  if (args.ros2) c.ros2.enabled = true;
   return c;
 }
 

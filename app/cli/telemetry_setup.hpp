@@ -21,11 +21,15 @@ struct TelemetryArgs {
   bool off = false;           // sim: --no-telemetry
   std::string config_file;    // --telemetry-config FILE; empty: the embedded default
   std::optional<int> domain;  // --domain N overrides the file's domain_id
+  bool ros2 = false;          // --ros2: also the standard ROS 2 topics (settings ros2.enabled)
+
+  // replay: whether the options ask for telemetry.
+  bool asked() const { return on || ros2 || !config_file.empty(); }
 };
 
 // sim (publishes by default, as the settings file says): --no-telemetry, --telemetry-config,
-// --domain. replay (off by default): --telemetry, --telemetry-config (implies --telemetry),
-// --domain.
+// --domain, --ros2. replay (off by default): --telemetry, --telemetry-config and --ros2 (both
+// imply --telemetry), --domain.
 void add_telemetry_options(CLI::App& command, TelemetryArgs& args, bool on_by_default);
 
 // Reads the settings file and applies --domain; throws config::ConfigError.

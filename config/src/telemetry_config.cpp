@@ -105,7 +105,7 @@ TelemetryConfig read_config(const Reader& r, const YAML::Node& root, std::string
   c.source_name = std::string(source);
   r.check_keys(root, "",
                {"format", "enabled", "domain_id", "participant_name", "transport",
-                "type_propagation", "topics", "commands"});
+                "type_propagation", "topics", "commands", "ros2"});
   const YAML::Node format = r.child(root, "format", "");
   if (!format.IsScalar() || format.Scalar() != kFormat) {
     r.fail(format, "format", std::string("expected ") + kFormat);
@@ -165,10 +165,50 @@ TelemetryConfig read_config(const Reader& r, const YAML::Node& root, std::string
              "(docs/remote-commands.md)");
     }
   }
+  if (const YAML::Node ros = root["ros2"]; ros.IsDefined() && !ros.IsNull()) {
+    r.check_keys(ros, "ros2", {"enabled", "namespace", "joint_states", "tip_velocity"});
+    c.ros2.enabled = r.flag(ros, "enabled", "ros2", c.ros2.enabled);
+    c.ros2.ros_namespace = r.optional_text(ros, "namespace", "ros2");
+    if (const std::string why = ros_namespace_error(c.ros2.ros_namespace); !why.empty()) {
+      r.fail(ros["namespace"], "ros2.namespace", why);
+    }
+    const std::pair<const char*, TopicSettings*> all[] = {{"joint_states", &c.ros2.joint_states},
+                                                          {"tip_velocity", &c.ros2.tip_velocity}};
+    for (const auto& [name, settings] : all) {
+      const YAML::Node t = ros[name];
+      if (t.IsDefined() && !t.IsNull()) {
+        *settings = read_topic(r, t, Reader::join("ros2", name), *settings, true);
+      }
+    }
+  }
   return c;
 }
 
 }  // namespace
+
+std::string ros_namespace_error(std::string_view text) {
+  if (text.empty()) return "";
+  const std::string hint = " (e.g. /crane1; \"\" for none)";
+  if (text.front() != '/') return "must start with '/'" + hint;
+  if (text.back() == '/') return "must not end with '/'" + hint;
+  bool segment_start = true;
+  for (std::size_t i = 1; i < text.size(); ++i) {
+    const char ch = text[i];
+    if (ch == '/') {
+      if (segment_start) return "has an empty segment ('//')" + hint;
+      segment_start = true;
+      continue;
+    }
+    const bool letter = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z');
+    const bool digit = ch >= '0' && ch <= '9';
+    if (!(letter || digit || ch == '_')) {
+      return "may hold only letters, digits, '_' and '/'" + hint;
+    }
+    if (segment_start && digit) return "a segment may not start with a digit" + hint;
+    segment_start = false;
+  }
+  return "";
+}
 
 const char* to_string(Reliability r) {
   return r == Reliability::kReliable ? "reliable" : "best_effort";

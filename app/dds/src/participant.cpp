@@ -45,20 +45,6 @@ std::string file_uri(const std::string& path) {
   return "file://" + std::filesystem::absolute(path).lexically_normal().string();
 }
 
-// type_object: the legacy TYPE_OBJECT and TYPE_ID discovery parameters (Fast DDS 2.x's
-// dynamic-type readers use them; other implementations ignore them). type_information: the
-// XTypes TYPE_INFORMATION parameter, which Cyclone DDS rejects as invalid in Fast DDS 2.9's form:
-// its endpoints then never match ours (docs/telemetry.md#interoperability).
-template <typename PubSubType>
-void register_type(fdds::DomainParticipant& p, const config::TypePropagation& propagation) {
-  fdds::TypeSupport type(new PubSubType());
-  type->auto_fill_type_object(propagation.type_object);
-  type->auto_fill_type_information(propagation.type_information);
-  if (type.register_type(&p) != ReturnCode_t::RETCODE_OK) {
-    throw std::runtime_error("DDS: cannot register type " + std::string(type.get_type_name()));
-  }
-}
-
 }  // namespace
 
 ParticipantPtr make_participant(const ParticipantOptions& options) {
@@ -116,23 +102,27 @@ ParticipantPtr make_participant(const ParticipantOptions& options) {
   // Every reader of the participant deserializes with these: a malformed sample is dropped and
   // counted, never an exception on Fast DDS's thread (checked_types.hpp).
   const config::TypePropagation& types = options.type_propagation;
-  register_type<CheckedPubSubType<craneassist::msg::StatusPubSubType>>(*p, types);
-  register_type<CheckedPubSubType<craneassist::msg::JointStatePubSubType>>(*p, types);
-  register_type<CheckedPubSubType<craneassist::msg::HydraulicsPubSubType>>(*p, types);
-  register_type<CheckedPubSubType<craneassist::msg::CommandPathPubSubType>>(*p, types);
-  register_type<CheckedPubSubType<craneassist::msg::OperatorCommandPubSubType>>(*p, types);
+  register_type_support<CheckedPubSubType<craneassist::msg::StatusPubSubType>>(*p, types);
+  register_type_support<CheckedPubSubType<craneassist::msg::JointStatePubSubType>>(*p, types);
+  register_type_support<CheckedPubSubType<craneassist::msg::HydraulicsPubSubType>>(*p, types);
+  register_type_support<CheckedPubSubType<craneassist::msg::CommandPathPubSubType>>(*p, types);
+  register_type_support<CheckedPubSubType<craneassist::msg::OperatorCommandPubSubType>>(*p, types);
   return p;
+}
+
+fdds::Topic* find_or_create_topic(fdds::DomainParticipant& p, const std::string& name,
+                                  const std::string& type_name) {
+  if (fdds::TopicDescription* existing = p.lookup_topicdescription(name)) {
+    return static_cast<fdds::Topic*>(existing);
+  }
+  fdds::Topic* t = p.create_topic(name, type_name, fdds::TOPIC_QOS_DEFAULT);
+  if (t == nullptr) throw std::runtime_error("DDS: cannot create topic " + name);
+  return t;
 }
 
 fdds::Topic* get_topic(fdds::DomainParticipant& p, Topic topic) {
   const TopicInfo& info = topic_info(topic);
-  const std::string name(info.dds_name);
-  if (fdds::TopicDescription* existing = p.lookup_topicdescription(name)) {
-    return static_cast<fdds::Topic*>(existing);
-  }
-  fdds::Topic* t = p.create_topic(name, std::string(info.type_name), fdds::TOPIC_QOS_DEFAULT);
-  if (t == nullptr) throw std::runtime_error("DDS: cannot create topic " + name);
-  return t;
+  return find_or_create_topic(p, std::string(info.dds_name), std::string(info.type_name));
 }
 
 namespace {

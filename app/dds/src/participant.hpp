@@ -6,7 +6,9 @@
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "craneassist/config/telemetry_config.hpp"
@@ -42,6 +44,28 @@ using ParticipantPtr =
 // options.type_propagation says, unless options.register_types is false. Throws
 // std::runtime_error naming what failed (with security: which file, when Fast DDS says).
 ParticipantPtr make_participant(const ParticipantOptions& options);
+
+// Registers a type on the participant. type_object: the legacy TYPE_OBJECT and TYPE_ID discovery
+// parameters (Fast DDS 2.x's dynamic-type readers use them; other implementations ignore them).
+// type_information: the XTypes TYPE_INFORMATION parameter, which Cyclone DDS rejects as invalid
+// in Fast DDS 2.9's form: its endpoints then never match ours
+// (docs/telemetry.md#interoperability). Throws std::runtime_error naming the type.
+template <typename PubSubType>
+void register_type_support(eprosima::fastdds::dds::DomainParticipant& p,
+                           const config::TypePropagation& propagation) {
+  eprosima::fastdds::dds::TypeSupport type(new PubSubType());
+  type->auto_fill_type_object(propagation.type_object);
+  type->auto_fill_type_information(propagation.type_information);
+  if (type.register_type(&p) != ReturnCode_t::RETCODE_OK) {
+    throw std::runtime_error("DDS: cannot register type " + std::string(type.get_type_name()));
+  }
+}
+
+// The topic `name` of type `type_name` on the participant (created on first use); throws
+// std::runtime_error naming it when it cannot be created.
+eprosima::fastdds::dds::Topic* find_or_create_topic(eprosima::fastdds::dds::DomainParticipant& p,
+                                                    const std::string& name,
+                                                    const std::string& type_name);
 
 // The topic of `topic` on the participant (created on first use).
 eprosima::fastdds::dds::Topic* get_topic(eprosima::fastdds::dds::DomainParticipant& p, Topic topic);

@@ -9,12 +9,15 @@
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/publisher/qos/PublisherQos.hpp>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 #include <vector>
 
 #include "craneassist_msgs.h"
 #include "participant.hpp"
+#include "ros2_writers.hpp"
+#include "topic_pacer.hpp"
 
 namespace craneassist::dds {
 
@@ -49,8 +52,9 @@ struct TelemetryPublisher::Impl {
       : info(std::move(run_info)), ring(capacity + 1) {
     const config::TopicSettings* settings[kTelemetryTopics] = {
         &config.status, &config.joints, &config.hydraulics, &config.command_path};
-    for (int i = 0; i < kTelemetryTopics; ++i) period_s[i] = 1.0 / settings[i]->rate_hz;
+    for (int i = 0; i < kTelemetryTopics; ++i) pacers[i] = TopicPacer(settings[i]->rate_hz);
     participant = make_participant(participant_options(config));
+    if (config.ros2.enabled) register_ros2_types(*participant, config.type_propagation);
     publisher = participant->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
     if (publisher == nullptr) throw std::runtime_error("DDS: cannot create the publisher");
     const Topic topics[kTelemetryTopics] = {Topic::kStatus, Topic::kJoints, Topic::kHydraulics,
@@ -62,6 +66,9 @@ struct TelemetryPublisher::Impl {
         throw std::runtime_error("DDS: cannot create the writer of " +
                                  std::string(topic_info(topics[i]).dds_name));
       }
+    }
+    if (config.ros2.enabled) {
+      ros2.emplace(*participant, *publisher, config.ros2, info);
     }
     joints.names(info.joint_names);
     joints.prismatic(info.joint_prismatic);
@@ -93,6 +100,10 @@ struct TelemetryPublisher::Impl {
     thread.join();
     sem_destroy(&wake);
     for (auto*& w : writers) w = nullptr;
+    if (ros2) {
+      for (int i = 0; i < Ros2Writers::kTopics; ++i) ros2_written[i] = ros2->written(i);
+      ros2.reset();
+    }
     participant.reset();
   }
 
@@ -128,13 +139,9 @@ struct TelemetryPublisher::Impl {
   // Writes each topic whose period has passed (by machine time); force: every topic not yet
   // written for this frame.
   void publish(const TelemetryFrame& f, bool force) {
+    if (ros2 && !ros2->publish(f, force)) write_errors.fetch_add(1, std::memory_order_relaxed);
     for (int i = 0; i < kTelemetryTopics; ++i) {
-      const bool due =
-          !written_once[i] || f.t_s < last_t[i] || f.t_s - last_t[i] >= period_s[i] - 1e-9;
-      if (!(due || (force && last_cycle[i] != f.cycle))) continue;
-      last_t[i] = f.t_s;
-      last_cycle[i] = f.cycle;
-      written_once[i] = true;
+      if (!pacers[i].due(f, force)) continue;
       bool ok = false;
       switch (i) {
         case 0:
@@ -237,6 +244,10 @@ struct TelemetryPublisher::Impl {
         s.matched_readers += m.current_count;
       }
     }
+    for (int i = 0; i < Ros2Writers::kTopics; ++i) {
+      s.ros2_samples_written[i] = ros2 ? ros2->written(i) : ros2_written[i];
+    }
+    if (ros2) s.matched_readers += ros2->matched_readers();
     s.write_errors = write_errors.load();
     return s;
   }
@@ -245,11 +256,10 @@ struct TelemetryPublisher::Impl {
   ParticipantPtr participant;
   fdds::Publisher* publisher = nullptr;
   fdds::DataWriter* writers[kTelemetryTopics] = {};
-  double period_s[kTelemetryTopics] = {};
+  std::optional<Ros2Writers> ros2;                        // config ros2.enabled
+  std::uint64_t ros2_written[Ros2Writers::kTopics] = {};  // its counts, after close()
   // Publisher thread only:
-  double last_t[kTelemetryTopics] = {};
-  std::uint64_t last_cycle[kTelemetryTopics] = {};
-  bool written_once[kTelemetryTopics] = {};
+  TopicPacer pacers[kTelemetryTopics];
   craneassist::msg::Status status;
   craneassist::msg::JointState joints;
   craneassist::msg::Hydraulics hydraulics;

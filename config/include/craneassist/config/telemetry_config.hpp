@@ -108,6 +108,29 @@ struct TypePropagation {
   bool type_information = false;
 };
 
+// The standard ROS 2 topics beside craneassist's own (docs/ros.md): ROS 2's naming on the wire
+// (topic "rt/<namespace>/joint_states", type "sensor_msgs::msg::dds_::JointState_"), so RViz,
+// Foxglove, PlotJuggler and `ros2 topic echo` read them without a bridge.
+struct Ros2Settings {
+  bool enabled = false;
+  // The ROS 2 namespace of the topics: "" or "/name[/name...]" (ROS name characters).
+  std::string ros_namespace;
+  // /joint_states: sensor_msgs/msg/JointState, the joints by their URDF names.
+  TopicSettings joint_states{50.0, Reliability::kReliable, Durability::kVolatile, 1};
+  // /craneassist/tip_velocity/command and .../reference: geometry_msgs/msg/TwistStamped in
+  // base_link (the URDF's root).
+  TopicSettings tip_velocity{50.0, Reliability::kReliable, Durability::kVolatile, 1};
+
+  // The DDS topic name of a ROS 2 topic name under the namespace: "rt" + namespace + "/" + name.
+  std::string dds_topic(std::string_view ros_name) const {
+    return "rt" + ros_namespace + "/" + std::string(ros_name);
+  }
+};
+
+// Why `text` is not a ROS 2 namespace ("" or "/a/b" from letters, digits and '_', no segment
+// starting with a digit, no empty segment, no trailing '/'); "" when it is one.
+std::string ros_namespace_error(std::string_view text);
+
 struct TelemetryConfig {
   bool enabled = true;  // telemetry publishing (open, unauthenticated: read-only data)
   int domain_id = 0;
@@ -119,6 +142,7 @@ struct TelemetryConfig {
   TopicSettings hydraulics{50.0, Reliability::kBestEffort, Durability::kVolatile, 1};
   TopicSettings command_path{50.0, Reliability::kBestEffort, Durability::kVolatile, 1};
   CommandInputSettings commands;
+  Ros2Settings ros2;
   std::string source_name;  // file the settings came from, or "<embedded ...>"
 };
 

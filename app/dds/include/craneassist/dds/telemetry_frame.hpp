@@ -47,6 +47,9 @@ struct TelemetryInfo {
   std::vector<bool> joint_prismatic;  // per joint: q in m (true) or rad (false)
   double flow_limit_m3_s = 0.0;
   double power_limit_w = 0.0;
+  // Maps a crane-frame vector (tip commands: x forward, y up, z lateral) to the DH base frame,
+  // the URDF's base_link (the ROS 2 topics' frame). Row-major 3x3.
+  std::array<double, 9> base_from_crane{1, 0, 0, 0, 1, 0, 0, 0, 1};
 };
 
 }  // namespace craneassist::dds

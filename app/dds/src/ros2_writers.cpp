@@ -1,0 +1,111 @@
+#include "ros2_writers.hpp"
+
+#include <time.h>
+
+#include <algorithm>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+
+#include "participant.hpp"
+#include "ros2_msgsPubSubTypes.h"
+#include "ros2_msgsTypeObject.h"
+
+namespace craneassist::dds {
+
+namespace fdds = eprosima::fastdds::dds;
+
+namespace {
+
+constexpr const char* kTopicNames[Ros2Writers::kTopics] = {
+    "joint_states", "craneassist/tip_velocity/command", "craneassist/tip_velocity/reference"};
+constexpr const char* kTypeNames[Ros2Writers::kTopics] = {
+    "sensor_msgs::msg::dds_::JointState_", "geometry_msgs::msg::dds_::TwistStamped_",
+    "geometry_msgs::msg::dds_::TwistStamped_"};
+
+// The frame's monotonic stamp on the wall clock (ROS 2 stamps messages with the system time).
+builtin_interfaces::msg::dds_::Time_ wall_stamp(std::int64_t monotonic_stamp_ns) {
+  timespec mono{}, wall{};
+  clock_gettime(CLOCK_MONOTONIC, &mono);
+  clock_gettime(CLOCK_REALTIME, &wall);
+  const std::int64_t offset_ns =
+      (static_cast<std::int64_t>(wall.tv_sec) - mono.tv_sec) * 1000000000 +
+      (wall.tv_nsec - mono.tv_nsec);
+  const std::int64_t ns = monotonic_stamp_ns + offset_ns;
+  builtin_interfaces::msg::dds_::Time_ t;
+  t.sec(static_cast<std::int32_t>(ns / 1000000000));
+  t.nanosec(static_cast<std::uint32_t>(ns % 1000000000));
+  return t;
+}
+
+}  // namespace
+
+void register_ros2_types(fdds::DomainParticipant& p, const config::TypePropagation& propagation) {
+  static std::once_flag type_objects;
+  std::call_once(type_objects, [] { registerros2_msgsTypes(); });
+  register_type_support<sensor_msgs::msg::dds_::JointState_PubSubType>(p, propagation);
+  register_type_support<geometry_msgs::msg::dds_::TwistStamped_PubSubType>(p, propagation);
+}
+
+Ros2Writers::Ros2Writers(fdds::DomainParticipant& participant, fdds::Publisher& publisher,
+                         const config::Ros2Settings& settings, const TelemetryInfo& info)
+    : pacers_{TopicPacer(settings.joint_states.rate_hz), TopicPacer(settings.tip_velocity.rate_hz),
+              TopicPacer(settings.tip_velocity.rate_hz)},
+      base_from_crane_(info.base_from_crane) {
+  const config::TopicSettings* qos[kTopics] = {&settings.joint_states, &settings.tip_velocity,
+                                               &settings.tip_velocity};
+  for (int i = 0; i < kTopics; ++i) {
+    const std::string name = settings.dds_topic(kTopicNames[i]);
+    fdds::Topic* topic = find_or_create_topic(participant, name, kTypeNames[i]);
+    writers_[i] = publisher.create_datawriter(topic, writer_qos(*qos[i]));
+    if (writers_[i] == nullptr)
+      throw std::runtime_error("DDS: cannot create the writer of " + name);
+  }
+  joint_state_.name(info.joint_names);
+  twist_.header().frame_id("base_link");
+}
+
+bool Ros2Writers::publish(const TelemetryFrame& f, bool force) {
+  bool ok = true;
+  for (int i = 0; i < kTopics; ++i) {
+    if (!pacers_[i].due(f, force)) continue;
+    const bool wrote = i == 0   ? write_joint_states(f)
+                       : i == 1 ? write_twist(i, f.command_m_s, f)
+                                : write_twist(i, f.reference_m_s, f);
+    if (wrote) written_[i].fetch_add(1, std::memory_order_relaxed);
+    ok = ok && wrote;
+  }
+  return ok;
+}
+
+bool Ros2Writers::write_joint_states(const TelemetryFrame& f) {
+  const auto n = static_cast<std::size_t>(std::min(f.dof, kMaxJoints));
+  joint_state_.header().stamp(wall_stamp(f.stamp_ns));
+  joint_state_.position().assign(f.q.begin(), f.q.begin() + static_cast<std::ptrdiff_t>(n));
+  joint_state_.velocity().assign(f.qdot.begin(), f.qdot.begin() + static_cast<std::ptrdiff_t>(n));
+  return writers_[0]->write(&joint_state_);
+}
+
+bool Ros2Writers::write_twist(int topic, const std::array<double, 3>& v_crane,
+                              const TelemetryFrame& f) {
+  const auto& r = base_from_crane_;
+  twist_.header().stamp(wall_stamp(f.stamp_ns));
+  auto& linear = twist_.twist().linear();
+  linear.x(r[0] * v_crane[0] + r[1] * v_crane[1] + r[2] * v_crane[2]);
+  linear.y(r[3] * v_crane[0] + r[4] * v_crane[1] + r[5] * v_crane[2]);
+  linear.z(r[6] * v_crane[0] + r[7] * v_crane[1] + r[8] * v_crane[2]);
+  return writers_[topic]->write(&twist_);
+}
+
+int Ros2Writers::matched_readers() const {
+  int n = 0;
+  for (auto* w : writers_) {
+    fdds::PublicationMatchedStatus m;
+    if (w != nullptr && w->get_publication_matched_status(m) == ReturnCode_t::RETCODE_OK) {
+      n += m.current_count;
+    }
+  }
+  return n;
+}
+
+}  // namespace craneassist::dds

@@ -1,0 +1,52 @@
+// The standard ROS 2 topics of the telemetry (config ros2, docs/ros.md), internal to the dds
+// module: sensor_msgs/msg/JointState on <ns>/joint_states and geometry_msgs/msg/TwistStamped on
+// <ns>/craneassist/tip_velocity/{command,reference}, named as ROS 2 names them on the wire
+// ("rt/..." topics, "...::msg::dds_::..._" types). Runs on the publisher thread.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+
+#include "craneassist/config/telemetry_config.hpp"
+#include "craneassist/dds/telemetry_frame.hpp"
+#include "ros2_msgs.h"
+#include "topic_pacer.hpp"
+
+namespace craneassist::dds {
+
+// Registers the ROS 2 types on the participant (as `propagation` says).
+void register_ros2_types(eprosima::fastdds::dds::DomainParticipant& p,
+                         const config::TypePropagation& propagation);
+
+class Ros2Writers {
+ public:
+  static constexpr int kTopics = 3;  // joint_states, tip velocity command, tip velocity reference
+
+  // Creates the topics and writers; throws std::runtime_error naming what failed. The types
+  // must be registered.
+  Ros2Writers(eprosima::fastdds::dds::DomainParticipant& participant,
+              eprosima::fastdds::dds::Publisher& publisher, const config::Ros2Settings& settings,
+              const TelemetryInfo& info);
+
+  // Writes the topics that are due (TopicPacer); false when a write failed.
+  bool publish(const TelemetryFrame& f, bool force);
+
+  std::uint64_t written(int topic) const { return written_[topic].load(); }
+  int matched_readers() const;
+
+ private:
+  bool write_joint_states(const TelemetryFrame& f);
+  bool write_twist(int topic, const std::array<double, 3>& v_crane, const TelemetryFrame& f);
+
+  eprosima::fastdds::dds::DataWriter* writers_[kTopics] = {};
+  TopicPacer pacers_[kTopics];
+  std::array<double, 9> base_from_crane_;
+  sensor_msgs::msg::dds_::JointState_ joint_state_;
+  geometry_msgs::msg::dds_::TwistStamped_ twist_;
+  std::atomic<std::uint64_t> written_[kTopics] = {};
+};
+
+}  // namespace craneassist::dds

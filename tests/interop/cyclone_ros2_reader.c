@@ -1,0 +1,252 @@
+/* A ROS 2 subscriber's view of craneassist's ROS 2 topics (docs/ros.md), without ROS 2: an
+ * Eclipse Cyclone DDS reader (the default middleware of several ROS 2 releases) whose types
+ * Cyclone's idlc generates from ROS 2's own .msg definitions (ros2_msg_to_idl.py), with ROS 2's
+ * default subscription QoS (reliable, volatile, keep last 10). It reads
+ *   rt<NS>/joint_states                        sensor_msgs/msg/JointState
+ *   rt<NS>/craneassist/tip_velocity/command    geometry_msgs/msg/TwistStamped
+ *   rt<NS>/craneassist/tip_velocity/reference  geometry_msgs/msg/TwistStamped
+ * and craneassist's own craneassist/status and craneassist/joints, until a status says `stopped`
+ * or SECONDS pass, and checks:
+ *   - JointState: the joint names are JOINTS (the URDF's), one position and velocity per joint,
+ *     no effort, finite; the stamp is this host's wall clock a moment ago; the last positions
+ *     equal the last q of craneassist/joints (the same cycle, as the run's final sample);
+ *   - TwistStamped: frame base_link, no angular part, the stamp as above; the command is
+ *     COMMAND (the replay's constant command, in base_link) in at least one sample; every
+ *     nonzero reference points along COMMAND (one scale factor on the whole motion).
+ *
+ * Usage: cyclone_ros2_reader DOMAIN SECONDS NAMESPACE JOINTS COMMAND
+ *   NAMESPACE: "" or /name; JOINTS: slew,lift,tilt,extension; COMMAND: vx,vy,vz (m/s, base_link)
+ * Exit 0: every check passed; 1: a check failed (each on stderr); 2: usage; 3: DDS failed.
+ * "cyclone ros2 reader: ready" on stdout once the readers exist. */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime */
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "craneassist_msgs.h"
+#include "cyclone_common.h"
+#include "dds/dds.h"
+#include "ros2_msgs_from_msg.h"
+
+enum { kJointStates, kCommand, kReference, kStatus, kJoints, kTopics };
+static const char* const kNames[kTopics] = {"joint_states", "tip_velocity/command",
+                                            "tip_velocity/reference", "craneassist/status",
+                                            "craneassist/joints"};
+
+static long g_errors = 0;
+#define CHECK(cond, topic, ...)                                      \
+  do {                                                               \
+    if (!(cond)) {                                                   \
+      if (++g_errors <= 20) {                                        \
+        fprintf(stderr, "cyclone ros2 reader: %s: ", kNames[topic]); \
+        fprintf(stderr, __VA_ARGS__);                                \
+        fprintf(stderr, " (check: %s)\n", #cond);                    \
+      }                                                              \
+    }                                                                \
+  } while (0)
+
+static long g_count[kTopics];
+static char* g_joint_names[8];
+static int g_dof = 0;
+static double g_command[3];
+static long g_command_matches = 0, g_command_nan = 0, g_reference_moving = 0;
+static double g_last_position[8], g_last_q[8];
+static int g_last_position_n = -1, g_last_q_n = -1;
+static double g_stamp_age_max_s = 0.0;
+static char g_last_status[32] = "";
+
+static int64_t wall_ns(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_REALTIME, &ts);
+  return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+/* A ROS 2 header: stamped with this host's wall clock within the last 2 s. */
+static void check_header(int topic, const std_msgs_msg_dds__Header_* h, const char* frame_id) {
+  const int64_t stamp = (int64_t)h->stamp.sec * 1000000000 + h->stamp.nanosec;
+  const double age_s = (double)(wall_ns() - stamp) * 1e-9;
+  CHECK(h->stamp.nanosec < 1000000000u, topic, "nanosec %u", h->stamp.nanosec);
+  CHECK(age_s > -0.01 && age_s < 2.0, topic, "stamp %d.%09u is %.3f s old", h->stamp.sec,
+        h->stamp.nanosec, age_s);
+  if (age_s > g_stamp_age_max_s) g_stamp_age_max_s = age_s;
+  CHECK(h->frame_id != NULL && strcmp(h->frame_id, frame_id) == 0, topic,
+        "frame_id '%s', expected '%s'", h->frame_id ? h->frame_id : "(null)", frame_id);
+}
+
+static void check_joint_state(const sensor_msgs_msg_dds__JointState_* m) {
+  check_header(kJointStates, &m->header, "");
+  CHECK((int)m->name._length == g_dof, kJointStates, "%u names", m->name._length);
+  for (uint32_t i = 0; i < m->name._length && (int)i < g_dof; ++i) {
+    CHECK(strcmp(m->name._buffer[i], g_joint_names[i]) == 0, kJointStates, "name %u '%s'", i,
+          m->name._buffer[i]);
+  }
+  CHECK((int)m->position._length == g_dof, kJointStates, "%u positions", m->position._length);
+  CHECK((int)m->velocity._length == g_dof, kJointStates, "%u velocities", m->velocity._length);
+  CHECK(m->effort._length == 0, kJointStates, "%u efforts", m->effort._length);
+  for (uint32_t i = 0; i < m->position._length && i < 8; ++i) {
+    CHECK(isfinite(m->position._buffer[i]), kJointStates, "position %u", i);
+    g_last_position[i] = m->position._buffer[i];
+  }
+  for (uint32_t i = 0; i < m->velocity._length; ++i) {
+    CHECK(isfinite(m->velocity._buffer[i]), kJointStates, "velocity %u", i);
+  }
+  g_last_position_n = (int)m->position._length;
+}
+
+static void check_twist(int topic, const geometry_msgs_msg_dds__TwistStamped_* m) {
+  check_header(topic, &m->header, "base_link");
+  const geometry_msgs_msg_dds__Vector3_* a = &m->twist.angular;
+  CHECK(a->x == 0.0 && a->y == 0.0 && a->z == 0.0, topic, "angular %g %g %g", a->x, a->y, a->z);
+  const double v[3] = {m->twist.linear.x, m->twist.linear.y, m->twist.linear.z};
+  if (topic == kCommand) {
+    /* NaN: no valid operator command (the replay's start and end); else the replay's. */
+    if (isnan(v[0]) && isnan(v[1]) && isnan(v[2])) {
+      ++g_command_nan;
+      return;
+    }
+    CHECK(isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]), topic, "linear %g %g %g", v[0], v[1],
+          v[2]);
+    if (fabs(v[0] - g_command[0]) < 1e-12 && fabs(v[1] - g_command[1]) < 1e-12 &&
+        fabs(v[2] - g_command[2]) < 1e-12) {
+      ++g_command_matches;
+    }
+    return;
+  }
+  CHECK(isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]), topic, "linear %g %g %g", v[0], v[1],
+        v[2]);
+  const double speed = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  if (speed < 1e-6) return;
+  ++g_reference_moving;
+  const double c =
+      sqrt(g_command[0] * g_command[0] + g_command[1] * g_command[1] + g_command[2] * g_command[2]);
+  const double cosine =
+      (v[0] * g_command[0] + v[1] * g_command[1] + v[2] * g_command[2]) / (speed * c);
+  CHECK(cosine > 1.0 - 1e-9, topic, "linear %g %g %g is not along the command (cos %.12f)", v[0],
+        v[1], v[2], cosine);
+}
+
+static void take_all(dds_entity_t reader, int topic) {
+  enum { kMax = 64 };
+  void* samples[kMax] = {NULL};
+  dds_sample_info_t infos[kMax];
+  const dds_return_t n = dds_take(reader, samples, infos, kMax, kMax);
+  if (n < 0) {
+    fprintf(stderr, "cyclone ros2 reader: dds_take %s: %s\n", kNames[topic], dds_strretcode(-n));
+    exit(3);
+  }
+  for (dds_return_t i = 0; i < n; ++i) {
+    if (!infos[i].valid_data) continue;
+    ++g_count[topic];
+    if (topic == kJointStates) {
+      check_joint_state(samples[i]);
+    } else if (topic == kCommand || topic == kReference) {
+      check_twist(topic, samples[i]);
+    } else if (topic == kStatus) {
+      const craneassist_msg_Status* s = samples[i];
+      snprintf(g_last_status, sizeof g_last_status, "%s", s->state ? s->state : "");
+    } else {
+      const craneassist_msg_JointState* j = samples[i];
+      for (uint32_t k = 0; k < j->q._length && k < 8; ++k) g_last_q[k] = j->q._buffer[k];
+      g_last_q_n = (int)j->q._length;
+    }
+  }
+  if (n > 0) dds_return_loan(reader, samples, n);
+}
+
+static dds_entity_t make_reader(dds_entity_t pp, const dds_topic_descriptor_t* desc,
+                                const char* name, dds_qos_t* qos) {
+  const dds_entity_t topic = create_topic_or_exit(pp, desc, name, "cyclone ros2 reader");
+  const dds_entity_t reader = dds_create_reader(pp, topic, qos, NULL);
+  dds_delete_qos(qos);
+  if (reader < 0) {
+    fprintf(stderr, "cyclone ros2 reader: dds_create_reader %s: %s\n", name,
+            dds_strretcode(-reader));
+    exit(3);
+  }
+  return reader;
+}
+
+/* ROS 2's default subscription QoS (rmw_qos_profile_default). */
+static dds_qos_t* ros2_default_qos(void) {
+  dds_qos_t* qos = dds_create_qos();
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
+  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
+  return qos;
+}
+
+int main(int argc, char** argv) {
+  if (argc != 6 ||
+      sscanf(argv[5], "%lf,%lf,%lf", &g_command[0], &g_command[1], &g_command[2]) != 3) {
+    fprintf(stderr, "usage: cyclone_ros2_reader DOMAIN SECONDS NAMESPACE JOINTS VX,VY,VZ\n");
+    return 2;
+  }
+  const dds_domainid_t domain = (dds_domainid_t)atoi(argv[1]);
+  const double seconds = atof(argv[2]);
+  const char* ns = argv[3];
+  for (char* name = strtok(argv[4], ","); name != NULL && g_dof < 8; name = strtok(NULL, ",")) {
+    g_joint_names[g_dof++] = name;
+  }
+  char names[3][256];
+  snprintf(names[0], sizeof names[0], "rt%s/joint_states", ns);
+  snprintf(names[1], sizeof names[1], "rt%s/craneassist/tip_velocity/command", ns);
+  snprintf(names[2], sizeof names[2], "rt%s/craneassist/tip_velocity/reference", ns);
+
+  const dds_entity_t pp = dds_create_participant(domain, NULL, NULL);
+  if (pp < 0) {
+    fprintf(stderr, "cyclone ros2 reader: dds_create_participant: %s\n", dds_strretcode(-pp));
+    return 3;
+  }
+  const dds_entity_t readers[kTopics] = {
+      make_reader(pp, &sensor_msgs_msg_dds__JointState__desc, names[0], ros2_default_qos()),
+      make_reader(pp, &geometry_msgs_msg_dds__TwistStamped__desc, names[1], ros2_default_qos()),
+      make_reader(pp, &geometry_msgs_msg_dds__TwistStamped__desc, names[2], ros2_default_qos()),
+      make_reader(pp, &craneassist_msg_Status_desc, "craneassist/status",
+                  craneassist_qos(true, DDS_SECS(1), 16)),
+      make_reader(pp, &craneassist_msg_JointState_desc, "craneassist/joints",
+                  craneassist_qos(false, 0, 16))};
+  printf("cyclone ros2 reader: ready on domain %d\n", (int)domain);
+  fflush(stdout);
+
+  const int64_t start = monotonic_ns();
+  int64_t stopped_at = 0;
+  while ((double)(monotonic_ns() - start) * 1e-9 < seconds) {
+    if (stopped_at != 0 && monotonic_ns() - stopped_at > 500000000) break;
+    for (int t = 0; t < kTopics; ++t) take_all(readers[t], t);
+    if (stopped_at == 0 && strcmp(g_last_status, "stopped") == 0) stopped_at = monotonic_ns();
+    dds_sleepfor(DDS_MSECS(5));
+  }
+  dds_delete(pp);
+
+  double last_diff = 0.0;
+  bool same_joints = g_last_position_n == g_dof && g_last_q_n == g_dof;
+  for (int i = 0; same_joints && i < g_dof; ++i) {
+    last_diff = fmax(last_diff, fabs(g_last_position[i] - g_last_q[i]));
+  }
+  CHECK(same_joints && last_diff == 0.0, kJointStates,
+        "last positions differ from the last craneassist/joints q by %g", last_diff);
+  CHECK(g_command_matches > 0, kCommand, "never (%g, %g, %g)", g_command[0], g_command[1],
+        g_command[2]);
+  CHECK(g_reference_moving > 0, kReference, "never moving");
+  printf(
+      "cyclone ros2 reader: received joint_states %ld, tip_velocity/command %ld, "
+      "tip_velocity/reference %ld; status %ld, joints %ld; last status '%s'; command "
+      "(%g, %g, %g) in %ld samples, NaN in %ld; %ld moving references along it; last positions "
+      "= last craneassist q: %s; stamp age max %.1f ms; %ld failed checks\n",
+      g_count[kJointStates], g_count[kCommand], g_count[kReference], g_count[kStatus],
+      g_count[kJoints], g_last_status, g_command[0], g_command[1], g_command[2], g_command_matches,
+      g_command_nan, g_reference_moving, same_joints && last_diff == 0.0 ? "yes" : "no",
+      1e3 * g_stamp_age_max_s, g_errors);
+  bool ok = g_errors == 0;
+  for (int t = 0; t < kTopics; ++t) {
+    if (g_count[t] == 0) {
+      fprintf(stderr, "cyclone ros2 reader: no sample on %s\n", kNames[t]);
+      ok = false;
+    }
+  }
+  return ok ? 0 : 1;
+}
