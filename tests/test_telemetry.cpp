@@ -29,6 +29,7 @@
 
 #include "craneassist/config/telemetry_config.hpp"
 #include "craneassist/dds/telemetry_publisher.hpp"
+#include "craneassist/dds/telemetry_watch.hpp"
 #include "craneassist/dds/topics.hpp"
 #include "craneassist_msgs.h"
 #include "dds_test_frames.hpp"
@@ -308,6 +309,75 @@ TEST(Telemetry, EveryTopicRoundTripsEveryField) {
   EXPECT_EQ(c.sddot_max(), 0.8);
   pub.close();
   EXPECT_EQ(pub.stats().frames_dropped, 0u);
+}
+
+// `craneassist web`'s side: the four topics of a publisher, assembled again into the frame the
+// loop pushed (the last one, which close() publishes on every topic), every field.
+TEST(Telemetry, TheWatchAssemblesThePublishedFrame) {
+  cdds::TelemetryWatch watch(cdds::WatchOptions{109, {}, {}, "watch"});
+  cdds::TelemetryPublisher pub(settings(109), info());
+  // Matched on both sides (best-effort samples before that are lost).
+  for (int i = 0; i < 500 && (watch.run().writers < 4 || pub.stats().matched_readers < 4); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_EQ(watch.run().writers, 4);
+  ASSERT_EQ(pub.stats().matched_readers, 4);
+  for (std::uint64_t k = 0; k < 20; ++k) ASSERT_TRUE(pub.push(frame(k)));
+  pub.close();
+  cdds::TelemetryFrame got;
+  const cdds::TelemetryFrame want = frame(19);
+  std::uint64_t seen = 0;
+  for (int i = 0; i < 300 && !(got.cycle == 19 && std::string(got.status) == "running" &&
+                               got.pump_flow_m3_s == want.pump_flow_m3_s && got.sdot != 0.0);
+       ++i) {
+    watch.latest(got, seen);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_EQ(got.cycle, 19u);
+  EXPECT_EQ(got.t_s, want.t_s);
+  EXPECT_GT(got.stamp_ns, 0);
+  ASSERT_EQ(got.dof, 4);
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(got.q[i], want.q[i]);
+    EXPECT_EQ(got.q_ref[i], want.q_ref[i]);
+    EXPECT_EQ(got.qdot[i], want.qdot[i]);
+    EXPECT_EQ(got.cylinder_pos_m[i], want.cylinder_pos_m[i]);
+    EXPECT_EQ(got.cylinder_vel_m_s[i], want.cylinder_vel_m_s[i]);
+    EXPECT_EQ(got.load_pressure_pa[i], want.load_pressure_pa[i]);
+    EXPECT_EQ(got.spool[i], want.spool[i]);
+  }
+  EXPECT_EQ(got.tip_m, want.tip_m);
+  EXPECT_EQ(got.tip_v_m_s, want.tip_v_m_s);
+  EXPECT_EQ(got.command_m_s, want.command_m_s);
+  EXPECT_EQ(got.reference_m_s, want.reference_m_s);
+  EXPECT_EQ(got.pump_flow_m3_s, want.pump_flow_m3_s);
+  EXPECT_EQ(got.pump_pressure_pa, want.pump_pressure_pa);
+  EXPECT_EQ(got.pump_power_w, want.pump_power_w);
+  EXPECT_EQ(got.energy_j, want.energy_j);
+  EXPECT_EQ(got.flow_demand_m3_s, want.flow_demand_m3_s);
+  EXPECT_EQ(got.ref_power_w, want.ref_power_w);
+  EXPECT_EQ(got.scale, want.scale);
+  EXPECT_EQ(got.s, want.s);
+  EXPECT_EQ(got.sdot, want.sdot);
+  EXPECT_EQ(got.sddot, want.sddot);
+  EXPECT_EQ(got.sdddot, want.sdddot);
+  EXPECT_EQ(got.sddot_min, want.sddot_min);
+  EXPECT_EQ(got.sddot_max, want.sddot_max);
+  EXPECT_EQ(got.tip_error_m, want.tip_error_m);
+  EXPECT_STREQ(got.status, want.status);
+  EXPECT_STREQ(got.stop_reason, want.stop_reason);
+  EXPECT_STREQ(got.active_limit, want.active_limit);
+  EXPECT_STREQ(got.pump_limit, want.pump_limit);
+  EXPECT_STREQ(got.input_source, want.input_source);
+  EXPECT_EQ(got.deadman, want.deadman);
+  EXPECT_EQ(got.loop_latency_max_s, want.loop_latency_max_s);
+  EXPECT_EQ(got.loop_compute_s, want.loop_compute_s);
+  EXPECT_EQ(got.loop_overruns, want.loop_overruns);
+  const cdds::WatchedRun run = watch.run();
+  EXPECT_EQ(run.crane, "test crane");
+  EXPECT_EQ(run.backend, "sim");
+  EXPECT_EQ(run.joint_names, (std::vector<std::string>{"slew", "lift", "tilt", "extension"}));
+  EXPECT_EQ(run.malformed, 0u);
 }
 
 // 2 s of machine time at 100 Hz: status at 10 Hz and the others at 50 Hz (the defaults), a

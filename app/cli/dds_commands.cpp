@@ -1,13 +1,20 @@
 #include "dds_commands.hpp"
 
+#include <spdlog/spdlog.h>
+
+#include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <thread>
 
+#include "crane_options.hpp"
 #include "craneassist/config/config_error.hpp"
 #include "craneassist/config/telemetry_config.hpp"
+#include "craneassist/dds/telemetry_watch.hpp"
 #include "craneassist/dds/tools.hpp"
 #include "exit_codes.hpp"
 #include "option_checks.hpp"
+#include "telemetry_observer.hpp"
 
 namespace craneassist::cli {
 namespace {
@@ -135,6 +142,130 @@ int run_dashboard_command(const DashboardArgs& args) {
   apply_common_options(o, args, *settings);
   StopOnSignal stop;
   return dds::run_dashboard(o);
+}
+
+CLI::App* add_web_watch_command(CLI::App& cli, WebWatchArgs& args) {
+  auto* web = cli.add_subcommand(
+      "web",
+      "Serve the web view (3-D crane, gauges, live plots) of a craneassist sim or replay running "
+      "elsewhere, from its DDS telemetry; a view only (docs/web.md#watching-a-run)");
+  add_config_option(*web, args.crane_file)
+      ->description(
+          "The crane config of the watched run: the page draws its geometry (default: "
+          "the embedded K70M reference crane)");
+  web->add_option("--web-listen", args.web.listen,
+                  "Where the page is served, ADDR:PORT (port 0: any free port)")
+      ->capture_default_str();
+  web->add_option("--web-rate", args.web.frame_rate_hz, "Frames per second streamed to each page")
+      ->check(FiniteRange(1.0, 100.0))
+      ->capture_default_str();
+  web->add_option("--duration", args.duration_s,
+                  "Serve this many seconds, then exit (default: until Ctrl-C)")
+      ->check(FiniteRange(1e-3, 1e7));
+  add_common_options(*web, args,
+                     "Fail (exit 3) when no telemetry arrives within this many seconds (default: "
+                     "wait)");
+  return web;
+}
+
+namespace {
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+// What the watched run says that the page cannot draw right: another crane's joints.
+void warn_if_other_crane(const dds::WatchedRun& run, const config::CraneConfig& cfg) {
+  std::vector<std::string> expected;
+  for (const auto& j : cfg.model.joints) expected.push_back(j.name);
+  if (!run.joint_names.empty() && run.joint_names != expected) {
+    spdlog::warn(
+        "web: the watched crane's joints ({}) are not --config's ({}): the page draws --config's "
+        "crane; give the watched run's config",
+        joined(run.joint_names), joined(expected));
+  } else if (!run.crane.empty() && run.crane != cfg.model.name) {
+    spdlog::warn("web: watching crane '{}' while --config is '{}'", run.crane, cfg.model.name);
+  }
+}
+
+}  // namespace
+
+int run_web_watch_command(const WebWatchArgs& args) {
+  const auto settings = tool_settings(args);
+  if (!settings) return kExitUsage;
+  config::CraneConfig cfg;
+  try {
+    cfg = load_crane(args.crane_file);
+  } catch (...) {
+    return input_error_exit("config");
+  }
+  WebView view;
+  if (const int rc = view.open(args.web, cfg, /*commands=*/false); rc != kExitOk) return rc;
+  std::unique_ptr<dds::TelemetryWatch> watch;
+  try {
+    dds::WatchOptions o;
+    o.domain_id = settings->domain_id;
+    o.transport = settings->transport;
+    o.type_propagation = settings->type_propagation;
+    watch = std::make_unique<dds::TelemetryWatch>(o);
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return kExitRuntime;
+  }
+  spdlog::info("web: watching the telemetry on DDS domain {} (a view only: drive with `sim --web`)",
+               settings->domain_id);
+  StopOnSignal stop;
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  const auto elapsed_s = [&] {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  };
+  dds::TelemetryFrame frame;
+  control::LogRow row;
+  std::uint64_t seen = 0;
+  bool receiving = false, announced = false;
+  std::string last_status;
+  int rc = kExitOk;
+  while (!dds::stop_requested()) {
+    if (args.duration_s > 0.0 && elapsed_s() >= args.duration_s) break;
+    if (watch->latest(frame, seen)) {
+      from_frame(frame, row);
+      view.publish(row);
+      receiving = true;
+      if (!announced) {  // once the status (the crane's name) and the joints are in
+        const dds::WatchedRun run = watch->run();
+        if (!run.crane.empty() && !run.joint_names.empty()) {
+          announced = true;
+          spdlog::info("web: receiving from crane '{}' ({} backend), {:.2f} s after start",
+                       run.crane, run.backend, elapsed_s());
+          warn_if_other_crane(run, cfg);
+        }
+      }
+      if (last_status != frame.status) {
+        last_status = frame.status;
+        if (last_status == "stopped") {
+          spdlog::info("web: the watched run stopped{}{}", *frame.stop_reason ? ": " : "",
+                       frame.stop_reason);
+        }
+      }
+    } else if (!receiving && args.timeout_s > 0.0 && elapsed_s() > args.timeout_s) {
+      const dds::WatchedRun run = watch->run();
+      spdlog::error(
+          "web: no telemetry on DDS domain {} within {:g} s ({} writers discovered; is a sim "
+          "running, or a replay with --telemetry, on this domain? docs/telemetry.md)",
+          settings->domain_id, args.timeout_s, run.writers);
+      rc = kExitRuntime;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  const dds::WatchedRun run = watch->run();
+  std::printf("  web watch: %llu samples from crane '%s', %llu malformed\n%s\n",
+              static_cast<unsigned long long>(run.samples), run.crane.c_str(),
+              static_cast<unsigned long long>(run.malformed), view.report().c_str());
+  return rc;
 }
 
 }  // namespace craneassist::cli

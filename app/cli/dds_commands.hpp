@@ -1,11 +1,14 @@
-// `craneassist echo TOPIC` and `craneassist dashboard`: DDS subscribers that print one topic's
-// samples or show the telemetry live (docs/dashboard.md). They need no crane config and have
-// no link to the control loop: they work against any craneassist on the same DDS domain.
+// `craneassist echo TOPIC`, `craneassist dashboard` and `craneassist web`: DDS subscribers that
+// print one topic's samples, show the telemetry live in the terminal (docs/dashboard.md) or serve
+// it to the web view (docs/web.md#watching-a-run). They have no link to the control loop: they
+// work against any craneassist on the same DDS domain.
 #pragma once
 
 #include <CLI/CLI.hpp>
 #include <optional>
 #include <string>
+
+#include "web_view.hpp"
 
 namespace craneassist::cli {
 
@@ -28,10 +31,19 @@ struct DashboardArgs : DdsToolArgs {
   bool once = false;
 };
 
+struct WebWatchArgs : DdsToolArgs {
+  std::string crane_file;   // --config: the crane the page draws (empty: the K70M reference)
+  WebArgs web;              // --web-listen, --web-rate
+  double duration_s = 0.0;  // > 0: serve this long; 0: until Ctrl-C or SIGTERM
+};
+
 CLI::App* add_echo_command(CLI::App& cli, EchoArgs& args);
 int run_echo_command(const EchoArgs& args);
 
 CLI::App* add_dashboard_command(CLI::App& cli, DashboardArgs& args);
 int run_dashboard_command(const DashboardArgs& args);
+
+CLI::App* add_web_watch_command(CLI::App& cli, WebWatchArgs& args);
+int run_web_watch_command(const WebWatchArgs& args);
 
 }  // namespace craneassist::cli

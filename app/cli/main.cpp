@@ -67,6 +67,7 @@ int main(int argc, char** argv) {
   add(commands, cli, add_remote_command, run_remote_command);
   add(commands, cli, add_echo_command, run_echo_command);
   add(commands, cli, add_dashboard_command, run_dashboard_command);
+  add(commands, cli, add_web_watch_command, run_web_watch_command);
 #endif
 
   try {

@@ -1,50 +1,71 @@
 #include "telemetry_observer.hpp"
 
 #include <algorithm>
+#include <type_traits>
 
 namespace craneassist::cli {
 
-void to_frame(const control::LogRow& row, int dof, dds::TelemetryFrame& f) noexcept {
-  const int n = std::min(dof, dds::kMaxJoints);
-  f.t_s = row.t;
-  f.dof = n;
+namespace {
+
+// Every field a log row and a telemetry frame share, as (row field, frame field) pairs: one list
+// for both directions. The first n joints only.
+template <class Row, class Frame, class Copy>
+void each_field(Row& row, Frame& f, int n, Copy copy) {
   for (int i = 0; i < n; ++i) {
     const auto s = static_cast<std::size_t>(i);
-    f.q[s] = row.q[s];
-    f.q_ref[s] = row.q_ref[s];
-    f.qdot[s] = row.qdot[s];
-    f.cylinder_pos_m[s] = row.cylinder_pos[s];
-    f.cylinder_vel_m_s[s] = row.cylinder_vel[s];
-    f.load_pressure_pa[s] = row.load_pressure[s];
-    f.spool[s] = row.spool[s];
+    copy(row.q[s], f.q[s]);
+    copy(row.q_ref[s], f.q_ref[s]);
+    copy(row.qdot[s], f.qdot[s]);
+    copy(row.cylinder_pos[s], f.cylinder_pos_m[s]);
+    copy(row.cylinder_vel[s], f.cylinder_vel_m_s[s]);
+    copy(row.load_pressure[s], f.load_pressure_pa[s]);
+    copy(row.spool[s], f.spool[s]);
   }
-  f.tip_m = row.tip;
-  f.tip_v_m_s = row.tip_v;
-  f.command_m_s = row.cmd;
-  f.reference_m_s = row.ref_v;
-  f.pump_flow_m3_s = row.pump_flow_m3s;
-  f.pump_pressure_pa = row.pump_pressure_pa;
-  f.pump_power_w = row.pump_power_w;
-  f.energy_j = row.energy_j;
-  f.flow_demand_m3_s = row.flow_demand_m3s;
-  f.ref_power_w = row.ref_power_w;
-  f.scale = row.scale;
-  f.s = row.s;
-  f.sdot = row.sdot;
-  f.sddot = row.sddot;
-  f.sdddot = row.sdddot;
-  f.sddot_min = row.sddot_min;
-  f.sddot_max = row.sddot_max;
-  f.tip_error_m = row.tip_error_m;
-  f.status = row.status;
-  f.stop_reason = row.stop_reason;
-  f.active_limit = row.active_limit;
-  f.pump_limit = row.pump_limit;
-  f.input_source = row.input_source;
-  f.deadman = row.deadman;
-  f.loop_latency_max_s = row.loop_latency_max_s;
-  f.loop_compute_s = row.loop_compute_s;
-  f.loop_overruns = static_cast<std::uint64_t>(row.loop_overruns);
+  copy(row.t, f.t_s);
+  copy(row.tip, f.tip_m);
+  copy(row.tip_v, f.tip_v_m_s);
+  copy(row.cmd, f.command_m_s);
+  copy(row.ref_v, f.reference_m_s);
+  copy(row.pump_flow_m3s, f.pump_flow_m3_s);
+  copy(row.pump_pressure_pa, f.pump_pressure_pa);
+  copy(row.pump_power_w, f.pump_power_w);
+  copy(row.energy_j, f.energy_j);
+  copy(row.flow_demand_m3s, f.flow_demand_m3_s);
+  copy(row.ref_power_w, f.ref_power_w);
+  copy(row.scale, f.scale);
+  copy(row.s, f.s);
+  copy(row.sdot, f.sdot);
+  copy(row.sddot, f.sddot);
+  copy(row.sdddot, f.sdddot);
+  copy(row.sddot_min, f.sddot_min);
+  copy(row.sddot_max, f.sddot_max);
+  copy(row.tip_error_m, f.tip_error_m);
+  copy(row.status, f.status);
+  copy(row.stop_reason, f.stop_reason);
+  copy(row.active_limit, f.active_limit);
+  copy(row.pump_limit, f.pump_limit);
+  copy(row.input_source, f.input_source);
+  copy(row.deadman, f.deadman);
+  copy(row.loop_latency_max_s, f.loop_latency_max_s);
+  copy(row.loop_compute_s, f.loop_compute_s);
+  copy(row.loop_overruns, f.loop_overruns);
+}
+
+}  // namespace
+
+void to_frame(const control::LogRow& row, int dof, dds::TelemetryFrame& f) noexcept {
+  const int n = std::min(dof, dds::kMaxJoints);
+  f.dof = n;
+  each_field(row, f, n, [](const auto& from, auto& to) {
+    to = static_cast<std::remove_reference_t<decltype(to)>>(from);
+  });
+}
+
+void from_frame(const dds::TelemetryFrame& f, control::LogRow& row) noexcept {
+  const int n = std::clamp(f.dof, 0, std::min(dds::kMaxJoints, control::LogRow::kMaxJoints));
+  each_field(row, f, n, [](auto& to, const auto& from) {
+    to = static_cast<std::remove_reference_t<decltype(to)>>(from);
+  });
 }
 
 void TelemetryObserver::on_cycle(const control::CycleRecord& cycle) noexcept {

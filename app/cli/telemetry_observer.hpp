@@ -30,5 +30,8 @@ dds::TelemetryInfo telemetry_info(const config::CraneConfig& config, const char*
 
 // Copies a log row into a telemetry frame (the cycle number is the caller's).
 void to_frame(const control::LogRow& row, int dof, dds::TelemetryFrame& frame) noexcept;
+// The reverse (`craneassist web`: a frame assembled from another process's telemetry). The
+// frame's first `dof` joints; the row's others stay as they were.
+void from_frame(const dds::TelemetryFrame& frame, control::LogRow& row) noexcept;
 
 }  // namespace craneassist::cli

@@ -32,8 +32,11 @@ class WebView {
 
   // Starts the server and prints the page's address; returns kExitOk, kExitUsage (a bad
   // --web-listen, or a build without the web view) or kExitRuntime (cannot listen), logged.
-  int open(const WebArgs& args, const config::CraneConfig& crane);
+  // commands false: the page is a view only.
+  int open(const WebArgs& args, const config::CraneConfig& crane, bool commands = true);
   control::CycleObserver* observer();
+  // A row from elsewhere (after open()): WebServer::publish.
+  void publish(const control::LogRow& row) noexcept;
   // The page's virtual joystick (after open()).
   std::unique_ptr<input::CommandSource> pad_source(const input::JoystickMapping& mapping);
   // The summary line, or "" when not open.

@@ -17,14 +17,16 @@ void add_web_options(CLI::App& command, WebArgs& args) {
   command.add_option("--web-rate", args.frame_rate_hz, "(not in this build)");
 }
 
-int WebView::open(const WebArgs&, const config::CraneConfig&) {
-  spdlog::error("--web: this craneassist was built without the web view (CRANEASSIST_WEB=OFF)");
+int WebView::open(const WebArgs&, const config::CraneConfig&, bool) {
+  spdlog::error("web view: this craneassist was built without the web view (CRANEASSIST_WEB=OFF)");
   return kExitUsage;
 }
 
 control::CycleObserver* WebView::observer() {
   return nullptr;
 }
+
+void WebView::publish(const control::LogRow&) noexcept {}
 
 std::unique_ptr<input::CommandSource> WebView::pad_source(const input::JoystickMapping&) {
   return nullptr;

@@ -54,13 +54,14 @@ void add_web_options(CLI::App& command, WebArgs& args) {
       ->capture_default_str();
 }
 
-int WebView::open(const WebArgs& args, const config::CraneConfig& crane) {
+int WebView::open(const WebArgs& args, const config::CraneConfig& crane, bool commands) {
   web::WebOptions o;
   if (!parse_listen(args.listen, o)) {
     spdlog::error("--web-listen: '{}' is not ADDR:PORT (e.g. 127.0.0.1:8080, :0, [::1]:8080)",
                   args.listen);
     return kExitUsage;
   }
+  o.commands = commands;
   o.remote_commands = args.remote_commands;
   o.frame_rate_hz = args.frame_rate_hz;
   try {
@@ -76,6 +77,10 @@ int WebView::open(const WebArgs& args, const config::CraneConfig& crane) {
 
 control::CycleObserver* WebView::observer() {
   return state_->server ? &state_->server->observer() : nullptr;
+}
+
+void WebView::publish(const control::LogRow& row) noexcept {
+  if (state_->server) state_->server->publish(row);
 }
 
 std::unique_ptr<input::CommandSource> WebView::pad_source(const input::JoystickMapping& mapping) {

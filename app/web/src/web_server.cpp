@@ -108,18 +108,20 @@ struct WebServer::Impl {
   class Observer : public control::CycleObserver {
    public:
     explicit Observer(Impl& impl) : impl_(impl) {}
-    void on_cycle(const control::CycleRecord& cycle) noexcept override {
-      if (impl_.row_mutex.try_lock()) {
-        impl_.row = cycle.row;
-        ++impl_.row_seq;
-        impl_.row_mutex.unlock();
-      }
-    }
+    void on_cycle(const control::CycleRecord& cycle) noexcept override { impl_.publish(cycle.row); }
 
    private:
     Impl& impl_;
   };
 
+  // Hands a row to the I/O thread; a busy slot skips it (the page samples at its own rate).
+  void publish(const control::LogRow& r) noexcept {
+    if (row_mutex.try_lock()) {
+      row = r;
+      ++row_seq;
+      row_mutex.unlock();
+    }
+  }
   void start();
   void tick();
   void broadcast(const std::shared_ptr<const std::string>& message);
@@ -521,6 +523,10 @@ std::string WebServer::url() const {
 
 control::CycleObserver& WebServer::observer() {
   return impl_->observer;
+}
+
+void WebServer::publish(const control::LogRow& row) noexcept {
+  impl_->publish(row);
 }
 
 std::unique_ptr<input::CommandSource> WebServer::make_pad_source(

@@ -63,6 +63,9 @@ class WebServer {
 
   // The loop observer that streams the cycles (valid while the server lives).
   control::CycleObserver& observer();
+  // What the observer does, for rows from elsewhere (`craneassist web`: the DDS telemetry of
+  // another process). Never waits: a busy hand-over slot skips the row.
+  void publish(const control::LogRow& row) noexcept;
 
   // The page's virtual joystick as a command source, mapped by `mapping` (one per server).
   std::unique_ptr<input::CommandSource> make_pad_source(const input::JoystickMapping& mapping);

@@ -1,0 +1,190 @@
+#include "craneassist/dds/telemetry_watch.hpp"
+
+#include <algorithm>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <mutex>
+#include <set>
+#include <string_view>
+
+#include "checked_types.hpp"
+#include "craneassist/dds/telemetry_publisher.hpp"
+#include "craneassist_msgs.h"
+#include "subscriber.hpp"
+
+namespace craneassist::dds {
+
+namespace fdds = eprosima::fastdds::dds;
+namespace msg = craneassist::msg;
+
+namespace {
+
+// A copy of `text` that is never freed (TelemetryFrame holds static strings). The texts are the
+// names of a few enums; a peer that sends endless new ones gets "?" after the first 256.
+const char* intern(const std::string& text) {
+  static std::mutex mutex;
+  static std::set<std::string, std::less<>> texts;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (auto it = texts.find(text); it != texts.end()) return it->c_str();
+  if (texts.size() >= 256) return "?";
+  return texts.insert(text).first->c_str();
+}
+
+template <std::size_t N>
+void copy_into(std::array<double, N>& to, const std::vector<double>& from, int n) {
+  std::fill(to.begin(), to.end(), 0.0);
+  std::copy_n(from.begin(), std::min<std::size_t>(from.size(), static_cast<std::size_t>(n)),
+              to.begin());
+}
+
+}  // namespace
+
+struct TelemetryWatch::Impl {
+  explicit Impl(const WatchOptions& o) {
+    ParticipantOptions po;
+    po.domain_id = o.domain_id;
+    po.name = o.participant_name;
+    po.transport = o.transport;
+    po.type_propagation = o.type_propagation;
+    session = std::make_unique<SubscriberSession>(
+        po,
+        std::vector<Topic>{Topic::kStatus, Topic::kJoints, Topic::kHydraulics, Topic::kCommandPath},
+        [this](Topic topic, fdds::DataReader& reader) { take(topic, reader); });
+  }
+
+  // On Fast DDS's threads (the samples are the caller's: two threads may take one topic).
+  void take(Topic topic, fdds::DataReader& reader) {
+    std::uint64_t bad = 0;
+    switch (topic) {
+      case Topic::kStatus:
+        take_all<msg::Status>(reader, bad);
+        break;
+      case Topic::kJoints:
+        take_all<msg::JointState>(reader, bad);
+        break;
+      case Topic::kHydraulics:
+        take_all<msg::Hydraulics>(reader, bad);
+        break;
+      case Topic::kCommandPath:
+        take_all<msg::CommandPath>(reader, bad);
+        break;
+      case Topic::kOperatorCommand:
+        break;
+    }
+    if (bad > 0) {
+      std::lock_guard<std::mutex> lock(mutex);
+      run.malformed += bad;
+    }
+  }
+
+  template <typename Sample>
+  void take_all(fdds::DataReader& reader, std::uint64_t& bad) {
+    Sample sample;
+    fdds::SampleInfo info;
+    while (take_next_valid(reader, &sample, info, bad)) apply(sample);
+  }
+
+  void apply(const msg::Status& s) {
+    std::lock_guard<std::mutex> lock(mutex);
+    run.crane = s.crane();
+    run.backend = s.backend();
+    frame.status = intern(s.state());
+    frame.stop_reason = intern(s.stop_reason());
+    frame.active_limit = intern(s.active_limit());
+    frame.pump_limit = intern(s.pump_limit());
+    frame.input_source = intern(s.input_source());
+    frame.deadman = s.deadman();
+    frame.tip_error_m = s.tip_error_m();
+    frame.loop_latency_max_s = s.loop_latency_max_s();
+    frame.loop_compute_s = s.loop_compute_s();
+    frame.loop_overruns = s.loop_overruns();
+    updated();
+  }
+
+  void apply(const msg::JointState& j) {
+    std::lock_guard<std::mutex> lock(mutex);
+    frame.cycle = j.header().cycle();
+    frame.t_s = j.header().t_s();
+    frame.stamp_ns = j.header().stamp_ns();
+    const int n = static_cast<int>(std::min<std::size_t>(j.q().size(), kMaxJoints));
+    frame.dof = n;
+    copy_into(frame.q, j.q(), n);
+    copy_into(frame.q_ref, j.q_ref(), n);
+    copy_into(frame.qdot, j.qdot(), n);
+    copy_into(frame.cylinder_pos_m, j.cylinder_pos_m(), n);
+    copy_into(frame.cylinder_vel_m_s, j.cylinder_vel_m_s(), n);
+    copy_into(frame.load_pressure_pa, j.load_pressure_pa(), n);
+    copy_into(frame.spool, j.spool(), n);
+    frame.tip_m = j.tip_m();
+    frame.tip_v_m_s = j.tip_v_m_s();
+    run.joint_names = j.names();
+    updated();
+  }
+
+  void apply(const msg::Hydraulics& h) {
+    std::lock_guard<std::mutex> lock(mutex);
+    frame.pump_flow_m3_s = h.flow_m3_s();
+    frame.pump_pressure_pa = h.pressure_pa();
+    frame.pump_power_w = h.power_w();
+    frame.energy_j = h.energy_j();
+    frame.flow_demand_m3_s = h.flow_demand_m3_s();
+    frame.ref_power_w = h.ref_power_w();
+    frame.pump_limit = intern(h.pump_limit());
+    updated();
+  }
+
+  void apply(const msg::CommandPath& c) {
+    std::lock_guard<std::mutex> lock(mutex);
+    frame.command_m_s = c.command_m_s();
+    frame.reference_m_s = c.reference_m_s();
+    frame.scale = c.scale();
+    frame.s = c.s();
+    frame.sdot = c.sdot();
+    frame.sddot = c.sddot();
+    frame.sdddot = c.sdddot();
+    frame.sddot_min = c.sddot_min();
+    frame.sddot_max = c.sddot_max();
+    frame.input_source = intern(c.input_source());
+    frame.deadman = c.deadman();
+    updated();
+  }
+
+  void updated() {
+    ++seq;
+    ++run.samples;
+  }
+
+  mutable std::mutex mutex;
+  TelemetryFrame frame;
+  WatchedRun run;
+  std::uint64_t seq = 0;
+  std::unique_ptr<SubscriberSession> session;  // last: its listeners stop before the rest goes
+};
+
+TelemetryWatch::TelemetryWatch(const WatchOptions& options)
+    : impl_(std::make_unique<Impl>(options)) {}
+
+TelemetryWatch::~TelemetryWatch() {
+  impl_->session.reset();
+}
+
+bool TelemetryWatch::latest(TelemetryFrame& out, std::uint64_t& seen) const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  if (impl_->seq == seen) return false;
+  out = impl_->frame;
+  seen = impl_->seq;
+  return true;
+}
+
+WatchedRun TelemetryWatch::run() const {
+  WatchedRun r;
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    r = impl_->run;
+  }
+  for (Topic t : {Topic::kStatus, Topic::kJoints, Topic::kHydraulics, Topic::kCommandPath}) {
+    r.writers += impl_->session->reader(t).matched_writers();
+  }
+  return r;
+}
+
+}  // namespace craneassist::dds

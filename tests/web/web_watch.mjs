@@ -1,0 +1,107 @@
+// `craneassist web` in a real browser (Debian's Chromium, headless, driven by playwright-core):
+// the page of a run in another process, from its DDS telemetry. `craneassist web` serves the
+// page; a `craneassist replay --telemetry` on the same DDS domain moves the tip out; the drawing
+// must follow, the page must be a view only, and the replay's end must show as `stopped`.
+//
+//   node tests/web/web_watch.mjs CRANEASSIST NODE_MODULES DOMAIN
+//
+// docs/web.md#watching-a-run.
+import { spawn } from 'node:child_process';
+import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { createRequire } from 'node:module';
+import { tmpdir } from 'node:os';
+import { join, resolve } from 'node:path';
+
+const [craneassist, nodeModules, domain] = process.argv.slice(2);
+if (!craneassist || !nodeModules || !domain) {
+  console.error('usage: web_watch.mjs CRANEASSIST NODE_MODULES DOMAIN');
+  process.exit(2);
+}
+const require = createRequire(resolve(nodeModules) + '/');
+const { chromium } = require('playwright-core');
+
+let failures = 0;
+const check = (ok, what) => {
+  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
+  if (!ok) failures += 1;
+};
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+// Runs a craneassist command; its output collected, its exit as a promise.
+function run(args) {
+  const child = spawn(craneassist, args, { stdio: ['ignore', 'pipe', 'pipe'] });
+  const p = { child, output: '' };
+  child.stdout.on('data', (d) => { p.output += d; });
+  child.stderr.on('data', (d) => { p.output += d; });
+  p.exit = new Promise((done) => child.on('exit', (code, signal) => done({ code, signal })));
+  return p;
+}
+
+const work = mkdtempSync(join(tmpdir(), 'web-watch-'));
+// Out along +x for 2.5 s, then still: the replay ends about 3 s after it starts.
+const replayFile = join(work, 'out.csv');
+writeFileSync(replayFile, 't,v_x,v_y,v_z\n0.0,0.3,0,0\n2.5,0,0,0\n3.0,0,0,0\n');
+
+const web = run(['web', '--web-listen', '127.0.0.1:0', '--domain', domain, '--duration', '60']);
+const url = await new Promise((done, fail) => {
+  const timer = setTimeout(() => fail(new Error(`no address printed:\n${web.output}`)), 15000);
+  const poll = setInterval(() => {
+    const m = web.output.match(/web: open (http:\S+)/);
+    if (m) { clearInterval(poll); clearTimeout(timer); done(m[1]); }
+  }, 50);
+});
+console.log(`page: ${url}`);
+
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
+  args: ['--no-sandbox', '--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+    '--disable-quic', '--no-first-run', '--disable-background-networking',
+    '--disable-component-update', '--disable-sync'],
+});
+const errors = [];
+let replay;
+try {
+  const page = await (await browser.newContext({ viewport: { width: 1360, height: 1020 } })).newPage();
+  page.on('pageerror', (e) => errors.push(e.message));
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  await page.goto(url);
+  await page.waitForFunction(() => window.craneassist.crane && window.craneassist.command !== 'none',
+    null, { timeout: 20000 });
+  check((await page.evaluate(() => window.craneassist.command)) === 'view',
+    'the page of a watched run is a view only (even with the token, from this host)');
+
+  // The run starts in another process; its telemetry reaches the page through `craneassist web`.
+  replay = run(['replay', replayFile, '--realtime', '--settle', '1', '--telemetry', '--domain',
+    domain, '--no-log']);
+  await page.waitForFunction(() => window.craneassist.drawn > 10, null, { timeout: 20000 });
+  const first = await page.evaluate(() => window.craneassist.last);
+  check(first.points && first.points.length === 5, `the crane is drawn from ${first.points.length} joint frames`);
+  await sleep(1500);
+  const later = await page.evaluate(() => window.craneassist.last);
+  const dx = later.tip[0] - first.tip[0];
+  check(dx > 0.2 && Math.abs(later.tip[2] - first.tip[2]) < 0.1 * dx,
+    `the drawn tip follows the replay out along +x: ${dx.toFixed(2)} m in 1.5 s`);
+  const moved = Math.hypot(...later.points[4].map((v, i) => v - first.points[4][i]));
+  check(moved > 0.2, `the drawn boom end moved ${moved.toFixed(2)} m`);
+  const rate = await page.evaluate(() => window.craneassist.rate_hz);
+  check(rate >= 20 && rate <= 40, `frames received: ${rate} per second (30 streamed)`);
+
+  const { code } = await replay.exit;
+  check(code === 0, `the replay ended with exit ${code}`);
+  await page.waitForFunction(() => window.craneassist.last && window.craneassist.last.status === 'stopped',
+    null, { timeout: 5000 }).catch(() => {});
+  const end = await page.evaluate(() => window.craneassist.last);
+  check(end.status === 'stopped', `the replay's end shows on the page: ${end.status}${end.stop_reason ? ': ' + end.stop_reason : ''}`);
+  check(errors.length === 0, `no errors in the page${errors.length ? ': ' + errors.join('; ') : ''}`);
+} finally {
+  await browser.close();
+  if (replay) replay.child.kill('SIGINT');
+  web.child.kill('SIGINT');
+  rmSync(work, { recursive: true, force: true });
+}
+const { code } = await web.exit;
+check(code === 0, `web ended with exit ${code}`);
+check(/web: receiving from crane 'K70M/.test(web.output), 'web named the watched crane');
+const report = web.output.match(/ {2}web watch: .*\n.*/);
+console.log(report ? report[0] : web.output);
+process.exit(failures === 0 ? 0 : 1);
