@@ -1,5 +1,6 @@
-/* What the Cyclone DDS programs of the interop tests share (cyclone_reader.c, cyclone_writer.c):
- * the clock of the telemetry headers' stamp_ns, and a topic with craneassist's QoS. */
+/* What the Cyclone DDS programs of the interop tests share (cyclone_reader.c, cyclone_writer.c,
+ * cyclone_ros2_reader.c): the clock of the telemetry headers' stamp_ns, a topic with
+ * craneassist's QoS, and the readers' checks. */
 #ifndef CRANEASSIST_CYCLONE_COMMON_H
 #define CRANEASSIST_CYCLONE_COMMON_H
 
@@ -44,5 +45,24 @@ static inline dds_qos_t* craneassist_qos(bool reliable, dds_duration_t max_block
   dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, depth);
   return qos;
 }
+
+/* The failed checks so far. */
+static inline long* check_errors(void) {
+  static long errors = 0;
+  return &errors;
+}
+
+/* A check of a reader: when cond is false, counted, and the first 20 printed as
+ * "WHO: WHAT: message (check: cond)". */
+#define CHECK_AS(who, what, cond, ...)            \
+  do {                                            \
+    if (!(cond)) {                                \
+      if (++*check_errors() <= 20) {              \
+        fprintf(stderr, "%s: %s: ", who, what);   \
+        fprintf(stderr, __VA_ARGS__);             \
+        fprintf(stderr, " (check: %s)\n", #cond); \
+      }                                           \
+    }                                             \
+  } while (0)
 
 #endif

@@ -19,12 +19,7 @@ domain=$5
 start_reader() {
   "$cyclone" "$domain" "$1" > "$work/reader.out" 2> "$work/reader.err" &
   bg_pid=$!
-  i=0
-  until grep -q "ready" "$work/reader.out" 2>/dev/null; do
-    i=$((i + 1))
-    [ $i -lt 100 ] || { cat "$work/reader.out" "$work/reader.err"; fail "reader not ready"; }
-    sleep 0.05
-  done
+  wait_ready reader.out reader.err
 }
 # The replay in real time (long enough for discovery, a few seconds), telemetry on $domain.
 run_replay() {

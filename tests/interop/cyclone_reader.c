@@ -25,18 +25,7 @@
 enum { kStatus, kJoints, kHydraulics, kCommandPath, kTopics };
 static const char* const kNames[kTopics] = {"status", "joints", "hydraulics", "command_path"};
 
-static long g_errors = 0;
-/* Each failed check: counted, the first 20 printed. */
-#define CHECK(cond, topic, ...)                                 \
-  do {                                                          \
-    if (!(cond)) {                                              \
-      if (++g_errors <= 20) {                                   \
-        fprintf(stderr, "cyclone reader: %s: ", kNames[topic]); \
-        fprintf(stderr, __VA_ARGS__);                           \
-        fprintf(stderr, " (check: %s)\n", #cond);               \
-      }                                                         \
-    }                                                           \
-  } while (0)
+#define CHECK(cond, topic, ...) CHECK_AS("cyclone reader", kNames[topic], cond, __VA_ARGS__)
 
 struct TopicState {
   long count;
@@ -282,8 +271,8 @@ int main(int argc, char** argv) {
       g_last_status,
       1e3 * fmax(fmax(g_state[0].latency_max_s, g_state[1].latency_max_s),
                  fmax(g_state[2].latency_max_s, g_state[3].latency_max_s)),
-      g_nan_commands, g_errors);
-  bool ok = g_errors == 0;
+      g_nan_commands, *check_errors());
+  bool ok = *check_errors() == 0;
   for (int t = 0; t < kTopics; ++t) {
     if (g_state[t].count == 0) {
       fprintf(stderr, "cyclone reader: no sample on craneassist/%s\n", kNames[t]);

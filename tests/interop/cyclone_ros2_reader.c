@@ -37,17 +37,7 @@ static const char* const kNames[kTopics] = {"joint_states", "tip_velocity/comman
                                             "tip_velocity/reference", "craneassist/status",
                                             "craneassist/joints"};
 
-static long g_errors = 0;
-#define CHECK(cond, topic, ...)                                      \
-  do {                                                               \
-    if (!(cond)) {                                                   \
-      if (++g_errors <= 20) {                                        \
-        fprintf(stderr, "cyclone ros2 reader: %s: ", kNames[topic]); \
-        fprintf(stderr, __VA_ARGS__);                                \
-        fprintf(stderr, " (check: %s)\n", #cond);                    \
-      }                                                              \
-    }                                                                \
-  } while (0)
+#define CHECK(cond, topic, ...) CHECK_AS("cyclone ros2 reader", kNames[topic], cond, __VA_ARGS__)
 
 static long g_count[kTopics];
 static char* g_joint_names[8];
@@ -240,8 +230,8 @@ int main(int argc, char** argv) {
       g_count[kJointStates], g_count[kCommand], g_count[kReference], g_count[kStatus],
       g_count[kJoints], g_last_status, g_command[0], g_command[1], g_command[2], g_command_matches,
       g_command_nan, g_reference_moving, same_joints && last_diff == 0.0 ? "yes" : "no",
-      1e3 * g_stamp_age_max_s, g_errors);
-  bool ok = g_errors == 0;
+      1e3 * g_stamp_age_max_s, *check_errors());
+  bool ok = *check_errors() == 0;
   for (int t = 0; t < kTopics; ++t) {
     if (g_count[t] == 0) {
       fprintf(stderr, "cyclone ros2 reader: no sample on %s\n", kNames[t]);

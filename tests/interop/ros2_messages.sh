@@ -29,12 +29,7 @@ YAML
 
 "$reader" "$domain" 40 /crane1 "$joints" "$command_base" > "$work/reader.out" 2> "$work/reader.err" &
 bg_pid=$!
-i=0
-until grep -q "ready" "$work/reader.out" 2>/dev/null; do
-  i=$((i + 1))
-  [ $i -lt 100 ] || { cat "$work/reader.out" "$work/reader.err"; fail "reader not ready"; }
-  sleep 0.05
-done
+wait_ready reader.out reader.err
 "$bin" replay "$work/replay.csv" --realtime --settle 3 --no-log --ros2 --domain "$domain" \
   --telemetry-config "$work/telemetry.yaml" > "$work/replay.out" 2>&1 ||
   { cat "$work/replay.out"; fail "replay failed"; }

@@ -23,12 +23,7 @@ esac
 
 "$discovery" "$domain" 20 > "$work/types.out" 2>&1 &
 bg_pid=$!
-i=0
-until grep -q "ready" "$work/types.out" 2>/dev/null; do
-  i=$((i + 1))
-  [ $i -lt 100 ] || { cat "$work/types.out"; fail "fastdds_type_discovery not ready"; }
-  sleep 0.05
-done
+wait_ready types.out types.out
 "$bin" replay "$replay" --realtime --settle 1 --no-log --telemetry-config "$work/telemetry.yaml" \
   --domain "$domain" > "$work/replay.out" 2>&1 || { cat "$work/replay.out"; fail "replay failed"; }
 wait "$bg_pid" || true

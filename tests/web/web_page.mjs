@@ -6,53 +6,24 @@
 //
 // Prints the figures (frames per second the page received, stick-to-drawing latency) and exits
 // 0 when every check holds. docs/web.md#tests.
-import { spawn } from 'node:child_process';
-import { createRequire } from 'node:module';
-import { resolve } from 'node:path';
+import { check, failed, launchChromium, openPage, printedUrl, run, sleep } from './lib.mjs';
 
 const [craneassist, nodeModules, screenshot] = process.argv.slice(2);
 if (!craneassist || !nodeModules) {
   console.error('usage: web_page.mjs CRANEASSIST NODE_MODULES [SCREENSHOT.png]');
   process.exit(2);
 }
-const require = createRequire(resolve(nodeModules) + '/');
-const { chromium } = require('playwright-core');
-
-let failures = 0;
-const check = (ok, what) => {
-  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
-  if (!ok) failures += 1;
-};
-const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
 // The simulator with the web view on any free port; its address from the first line it prints.
-const sim = spawn(craneassist, ['sim', '--web', '--web-listen', '127.0.0.1:0', '--no-telemetry',
-  '--duration', '60'], { stdio: ['ignore', 'pipe', 'pipe'] });
-let output = '';
-sim.stdout.on('data', (d) => { output += d; });
-sim.stderr.on('data', (d) => { output += d; });
-const simExit = new Promise((resolve) => sim.on('exit', (code, signal) => resolve({ code, signal })));
-const url = await new Promise((resolve, reject) => {
-  const timer = setTimeout(() => reject(new Error(`no address printed:\n${output}`)), 15000);
-  const poll = setInterval(() => {
-    const m = output.match(/web: open (http:\S+)/);
-    if (m) { clearInterval(poll); clearTimeout(timer); resolve(m[1]); }
-  }, 50);
-});
+const sim = run(craneassist, ['sim', '--web', '--web-listen', '127.0.0.1:0', '--no-telemetry',
+  '--duration', '60']);
+const url = await printedUrl(sim);
 console.log(`page: ${url}`);
 
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
-  args: ['--no-sandbox', '--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-    '--disable-quic', '--no-first-run', '--disable-background-networking',
-    '--disable-component-update', '--disable-sync'],
-});
+const browser = await launchChromium(nodeModules);
 const errors = [];
 try {
-  const context = await browser.newContext({ viewport: { width: 1360, height: 1020 } });
-  const page = await context.newPage();
-  page.on('pageerror', (e) => errors.push(e.message));
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  const { context, page } = await openPage(browser, errors);
   await page.goto(url);
 
   // 1. The page loads, connects and draws the crane from the stream.
@@ -114,11 +85,11 @@ try {
   check(errors.length === 0, `no errors in the page${errors.length ? ': ' + errors.join('; ') : ''}`);
 } finally {
   await browser.close();
-  sim.kill('SIGINT');
+  sim.child.kill('SIGINT');
 }
-const { code } = await simExit;
+const { code } = await sim.exit;
 check(code === 0, `sim ended with exit ${code}`);
-check(/input device disconnected: stopping/.test(output), 'sim reported the lost page as a disconnected input');
-const report = output.match(/ {2}web: .*/);
-console.log(report ? report[0] : output);
-process.exit(failures === 0 ? 0 : 1);
+check(/input device disconnected: stopping/.test(sim.output), 'sim reported the lost page as a disconnected input');
+const report = sim.output.match(/ {2}web: .*/);
+console.log(report ? report[0] : sim.output);
+process.exit(failed() === 0 ? 0 : 1);

@@ -6,35 +6,15 @@
 //   node tests/web/web_watch.mjs CRANEASSIST NODE_MODULES DOMAIN
 //
 // docs/web.md#watching-a-run.
-import { spawn } from 'node:child_process';
 import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
-import { createRequire } from 'node:module';
 import { tmpdir } from 'node:os';
-import { join, resolve } from 'node:path';
+import { join } from 'node:path';
+import { check, failed, launchChromium, openPage, printedUrl, run, sleep } from './lib.mjs';
 
 const [craneassist, nodeModules, domain] = process.argv.slice(2);
 if (!craneassist || !nodeModules || !domain) {
   console.error('usage: web_watch.mjs CRANEASSIST NODE_MODULES DOMAIN');
   process.exit(2);
-}
-const require = createRequire(resolve(nodeModules) + '/');
-const { chromium } = require('playwright-core');
-
-let failures = 0;
-const check = (ok, what) => {
-  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
-  if (!ok) failures += 1;
-};
-const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
-
-// Runs a craneassist command; its output collected, its exit as a promise.
-function run(args) {
-  const child = spawn(craneassist, args, { stdio: ['ignore', 'pipe', 'pipe'] });
-  const p = { child, output: '' };
-  child.stdout.on('data', (d) => { p.output += d; });
-  child.stderr.on('data', (d) => { p.output += d; });
-  p.exit = new Promise((done) => child.on('exit', (code, signal) => done({ code, signal })));
-  return p;
 }
 
 const work = mkdtempSync(join(tmpdir(), 'web-watch-'));
@@ -42,28 +22,16 @@ const work = mkdtempSync(join(tmpdir(), 'web-watch-'));
 const replayFile = join(work, 'out.csv');
 writeFileSync(replayFile, 't,v_x,v_y,v_z\n0.0,0.3,0,0\n2.5,0,0,0\n3.0,0,0,0\n');
 
-const web = run(['web', '--web-listen', '127.0.0.1:0', '--domain', domain, '--duration', '60']);
-const url = await new Promise((done, fail) => {
-  const timer = setTimeout(() => fail(new Error(`no address printed:\n${web.output}`)), 15000);
-  const poll = setInterval(() => {
-    const m = web.output.match(/web: open (http:\S+)/);
-    if (m) { clearInterval(poll); clearTimeout(timer); done(m[1]); }
-  }, 50);
-});
+const web = run(craneassist, ['web', '--web-listen', '127.0.0.1:0', '--domain', domain,
+  '--duration', '60']);
+const url = await printedUrl(web);
 console.log(`page: ${url}`);
 
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
-  args: ['--no-sandbox', '--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-    '--disable-quic', '--no-first-run', '--disable-background-networking',
-    '--disable-component-update', '--disable-sync'],
-});
+const browser = await launchChromium(nodeModules);
 const errors = [];
 let replay;
 try {
-  const page = await (await browser.newContext({ viewport: { width: 1360, height: 1020 } })).newPage();
-  page.on('pageerror', (e) => errors.push(e.message));
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  const { page } = await openPage(browser, errors);
   await page.goto(url);
   await page.waitForFunction(() => window.craneassist.crane && window.craneassist.command !== 'none',
     null, { timeout: 20000 });
@@ -71,7 +39,7 @@ try {
     'the page of a watched run is a view only (even with the token, from this host)');
 
   // The run starts in another process; its telemetry reaches the page through `craneassist web`.
-  replay = run(['replay', replayFile, '--realtime', '--settle', '1', '--telemetry', '--domain',
+  replay = run(craneassist, ['replay', replayFile, '--realtime', '--settle', '1', '--telemetry', '--domain',
     domain, '--no-log']);
   await page.waitForFunction(() => window.craneassist.drawn > 10, null, { timeout: 20000 });
   const first = await page.evaluate(() => window.craneassist.last);
@@ -104,4 +72,4 @@ check(code === 0, `web ended with exit ${code}`);
 check(/web: receiving from crane 'K70M/.test(web.output), 'web named the watched crane');
 const report = web.output.match(/ {2}web watch: .*\n.*/);
 console.log(report ? report[0] : web.output);
-process.exit(failures === 0 ? 0 : 1);
+process.exit(failed() === 0 ? 0 : 1);
