@@ -7,6 +7,9 @@
 #   writer: cyclone_writer drives `craneassist echo` on every telemetry topic
 #   type_information: with `type_propagation.type_information: true` (Fast DDS 2.9's
 #     TYPE_INFORMATION record) Cyclone matches nothing: what the setting's default avoids
+#   ros2: cyclone_ros2_reader, built from ROS 2's own message definitions, reads the ROS 2
+#     topics (docs/ros.md) of a replay of REPLAY with --ros2 under the namespace /crane1, as a
+#     ROS 2 node would (REPLAY: a constant command, tests/data/constant_command.csv)
 set -eu
 . "$(dirname "$0")/../cli/test_lib.sh"
 case_name=$1
@@ -15,9 +18,10 @@ cyclone=$3
 replay=$4
 domain=$5
 
-# Starts cyclone_reader in the background, waits until its readers exist.
+# Starts the Cyclone reader with ARGS after the domain in the background, waits until its
+# readers exist.
 start_reader() {
-  "$cyclone" "$domain" "$1" > "$work/reader.out" 2> "$work/reader.err" &
+  "$cyclone" "$domain" "$@" > "$work/reader.out" 2> "$work/reader.err" &
   bg_pid=$!
   wait_ready reader.out reader.err
 }
@@ -135,6 +139,36 @@ EOF
   [ "$rc" = 1 ] || fail "cyclone reader: exit $rc, expected 1 (nothing received)"
   has reader.out "received status 0, joints 0, hydraulics 0, command_path 0"
   echo "type_information OK"
+  ;;
+ros2)
+  # The joints as the URDF names them (the movable ones, in order): what JointState must carry.
+  "$bin" urdf > "$work/crane.urdf"
+  joints=$(grep '<joint ' "$work/crane.urdf" | grep -v 'type="fixed"' |
+    sed 's/.*name="\([^"]*\)".*/\1/' | paste -sd, -)
+  [ -n "$joints" ] || fail "no joints in the URDF"
+  # The replay's command (0.3, 0.2, -0.1) m/s in the crane frame (x forward, y up, z lateral),
+  # in base_link (the K70M's crane_from_base swaps y and z): what the TwistStamped must carry.
+  command_base=0.3,-0.1,0.2
+  cat > "$work/telemetry.yaml" <<YAML
+format: craneassist-telemetry/1
+topics:
+  joints: {reliability: reliable}   # the last sample compared with joint_states' must arrive
+ros2:
+  namespace: /crane1
+YAML
+  start_reader 40 /crane1 "$joints" "$command_base"
+  run_replay --ros2 --telemetry-config "$work/telemetry.yaml"
+  rc=0
+  wait "$bg_pid" || rc=$?
+  bg_pid=
+  cat "$work/reader.out" "$work/reader.err"
+  grep "telemetry" "$work/replay.out"
+  [ "$rc" = 0 ] || fail "cyclone ros2 reader: exit $rc"
+  has replay.out "ROS 2 topics /crane1/joint_states"
+  has reader.out " 0 failed checks"
+  has reader.out "last positions = last craneassist q: yes"
+  echo "joints: $joints; command in base_link: $command_base"
+  echo "ros2 OK"
   ;;
 *)
   fail "unknown case $case_name"
