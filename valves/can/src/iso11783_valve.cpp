@@ -72,7 +72,8 @@ bool make_frame(std::uint32_t pgn_base, std::uint8_t valve, std::uint8_t source,
   return true;
 }
 
-// Checks the identifier and length of a frame of PGNs base..base+15; valve and source out.
+// Checks the identifier and length of a frame of PGNs base..base+15; valve and source out (set
+// only when the frame is one).
 CodecStatus check_frame(const CanFrame& frame, std::uint32_t pgn_base, std::uint8_t& valve,
                         std::uint8_t& source) {
   if (!frame.extended || frame.id > kMaxExtendedId) return CodecStatus::kWrongIdentifier;
@@ -87,6 +88,32 @@ CodecStatus check_frame(const CanFrame& frame, std::uint32_t pgn_base, std::uint
 
 bool valid_state_code(std::uint8_t code) {
   return code <= 3 || code >= 14;
+}
+
+// Bytes 0 and 1 of the measured and the estimated flow messages: the extend and the retract
+// port's flow, 1 %/bit from -125 %.
+constexpr double kPortFlowPerBit = 0.01;
+constexpr double kPortFlowOffset = -1.25;
+
+void put_port_flows(double extend_flow, double retract_flow, CanFrame& out, bool& clamped) {
+  out.data[0] = static_cast<std::uint8_t>(
+      to_raw_or_na(extend_flow, kPortFlowPerBit, kPortFlowOffset, kMaxValid8, 0xFF, clamped));
+  out.data[1] = static_cast<std::uint8_t>(
+      to_raw_or_na(retract_flow, kPortFlowPerBit, kPortFlowOffset, kMaxValid8, 0xFF, clamped));
+}
+
+void get_port_flows(const CanFrame& frame, double& extend_flow, double& retract_flow) {
+  extend_flow = from_raw8(frame.data[0], kPortFlowPerBit, kPortFlowOffset);
+  retract_flow = from_raw8(frame.data[1], kPortFlowPerBit, kPortFlowOffset);
+}
+
+// The limit status in the top 3 bits of a byte, the rest not available.
+std::uint8_t limit_byte(LimitStatus limit) {
+  return static_cast<std::uint8_t>((static_cast<std::uint8_t>(limit) << 5) | 0x1F);
+}
+
+LimitStatus limit_of(std::uint8_t byte) {
+  return static_cast<LimitStatus>((byte >> 5) & 0x7u);
 }
 
 }  // namespace
@@ -167,12 +194,8 @@ CodecStatus encode(const AuxValveCommand& command, std::uint8_t source_address,
 }
 
 CodecStatus decode(const CanFrame& frame, AuxValveCommand& command, std::uint8_t& source_address) {
-  std::uint8_t valve = 0;
-  std::uint8_t source = 0;
-  const CodecStatus s = check_frame(frame, kPgnAuxValveCommand0, valve, source);
+  const CodecStatus s = check_frame(frame, kPgnAuxValveCommand0, command.valve, source_address);
   if (s != CodecStatus::kOk) return s;
-  command.valve = valve;
-  source_address = source;
   const std::uint8_t resolution_mode = frame.data[1] & 0x3u;
   const std::uint32_t extended = le16(frame, 3);
   command.extended_resolution = resolution_mode == 0x1 && extended <= kMaxValid16;
@@ -200,32 +223,24 @@ CodecStatus encode(const AuxValveMeasuredFlow& m, std::uint8_t source_address,
     return CodecStatus::kInvalidArgument;
   }
   bool clamped = false;
-  out.data[0] = static_cast<std::uint8_t>(
-      to_raw_or_na(m.extend_flow, 0.01, -1.25, kMaxValid8, 0xFF, clamped));
-  out.data[1] = static_cast<std::uint8_t>(
-      to_raw_or_na(m.retract_flow, 0.01, -1.25, kMaxValid8, 0xFF, clamped));
+  put_port_flows(m.extend_flow, m.retract_flow, out, clamped);
   put_le16(out, 2, to_raw_or_na(m.extend_pressure_pa, 5000.0, 0.0, kMaxValid16, 0xFFFF, clamped));
   put_le16(out, 4, to_raw_or_na(m.retract_pressure_pa, 5000.0, 0.0, kMaxValid16, 0xFFFF, clamped));
   out.data[6] = static_cast<std::uint8_t>(
       to_raw_or_na(m.return_pressure_pa, 16000.0, 0.0, kMaxValid8, 0xFF, clamped));
-  out.data[7] = static_cast<std::uint8_t>((static_cast<std::uint8_t>(m.limit) << 5) | 0x1F);
+  out.data[7] = limit_byte(m.limit);
   frame = out;
   return clamped ? CodecStatus::kClamped : CodecStatus::kOk;
 }
 
 CodecStatus decode(const CanFrame& frame, AuxValveMeasuredFlow& m, std::uint8_t& source_address) {
-  std::uint8_t valve = 0;
-  std::uint8_t source = 0;
-  const CodecStatus s = check_frame(frame, kPgnAuxValveMeasuredFlow0, valve, source);
+  const CodecStatus s = check_frame(frame, kPgnAuxValveMeasuredFlow0, m.valve, source_address);
   if (s != CodecStatus::kOk) return s;
-  m.valve = valve;
-  source_address = source;
-  m.extend_flow = from_raw8(frame.data[0], 0.01, -1.25);
-  m.retract_flow = from_raw8(frame.data[1], 0.01, -1.25);
+  get_port_flows(frame, m.extend_flow, m.retract_flow);
   m.extend_pressure_pa = from_raw16(le16(frame, 2), 5000.0, 0.0);
   m.retract_pressure_pa = from_raw16(le16(frame, 4), 5000.0, 0.0);
   m.return_pressure_pa = from_raw8(frame.data[6], 16000.0, 0.0);
-  m.limit = static_cast<LimitStatus>((frame.data[7] >> 5) & 0x7u);
+  m.limit = limit_of(frame.data[7]);
   return CodecStatus::kOk;
 }
 
@@ -242,29 +257,21 @@ CodecStatus encode(const AuxValveEstimatedFlow& m, std::uint8_t source_address,
     return CodecStatus::kInvalidArgument;
   }
   bool clamped = false;
-  out.data[0] = static_cast<std::uint8_t>(
-      to_raw_or_na(m.extend_flow, 0.01, -1.25, kMaxValid8, 0xFF, clamped));
-  out.data[1] = static_cast<std::uint8_t>(
-      to_raw_or_na(m.retract_flow, 0.01, -1.25, kMaxValid8, 0xFF, clamped));
+  put_port_flows(m.extend_flow, m.retract_flow, out, clamped);
   out.data[2] = static_cast<std::uint8_t>((fail_safe << 6) | 0x30 | state);
-  out.data[3] = static_cast<std::uint8_t>((static_cast<std::uint8_t>(m.limit) << 5) | 0x1F);
+  out.data[3] = limit_byte(m.limit);
   frame = out;
   return clamped ? CodecStatus::kClamped : CodecStatus::kOk;
 }
 
 CodecStatus decode(const CanFrame& frame, AuxValveEstimatedFlow& m, std::uint8_t& source_address) {
-  std::uint8_t valve = 0;
-  std::uint8_t source = 0;
-  const CodecStatus s = check_frame(frame, kPgnAuxValveEstimatedFlow0, valve, source);
+  const CodecStatus s = check_frame(frame, kPgnAuxValveEstimatedFlow0, m.valve, source_address);
   if (s != CodecStatus::kOk) return s;
-  m.valve = valve;
-  source_address = source;
-  m.extend_flow = from_raw8(frame.data[0], 0.01, -1.25);
-  m.retract_flow = from_raw8(frame.data[1], 0.01, -1.25);
+  get_port_flows(frame, m.extend_flow, m.retract_flow);
   const std::uint8_t state = frame.data[2] & 0x0Fu;
   m.state = static_cast<ValveState>(state);
   m.fail_safe = static_cast<FailSafeMode>((frame.data[2] >> 6) & 0x3u);
-  m.limit = static_cast<LimitStatus>((frame.data[3] >> 5) & 0x7u);
+  m.limit = limit_of(frame.data[3]);
   return valid_state_code(state) ? CodecStatus::kOk : CodecStatus::kBadField;
 }
 
