@@ -4,6 +4,7 @@
 #include <array>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "allocation_counter.hpp"
 #include "craneassist/can/can_frame.hpp"
@@ -48,6 +49,30 @@ TEST(Candump, WritesTheCandumpLogFormat) {
   EXPECT_EQ(format(frame(0x1, true, {0}), 0, "vcan0"), "(0.000000) vcan0 00000001#00");
 }
 
+// candump -l -x's direction mark (can-utils 2023.03+): " T" sent, " R" received; parsed back.
+TEST(Candump, MarksAndReadsTheDirection) {
+  std::array<char, kCandumpLineCapacity> buf{};
+  std::size_t n = 0;
+  const CanFrame longest = frame(0x1FFFFFFF, true, {1, 2, 3, 4, 5, 6, 7, 8});
+  ASSERT_EQ(format_candump(longest, 1700000000123456, "vcan0", buf, n, CandumpDirection::kTx),
+            CandumpStatus::kOk);
+  EXPECT_EQ(std::string(buf.data(), n), "(1700000000.123456) vcan0 1FFFFFFF#0102030405060708 T");
+  ASSERT_EQ(format_candump(frame(0x301, false, {0xAB}), 5, "can1", buf, n, CandumpDirection::kRx),
+            CandumpStatus::kOk);
+  EXPECT_EQ(std::string(buf.data(), n), "(0.000005) can1 301#AB R");
+  const std::pair<const char*, CandumpDirection> lines[] = {
+      {"(1.5) vcan0 123#00 T", CandumpDirection::kTx},
+      {"(1.5) vcan0 123#00 R\n", CandumpDirection::kRx},
+      {"(1.5) vcan0 123# T", CandumpDirection::kTx},
+      {"(1.5) vcan0 123#00", CandumpDirection::kNone}};
+  for (const auto& [line, direction] : lines) {
+    CandumpRecord r;
+    ASSERT_EQ(parse_candump(line, r), CandumpStatus::kOk) << line;
+    EXPECT_EQ(r.direction, direction) << line;
+    EXPECT_EQ(r.frame.id, 0x123u);
+  }
+}
+
 TEST(Candump, FormatErrors) {
   std::array<char, kCandumpLineCapacity> buf{};
   std::size_t n = 7;
@@ -69,7 +94,7 @@ TEST(Candump, LongestLineFitsTheCapacity) {
   std::array<char, kCandumpLineCapacity> buf{};
   std::size_t n = 0;
   EXPECT_EQ(format_candump(frame(0x1FFFFFFF, true, {1, 2, 3, 4, 5, 6, 7, 8}), INT64_MAX,
-                           "abcdefghijklmno", buf, n),
+                           "abcdefghijklmno", buf, n, CandumpDirection::kTx),
             CandumpStatus::kOk);
   EXPECT_LE(n + 1, kCandumpLineCapacity);
   EXPECT_EQ(buf[n], '\0');
@@ -138,6 +163,10 @@ TEST(Candump, ReportsMalformedLinesWithoutCrashing) {
       {"(1.5) vcan0 123##100", CandumpStatus::kUnsupportedFrame},
       {"(1.5) vcan0 20000080#0000000000000000", CandumpStatus::kUnsupportedFrame},
       {"(1.5) vcan0 123#00 junk", CandumpStatus::kTrailingCharacters},
+      {"(1.5) vcan0 123#00 X", CandumpStatus::kTrailingCharacters},
+      {"(1.5) vcan0 123#00 T R", CandumpStatus::kTrailingCharacters},
+      {"(1.5) vcan0 123#00 t", CandumpStatus::kTrailingCharacters},
+      {"(1.5) vcan0 123#00T", CandumpStatus::kBadData},
   };
   for (const Case& c : cases) {
     CandumpRecord r;

@@ -47,6 +47,8 @@ echo "--- the independent candump capture"
 ./can_backend_check traffic /tmp/cap1.log || fail "traffic"
 echo "--- the backend's own candump log"
 ./can_backend_check traffic /tmp/backend.log || fail "backend log"
+# --can-log marks the direction (candump -l -x): what craneassist sent T, what it received R.
+grep -q ' T$' /tmp/backend.log && grep -q ' R$' /tmp/backend.log || fail "backend log: no T/R marks"
 
 echo "=== 2. the emulator dies: feedback stops"
 start_emulator

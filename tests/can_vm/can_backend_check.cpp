@@ -169,8 +169,16 @@ int traffic(const char* path) {
   int last_counter = -1;
   std::int64_t last_enabled_heartbeat = -1;
   bool last_block[4] = {};
+  // craneassist's own --can-log marks each frame (candump -l -x): what it sent (commands,
+  // heartbeat) T, what it received (the emulator's feedback) R. A candump capture has no marks.
+  int marked = 0, wrong_direction = 0;
   for (const auto& r : recs) {
     const int s = section_of(r.frame);
+    if (r.direction != CandumpDirection::kNone) {
+      ++marked;
+      const bool sent = s >= 0 || (r.frame.extended && r.frame.id == kHeartbeat);
+      wrong_direction += (r.direction == CandumpDirection::kTx) != sent;
+    }
     if (s >= 0) last_block[s] = is_block(r.frame);
     if (r.frame.extended && r.frame.id == kHeartbeat) {
       heartbeat.push_back(r.timestamp);
@@ -203,8 +211,10 @@ int traffic(const char* path) {
   }
   std::printf(
       "capture %s: %zu frames, %d command payloads wrong, %d unexpected identifiers, %d "
-      "AVC commands not block\n",
-      path, recs.size(), bad_payload, unknown, moving);
+      "AVC commands not block; %d marked T or R, %d of them the wrong way\n",
+      path, recs.size(), bad_payload, unknown, moving, marked, wrong_direction);
+  if (marked != 0 && marked != static_cast<int>(recs.size())) ok = false;  // all or none
+  if (wrong_direction != 0) ok = false;
   const char* names[] = {"slew AVC 0CFE3080", "lift AVC 0CFE3180", "tilt AVC 0CFE3280",
                          "extension current 210"};
   // The command cycle while the loop ran: up to the last heartbeat in state enabled (the block

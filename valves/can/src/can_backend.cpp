@@ -47,18 +47,20 @@ std::int64_t mono_us() {
 struct LogEntry {
   CanFrame frame;
   TimestampUs t_us = 0;
+  CandumpDirection direction = CandumpDirection::kNone;  // sent or received
 };
 
 // Single producer, single consumer; a full ring drops the entry (counted by the caller).
 class LogRing {
  public:
   explicit LogRing(std::size_t capacity) : buf_(capacity + 1) {}
-  bool push(const CanFrame& f, TimestampUs t) {
+  bool push(const CanFrame& f, TimestampUs t, CandumpDirection direction) {
     const std::size_t h = head_.load(std::memory_order_relaxed);
     const std::size_t next = (h + 1) % buf_.size();
     if (next == tail_.load(std::memory_order_acquire)) return false;
     buf_[h].frame = f;
     buf_[h].t_us = t;
+    buf_[h].direction = direction;
     head_.store(next, std::memory_order_release);
     return true;
   }
@@ -145,7 +147,7 @@ SendStatus send_counted(Transport& transport, Counters& counters, Ring& ring, bo
   const SendStatus st = transport.send(frame);
   if (st == SendStatus::kOk) {
     counters.frames_sent.fetch_add(1, std::memory_order_relaxed);
-    if (logging && !ring.push(frame, now_rt_us)) {
+    if (logging && !ring.push(frame, now_rt_us, CandumpDirection::kTx)) {
       counters.log_dropped.fetch_add(1, std::memory_order_relaxed);
     }
   } else {
@@ -320,7 +322,8 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
     }
     const CanFrame& f = m.rx.frame;
     m.counters.frames_received.fetch_add(1, std::memory_order_relaxed);
-    if (m.log_file != nullptr && !m.control_ring.push(f, m.rx.timestamp_us)) {
+    if (m.log_file != nullptr &&
+        !m.control_ring.push(f, m.rx.timestamp_us, CandumpDirection::kRx)) {
       m.counters.log_dropped.fetch_add(1, std::memory_order_relaxed);
     }
     bool known = false;
@@ -560,8 +563,8 @@ void CanBackend::log_loop() {
       for (LogRing* ring : {&m.control_ring, &m.watchdog_ring}) {
         while (ring->pop(e)) {
           std::size_t written = 0;
-          if (format_candump(e.frame, e.t_us, m.transport.interface_name(), line, written) ==
-              CandumpStatus::kOk) {
+          if (format_candump(e.frame, e.t_us, m.transport.interface_name(), line, written,
+                             e.direction) == CandumpStatus::kOk) {
             std::fwrite(line, 1, written, m.log_file);
             std::fputc('\n', m.log_file);
           }

@@ -79,7 +79,8 @@ const char* to_string(CandumpStatus status) {
 }
 
 CandumpStatus format_candump(const CanFrame& frame, TimestampUs timestamp, std::string_view iface,
-                             std::span<char> out, std::size_t& written) {
+                             std::span<char> out, std::size_t& written,
+                             CandumpDirection direction) {
   written = 0;
   if (!is_valid(frame)) return CandumpStatus::kInvalidFrame;
   if (!valid_interface(iface)) return CandumpStatus::kBadInterface;
@@ -106,7 +107,11 @@ CandumpStatus format_candump(const CanFrame& frame, TimestampUs timestamp, std::
   std::size_t pos = 0;
   if (!append(out, pos, std::string_view(head, static_cast<std::size_t>(n))) ||
       !append(out, pos, iface) || !append(out, pos, " ") ||
-      !append(out, pos, std::string_view(body, b))) {
+      !append(out, pos, std::string_view(body, b)) ||
+      !append(out, pos,
+              direction == CandumpDirection::kTx   ? " T"
+              : direction == CandumpDirection::kRx ? " R"
+                                                   : "")) {
     if (!out.empty()) out[0] = '\0';
     return CandumpStatus::kBufferTooSmall;
   }
@@ -197,7 +202,16 @@ CandumpStatus parse_candump(std::string_view line, CandumpRecord& record) {
     i += 2;
   }
   frame.dlc = dlc;
-  if (!trim(s.substr(i)).empty()) return CandumpStatus::kTrailingCharacters;
+  // The direction mark of candump -l -x, after a blank: "T" or "R".
+  const std::string_view rest = trim(s.substr(i));
+  record.direction = CandumpDirection::kNone;
+  if (rest == "T") {
+    record.direction = CandumpDirection::kTx;
+  } else if (rest == "R") {
+    record.direction = CandumpDirection::kRx;
+  } else if (!rest.empty()) {
+    return CandumpStatus::kTrailingCharacters;
+  }
   record.frame = frame;
   return CandumpStatus::kOk;
 }

@@ -10,6 +10,11 @@
 // data bytes as pairs of hex digits. Remote frames (`123#R`), CAN FD (`123##1...`) and error
 // frames (identifier with the error flag 0x20000000) are reported as unsupported, never
 // misread. Nothing here allocates or throws.
+//
+// A line may end in the direction mark of `candump -l -x` (can-utils 2023.03 and later): " T"
+// for a frame this host sent, " R" for one it received:
+//
+//   (1700000000.123456) vcan0 18FF0080#0101000000000000 T
 #pragma once
 
 #include <array>
@@ -41,7 +46,10 @@ bool same_frame(const CanFrame& a, const CanFrame& b);
 // kMaxInterfaceLength) " " 8 id digits "#" 16 data digits, plus a terminating NUL.
 inline constexpr std::size_t kMaxInterfaceLength = 15;  // IFNAMSIZ - 1 on Linux
 inline constexpr std::size_t kCandumpLineCapacity =
-    1 + 20 + 1 + 6 + 2 + kMaxInterfaceLength + 1 + 8 + 1 + 16 + 1;
+    1 + 20 + 1 + 6 + 2 + kMaxInterfaceLength + 1 + 8 + 1 + 16 + 2 + 1;
+
+// The direction mark at the end of a line: none (plain candump -L), " T" sent, " R" received.
+enum class CandumpDirection { kNone, kTx, kRx };
 
 enum class CandumpStatus {
   kOk,
@@ -62,12 +70,14 @@ using TimestampUs = std::int64_t;
 // Writes one line without the newline, NUL-terminated, into out; `written` is the length without
 // the NUL. On failure nothing usable is written and written is 0.
 CandumpStatus format_candump(const CanFrame& frame, TimestampUs timestamp, std::string_view iface,
-                             std::span<char> out, std::size_t& written);
+                             std::span<char> out, std::size_t& written,
+                             CandumpDirection direction = CandumpDirection::kNone);
 
 struct CandumpRecord {
   TimestampUs timestamp = 0;
   std::string_view iface;  // points into the parsed line
   CanFrame frame;
+  CandumpDirection direction = CandumpDirection::kNone;
 };
 
 // Parses one line (a trailing '\n' or "\r\n" and surrounding blanks are accepted). On failure
