@@ -11,6 +11,7 @@
 #include "craneassist/can/mapping_config.hpp"
 #include "craneassist/config/config_error.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "thrown_error.hpp"
 
 using namespace craneassist::can;
 using craneassist::config::ConfigError;
@@ -36,13 +37,8 @@ const std::string kPosition =
 
 // Parses text expecting a ConfigError; returns it.
 ConfigError error_of(const std::string& text) {
-  try {
-    parse_can_mapping(text, "map.yaml");
-  } catch (const ConfigError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no error for:\n" << text;
-  return ConfigError("", 0, "", "");
+  return craneassist::test::thrown_error<ConfigError>([&] { parse_can_mapping(text, "map.yaml"); },
+                                                      "no error for:\n" + text);
 }
 
 }  // namespace

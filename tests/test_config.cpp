@@ -10,6 +10,7 @@
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/config/quantity.hpp"
 #include "craneassist/config/yaml_reader.hpp"
+#include "thrown_error.hpp"
 
 using craneassist::config::ConfigError;
 using craneassist::config::Dimension;
@@ -30,13 +31,9 @@ ConfigError error_after_edit(const std::string& from, const std::string& to) {
   const auto pos = text.find(from);
   EXPECT_NE(pos, std::string::npos) << from;
   text.replace(pos, from.size(), to);
-  try {
-    craneassist::config::parse_crane_config(text, "edited.yaml");
-  } catch (const ConfigError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no error after replacing '" << from << "' with '" << to << "'";
-  return ConfigError("", 0, "", "");
+  return craneassist::test::thrown_error<ConfigError>(
+      [&] { craneassist::config::parse_crane_config(text, "edited.yaml"); },
+      "no error after replacing '" + from + "' with '" + to + "'");
 }
 
 // Replaces the first occurrence of `from` in the K70M file and parses the result.

@@ -19,6 +19,8 @@
 #include "craneassist/input/joint_trajectory.hpp"
 #include "craneassist/input/prescribed_path.hpp"
 #include "craneassist/input/replay.hpp"
+#include "file_error_checks.hpp"
+#include "thrown_error.hpp"
 
 namespace craneassist::input {
 namespace {
@@ -84,13 +86,8 @@ std::string row(const Format& format, std::string t, std::size_t column = 0,
 
 // The error a text gives (a failure when it is accepted).
 FileError error_of(const Format& format, std::string_view text) {
-  try {
-    format.parse(text);
-  } catch (const FileError& e) {
-    return e;
-  }
-  ADD_FAILURE() << format.name << " accepted:\n" << text;
-  return FileError("", 0, "", "");
+  return test::thrown_error<FileError>([&] { format.parse(text); },
+                                       format.name + " accepted:\n" + std::string(text));
 }
 
 // Checks file, line, field, the whole reason and the what() layout: "FILE:LINE: field 'NAME':
@@ -99,13 +96,8 @@ void expect_error(const Format& format, std::string_view text, std::size_t line,
                   const std::string& field, const std::string& reason) {
   SCOPED_TRACE(format.name + ":\n" + std::string(text));
   const FileError e = error_of(format, text);
-  EXPECT_EQ(e.file(), kSource);
-  EXPECT_EQ(e.line(), line);
-  EXPECT_EQ(e.field(), field);
+  test::expect_file_error(e, kSource, line, field, reason);
   EXPECT_EQ(e.reason(), reason);
-  const std::string where = std::string(kSource) + ":" + std::to_string(line) + ": ";
-  EXPECT_EQ(std::string(e.what()),
-            where + (field.empty() ? "" : "field '" + field + "': ") + reason);
 }
 
 // A file: a comment, the header, valid rows at t = 0, 1, ... and then `last` if given.

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "craneassist/config/joystick_config.hpp"
+#include "thrown_error.hpp"
 
 using namespace craneassist;
 
@@ -26,13 +27,8 @@ config::ConfigError error_after_edit(const std::string& from, const std::string&
   const auto pos = text.find(from);
   EXPECT_NE(pos, std::string::npos) << from;
   text.replace(pos, from.size(), to);
-  try {
-    config::parse_joystick_config(text, "pad.yaml");
-  } catch (const config::ConfigError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no error for " << to;
-  return config::ConfigError("", 0, "", "");
+  return test::thrown_error<config::ConfigError>(
+      [&] { config::parse_joystick_config(text, "pad.yaml"); }, "no error for " + to);
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 #include "craneassist/control/replay_runner.hpp"
 #include "craneassist/input/replay.hpp"
 #include "craneassist/offline/sim_setup.hpp"
+#include "csv_cells.hpp"
 
 using namespace craneassist;
 
@@ -180,11 +181,7 @@ TEST(LiveLoop, RecordedSessionReplaysToTheSameLog) {
   std::istringstream lines(a);
   std::string line;
   std::getline(lines, line);
-  std::vector<std::string> header;
-  {
-    std::istringstream names(line);
-    for (std::string x; std::getline(names, x, ',');) header.push_back(x);
-  }
+  const std::vector<std::string> header = test::csv_cells(line);
   auto column = [&](const std::string& name) {
     const auto it = std::find(header.begin(), header.end(), name);
     EXPECT_NE(it, header.end()) << name;
@@ -193,9 +190,7 @@ TEST(LiveLoop, RecordedSessionReplaysToTheSameLog) {
   const std::size_t cmd_vx = column("cmd_vx"), sdot = column("sdot"), spool1 = column("spool1");
   int nan_rows = 0, at_rest_rows = 0, neutral_rows = 0;
   while (std::getline(lines, line)) {
-    std::vector<std::string> f;
-    std::istringstream fields(line);
-    for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+    const std::vector<std::string> f = test::csv_cells(line);
     if (f[cmd_vx] != "nan") continue;
     ++nan_rows;
     if (std::stod(f[sdot]) != 0.0) continue;

@@ -13,6 +13,8 @@
 
 #include "allocation_counter.hpp"
 #include "craneassist/input/prescribed_path.hpp"
+#include "file_error_checks.hpp"
+#include "thrown_error.hpp"
 
 namespace craneassist::input {
 namespace {
@@ -42,27 +44,15 @@ double sampled_peak_speed(const PrescribedPath& path, double dt_s) {
 }
 
 FileError parse_error(std::string_view text) {
-  try {
-    PrescribedPath::parse(text, kSource);
-  } catch (const FileError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "accepted:\n" << text;
-  return FileError("", 0, "", "");
+  return test::thrown_error<FileError>([&] { PrescribedPath::parse(text, kSource); },
+                                       "accepted:\n" + std::string(text));
 }
 
 // Checks line, field, that the reason contains reason_part, and the what() layout.
 void expect_rejected(std::string_view text, std::size_t line, std::string_view field,
                      std::string_view reason_part) {
   SCOPED_TRACE(std::string("text:\n") + std::string(text));
-  const FileError e = parse_error(text);
-  EXPECT_EQ(e.file(), kSource);
-  EXPECT_EQ(e.line(), line);
-  EXPECT_EQ(e.field(), field);
-  EXPECT_NE(e.reason().find(reason_part), std::string::npos) << e.reason();
-  const std::string prefix = std::string(kSource) + ":" + std::to_string(line) + ": ";
-  const std::string field_part = field.empty() ? "" : "field '" + std::string(field) + "': ";
-  EXPECT_EQ(std::string(e.what()), prefix + field_part + e.reason());
+  test::expect_file_error(parse_error(text), kSource, line, field, reason_part);
 }
 
 // ---- quintic line ------------------------------------------------------------------------------

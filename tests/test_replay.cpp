@@ -17,6 +17,8 @@
 
 #include "allocation_counter.hpp"
 #include "craneassist/input/replay.hpp"
+#include "file_error_checks.hpp"
+#include "thrown_error.hpp"
 
 namespace craneassist::input {
 namespace {
@@ -27,27 +29,15 @@ constexpr const char* kSource = "bad_replay.csv";
 
 // Parses text that must be rejected; returns the error for further checks.
 FileError parse_error(std::string_view text, const ReplayLimits& limits = {}) {
-  try {
-    Replay::parse(text, kSource, limits);
-  } catch (const FileError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "accepted:\n" << text;
-  return FileError("", 0, "", "");
+  return test::thrown_error<FileError>([&] { Replay::parse(text, kSource, limits); },
+                                       "accepted:\n" + std::string(text));
 }
 
 // Checks line, field, that the reason contains reason_part, and the what() layout.
 void expect_rejected(std::string_view text, std::size_t line, std::string_view field,
                      std::string_view reason_part, const ReplayLimits& limits = {}) {
   SCOPED_TRACE(std::string("text:\n") + std::string(text));
-  const FileError e = parse_error(text, limits);
-  EXPECT_EQ(e.file(), kSource);
-  EXPECT_EQ(e.line(), line);
-  EXPECT_EQ(e.field(), field);
-  EXPECT_NE(e.reason().find(reason_part), std::string::npos) << e.reason();
-  const std::string prefix = std::string(kSource) + ":" + std::to_string(line) + ": ";
-  const std::string field_part = field.empty() ? "" : "field '" + std::string(field) + "': ";
-  EXPECT_EQ(std::string(e.what()), prefix + field_part + e.reason());
+  test::expect_file_error(parse_error(text, limits), kSource, line, field, reason_part);
 }
 
 void expect_vec(const Eigen::Vector3d& actual, double x, double y, double z) {

@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -17,6 +16,7 @@
 #include "craneassist/input/replay.hpp"
 #include "craneassist/offline/sine_path_experiment.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
+#include "csv_cells.hpp"
 
 using namespace craneassist;
 
@@ -36,14 +36,12 @@ Log read_log(const std::filesystem::path& path) {
   std::ifstream in(path);
   std::string line;
   std::getline(in, line);
-  std::vector<std::string> names;
-  std::stringstream hs(line);
-  for (std::string cell; std::getline(hs, cell, ',');) names.push_back(cell);
+  const std::vector<std::string> names = test::csv_cells(line);
   Log log;
   while (std::getline(in, line)) {
-    std::stringstream ss(line);
-    std::size_t c = 0;
-    for (std::string cell; std::getline(ss, cell, ','); ++c) {
+    const std::vector<std::string> cells = test::csv_cells(line);
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      const std::string& cell = cells[c];
       if (names[c] == "active_limit") {
         log.active_limit.push_back(cell);
       } else if (names[c] == "pump_limit") {

@@ -6,6 +6,7 @@
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/offline/scenario_suite.hpp"
+#include "thrown_error.hpp"
 
 using namespace craneassist;
 
@@ -15,14 +16,12 @@ const std::filesystem::path kReplays =
     std::filesystem::path(CRANEASSIST_SOURCE_DIR) / "examples/replays";
 
 config::ConfigError error_of(const std::string& yaml) {
-  try {
-    const auto suite = offline::parse_suite(yaml, "test.yaml", kReplays);
-    offline::check_suite(suite, config::default_crane_config());
-  } catch (const config::ConfigError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no error for:\n" << yaml;
-  return config::ConfigError("", 0, "", "");
+  return test::thrown_error<config::ConfigError>(
+      [&] {
+        const auto suite = offline::parse_suite(yaml, "test.yaml", kReplays);
+        offline::check_suite(suite, config::default_crane_config());
+      },
+      "no error for:\n" + yaml);
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "craneassist/dynamics/valve_table.hpp"
 #include "craneassist/valves/proportional_valves.hpp"
 #include "craneassist/valves/reference_follower.hpp"
+#include "thrown_error.hpp"
 
 namespace {
 
@@ -47,13 +48,9 @@ std::string k70m_with_tables(const std::string& block) {
 }
 
 config::ConfigError table_error(const std::string& block) {
-  try {
-    config::parse_crane_config(k70m_with_tables(block), "tables.yaml");
-  } catch (const config::ConfigError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no error for\n" << block;
-  return config::ConfigError("", 0, "", "");
+  return test::thrown_error<config::ConfigError>(
+      [&] { config::parse_crane_config(k70m_with_tables(block), "tables.yaml"); },
+      "no error for\n" + block);
 }
 
 int line_in(const std::string& text, const std::string& needle) {

@@ -90,6 +90,17 @@ void apply_common_options(ToolOptions& o, const DdsToolArgs& args,
   o.type_propagation = settings.type_propagation;
 }
 
+// Runs a tool (dds::run_echo, dds::run_dashboard) with its own options o and the settings and
+// common options, ending cleanly on a signal; kExitUsage when the settings file is bad.
+template <class ToolOptions, class Run>
+int run_tool(const DdsToolArgs& args, ToolOptions o, Run run) {
+  const auto settings = tool_settings(args);
+  if (!settings) return kExitUsage;
+  apply_common_options(o, args, *settings);
+  StopOnSignal stop;
+  return run(o);
+}
+
 }  // namespace
 
 CLI::App* add_echo_command(CLI::App& cli, EchoArgs& args) {
@@ -111,15 +122,11 @@ CLI::App* add_echo_command(CLI::App& cli, EchoArgs& args) {
 }
 
 int run_echo_command(const EchoArgs& args) {
-  const auto settings = tool_settings(args);
-  if (!settings) return kExitUsage;
   dds::EchoOptions o;
   o.topic = args.topic;
   o.count = args.count;
   o.format = args.format == "csv" ? dds::EchoFormat::kCsv : dds::EchoFormat::kText;
-  apply_common_options(o, args, *settings);
-  StopOnSignal stop;
-  return dds::run_echo(o);
+  return run_tool(args, o, dds::run_echo);
 }
 
 CLI::App* add_dashboard_command(CLI::App& cli, DashboardArgs& args) {
@@ -135,13 +142,9 @@ CLI::App* add_dashboard_command(CLI::App& cli, DashboardArgs& args) {
 }
 
 int run_dashboard_command(const DashboardArgs& args) {
-  const auto settings = tool_settings(args);
-  if (!settings) return kExitUsage;
   dds::DashboardOptions o;
   o.once = args.once;
-  apply_common_options(o, args, *settings);
-  StopOnSignal stop;
-  return dds::run_dashboard(o);
+  return run_tool(args, o, dds::run_dashboard);
 }
 
 CLI::App* add_web_watch_command(CLI::App& cli, WebWatchArgs& args) {

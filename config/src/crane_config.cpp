@@ -116,6 +116,15 @@ class Reader : public YamlReader {
     return v;
   }
 
+  // One of `values` by its name (required); else a failure "expected A, B or C, got 'X'".
+  template <typename Enum, std::size_t N>
+  Enum one_of(const YAML::Node& map, const std::string& key, const std::string& path,
+              const std::array<Enum, N>& values) const {
+    const std::string name = text(map, key, path);
+    if (const auto value = parse_name(values, name)) return *value;
+    fail(map[key], join(path, key), "expected " + alternatives(values) + ", got '" + name + "'");
+  }
+
   int unsourced() const { return unsourced_; }
 
  private:
@@ -412,15 +421,7 @@ void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& mo
                                      p.max_pressure_pa, "between 0 and max_pressure");
   // Optional: the mode defaults to load sensing; the constant-pressure setpoint is needed in that
   // mode only, but may be given in either (--pump-mode cp then uses it).
-  if (pump["mode"].IsDefined()) {
-    const std::string mode = r.text(pump, "mode", pp);
-    if (const auto parsed = dynamics::parse_pump_mode(mode)) {
-      p.mode = *parsed;
-    } else {
-      r.fail(pump["mode"], pp + ".mode",
-             "expected " + alternatives(dynamics::kPumpModes) + ", got '" + mode + "'");
-    }
-  }
+  if (pump["mode"].IsDefined()) p.mode = r.one_of(pump, "mode", pp, dynamics::kPumpModes);
   if (pump["supply_pressure"].IsDefined()) {
     p.supply_pressure_pa = r.value(pump, "supply_pressure", pp, Dimension::kPressure);
     if (const std::string why = supply_pressure_problem(p, p.supply_pressure_pa); !why.empty()) {
@@ -545,13 +546,7 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
                                           0.0, 10.0, "between 0 and 10 s");
   sc.power_reserve = r.value_in(scaling, "power_reserve", sp, Dimension::kDimensionless, 0.0, 0.5,
                                 "between 0 and 0.5");
-  const std::string bound = r.text(scaling, "power_bound", sp);
-  if (const auto parsed = dynamics::parse_power_bound(bound)) {
-    sc.power_bound = *parsed;
-  } else {
-    r.fail(scaling["power_bound"], sp + ".power_bound",
-           "expected " + alternatives(dynamics::kPowerBounds) + ", got '" + bound + "'");
-  }
+  sc.power_bound = r.one_of(scaling, "power_bound", sp, dynamics::kPowerBounds);
 
   const YAML::Node redundancy = r.child(root, "redundancy", "");
   r.check_keys(redundancy, "redundancy", {"resolution"});

@@ -101,11 +101,7 @@ RigidBodyTerms::RigidBodyTerms(const CraneModel& model)
     // Motor reactions of path_terms(); ODE fills these on every step.
     dJointSetFeedback(crane.joint(i), &impl_->feedback[i]);
     // Rigid motor rows (the motor CFM defaults to the world's CFM at joint creation; say it).
-    if (crane.model().joints[i - 1].type == JointType::kRevolute) {
-      dJointSetHingeParam(crane.joint(i), dParamCFM, 0.0);
-    } else {
-      dJointSetSliderParam(crane.joint(i), dParamCFM, 0.0);
-    }
+    set_motor_param(i, dParamCFM, 0.0);
   }
   // Warm-up: the first dWorldStep allocates ODE's step arena; the motor steps of path_terms()
   // have n more constraint rows, so size it for those too.
@@ -136,12 +132,7 @@ bool RigidBodyTerms::step_world() noexcept {
 void RigidBodyTerms::step_from_rest(const JointVector& q, const JointVector& effort,
                                     bool with_gravity, JointVector& qddot) {
   OdeCrane& crane = *impl_->crane;
-  power_motors(false);
-  crane.set_state(q, zero_);
-  for (int i = 1; i <= n_; ++i) {
-    dBodySetForce(crane.body(i), 0.0, 0.0, 0.0);
-    dBodySetTorque(crane.body(i), 0.0, 0.0, 0.0);
-  }
+  rest_at(q, false);
   set_gravity(with_gravity);
   crane.add_joint_efforts(effort);
   if (!step_world()) {
@@ -213,35 +204,38 @@ void RigidBodyTerms::compute(const JointVector& q, const JointVector& qdot, Dyna
 
 void RigidBodyTerms::power_motors(bool on) noexcept {
   if (on == motors_on_) return;
-  const OdeCrane& crane = *impl_->crane;
   // dInfinity makes the motor row an unbounded (equality) row of ODE's LCP; 0 removes the row.
   const double fmax = on ? dInfinity : 0.0;
-  for (int i = 1; i <= n_; ++i) {
-    if (crane.model().joints[i - 1].type == JointType::kRevolute) {
-      dJointSetHingeParam(crane.joint(i), dParamFMax, fmax);
-    } else {
-      dJointSetSliderParam(crane.joint(i), dParamFMax, fmax);
-    }
-  }
+  for (int i = 1; i <= n_; ++i) set_motor_param(i, dParamFMax, fmax);
   motors_on_ = on;
+}
+
+void RigidBodyTerms::set_motor_param(int i, int param, double value) noexcept {
+  const OdeCrane& crane = *impl_->crane;
+  if (crane.model().joints[i - 1].type == JointType::kRevolute) {
+    dJointSetHingeParam(crane.joint(i), param, value);
+  } else {
+    dJointSetSliderParam(crane.joint(i), param, value);
+  }
+}
+
+void RigidBodyTerms::rest_at(const JointVector& q, bool motors) noexcept {
+  OdeCrane& crane = *impl_->crane;
+  power_motors(motors);
+  crane.set_state(q, zero_);
+  for (int i = 1; i <= n_; ++i) {
+    dBodySetForce(crane.body(i), 0.0, 0.0, 0.0);
+    dBodySetTorque(crane.body(i), 0.0, 0.0, 0.0);
+  }
 }
 
 bool RigidBodyTerms::motor_step(const JointVector& q, const JointVector& qddot, bool with_gravity,
                                 const JointVector* velocity_products,
                                 JointVector& effort) noexcept {
-  OdeCrane& crane = *impl_->crane;
-  power_motors(true);
-  crane.set_state(q, zero_);
+  rest_at(q, true);
   for (int i = 1; i <= n_; ++i) {
-    dBodySetForce(crane.body(i), 0.0, 0.0, 0.0);
-    dBodySetTorque(crane.body(i), 0.0, 0.0, 0.0);
     // From rest the motor row enforces rate = dParamVel after the step: dt * qddot.
-    const double rate = kProbeStepS * qddot[i - 1];
-    if (crane.model().joints[i - 1].type == JointType::kRevolute) {
-      dJointSetHingeParam(crane.joint(i), dParamVel, rate);
-    } else {
-      dJointSetSliderParam(crane.joint(i), dParamVel, rate);
-    }
+    set_motor_param(i, dParamVel, kProbeStepS * qddot[i - 1]);
   }
   set_gravity(with_gravity);
   if (velocity_products != nullptr) add_velocity_product_wrenches(*velocity_products);

@@ -21,36 +21,41 @@ constexpr std::array<const char*, kGamepadButtonCount> kButtonNames = {"a",
                                                                        "dpad_left",
                                                                        "dpad_right"};
 
+// The name of enumerator i of a name table, "unknown" past its end.
+template <std::size_t N>
+const char* name_in(const std::array<const char*, N>& names, std::size_t i) {
+  return i < N ? names[i] : "unknown";
+}
+
+// The enumerator whose name in the table is `name`: true and out set; false (out unchanged) when
+// no name matches.
+template <class Enum, std::size_t N>
+bool parse_name(const std::array<const char*, N>& names, std::string_view name, Enum& out) {
+  for (std::size_t i = 0; i < N; ++i) {
+    if (name == names[i]) {
+      out = static_cast<Enum>(i);
+      return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 const char* to_string(GamepadAxis axis) {
-  const auto i = static_cast<std::size_t>(axis);
-  return i < kAxisNames.size() ? kAxisNames[i] : "unknown";
+  return name_in(kAxisNames, static_cast<std::size_t>(axis));
 }
 
 const char* to_string(GamepadButton button) {
-  const auto i = static_cast<std::size_t>(button);
-  return i < kButtonNames.size() ? kButtonNames[i] : "unknown";
+  return name_in(kButtonNames, static_cast<std::size_t>(button));
 }
 
 bool parse_gamepad_axis(std::string_view name, GamepadAxis& out) {
-  for (std::size_t i = 0; i < kAxisNames.size(); ++i) {
-    if (name == kAxisNames[i]) {
-      out = static_cast<GamepadAxis>(i);
-      return true;
-    }
-  }
-  return false;
+  return parse_name(kAxisNames, name, out);
 }
 
 bool parse_gamepad_button(std::string_view name, GamepadButton& out) {
-  for (std::size_t i = 0; i < kButtonNames.size(); ++i) {
-    if (name == kButtonNames[i]) {
-      out = static_cast<GamepadButton>(i);
-      return true;
-    }
-  }
-  return false;
+  return parse_name(kButtonNames, name, out);
 }
 
 }  // namespace craneassist::input

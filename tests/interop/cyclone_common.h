@@ -1,6 +1,7 @@
 /* What the Cyclone DDS programs of the interop tests share (cyclone_reader.c, cyclone_writer.c,
- * cyclone_ros2_reader.c): the clock of the telemetry headers' stamp_ns, a topic with
- * craneassist's QoS, and the readers' checks. */
+ * cyclone_ros2_reader.c): the clock of the telemetry headers' stamp_ns, exit 3 when Cyclone
+ * fails, the participant, topics with their readers or writers, craneassist's QoS, and the
+ * readers' checks. */
 #ifndef CRANEASSIST_CYCLONE_COMMON_H
 #define CRANEASSIST_CYCLONE_COMMON_H
 
@@ -19,15 +20,48 @@ static inline int64_t monotonic_ns(void) {
   return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
 }
 
+/* rc, what the Cyclone call `call` returned for the topic `name` (an entity or a count); exits 3
+ * with "WHO: CALL NAME: reason" when it is an error. */
+static inline dds_return_t dds_or_exit(dds_return_t rc, const char* who, const char* call,
+                                       const char* name) {
+  if (rc < 0) {
+    fprintf(stderr, "%s: %s %s: %s\n", who, call, name, dds_strretcode(-rc));
+    exit(3);
+  }
+  return rc;
+}
+
+/* The participant on `domain`; exits 3 (naming `who`) when Cyclone refuses it. */
+static inline dds_entity_t create_participant_or_exit(dds_domainid_t domain, const char* who) {
+  const dds_entity_t pp = dds_create_participant(domain, NULL, NULL);
+  if (pp < 0) {
+    fprintf(stderr, "%s: dds_create_participant: %s\n", who, dds_strretcode(-pp));
+    exit(3);
+  }
+  return pp;
+}
+
 /* The topic `name` on pp; exits 3 (naming `who`) when Cyclone refuses it. */
 static inline dds_entity_t create_topic_or_exit(dds_entity_t pp, const dds_topic_descriptor_t* desc,
                                                 const char* name, const char* who) {
-  const dds_entity_t topic = dds_create_topic(pp, desc, name, NULL, NULL);
-  if (topic < 0) {
-    fprintf(stderr, "%s: dds_create_topic %s: %s\n", who, name, dds_strretcode(-topic));
-    exit(3);
-  }
-  return topic;
+  return dds_or_exit(dds_create_topic(pp, desc, name, NULL, NULL), who, "dds_create_topic", name);
+}
+
+/* dds_create_reader or dds_create_writer. */
+typedef dds_entity_t (*create_endpoint_fn)(dds_entity_t, dds_entity_t, const dds_qos_t*,
+                                           const dds_listener_t*);
+
+/* A reader or a writer (`create`, named `call`) of a new topic `name` on pp with qos, which it
+ * frees; exits 3 (naming `who`) when Cyclone refuses the topic or the endpoint. */
+static inline dds_entity_t create_endpoint_or_exit(create_endpoint_fn create, const char* call,
+                                                   dds_entity_t pp,
+                                                   const dds_topic_descriptor_t* desc,
+                                                   const char* name, dds_qos_t* qos,
+                                                   const char* who) {
+  const dds_entity_t topic = create_topic_or_exit(pp, desc, name, who);
+  const dds_entity_t endpoint = create(pp, topic, qos, NULL);
+  dds_delete_qos(qos);
+  return dds_or_exit(endpoint, who, call, name);
 }
 
 /* craneassist's default QoS: status reliable (blocking at most max_blocking) and transient

@@ -30,6 +30,15 @@ run_replay() {
   "$bin" replay "$replay" --realtime --settle 3 --no-log --telemetry --domain "$domain" "$@" \
     > "$work/replay.out" 2>&1 || { cat "$work/replay.out"; fail "replay failed"; }
 }
+# Waits for the reader started by start_reader, its exit code in $reader_rc; shows what it
+# printed and the replay's lines with PATTERN.
+finish_reader() {
+  reader_rc=0
+  wait "$bg_pid" || reader_rc=$?
+  bg_pid=
+  cat "$work/reader.out" "$work/reader.err"
+  grep "$1" "$work/replay.out"
+}
 # The count of TOPIC in the line with "samples" or "received" of FILE ("..., TOPIC N, ...").
 count_of() {
   grep -E "samples status|received status" "$work/$2" |
@@ -40,12 +49,8 @@ case $case_name in
 reader)
   start_reader 40
   run_replay
-  rc=0
-  wait "$bg_pid" || rc=$?
-  bg_pid=
-  cat "$work/reader.out" "$work/reader.err"
-  grep "telemetry:" "$work/replay.out"
-  [ "$rc" = 0 ] || fail "cyclone reader: exit $rc"
+  finish_reader "telemetry:"
+  [ "$reader_rc" = 0 ] || fail "cyclone reader: exit $reader_rc"
   has reader.out "last status 'stopped'"
   has reader.out " 0 failed checks"
   # Best effort over discovery: Cyclone gets most of what was published (not the samples
@@ -131,12 +136,8 @@ type_propagation: {type_object: true, type_information: true}
 EOF
   start_reader 9
   run_replay --telemetry-config "$work/telemetry.yaml"
-  rc=0
-  wait "$bg_pid" || rc=$?
-  bg_pid=
-  cat "$work/reader.out"
-  grep "telemetry:" "$work/replay.out"
-  [ "$rc" = 1 ] || fail "cyclone reader: exit $rc, expected 1 (nothing received)"
+  finish_reader "telemetry:"
+  [ "$reader_rc" = 1 ] || fail "cyclone reader: exit $reader_rc, expected 1 (nothing received)"
   has reader.out "received status 0, joints 0, hydraulics 0, command_path 0"
   echo "type_information OK"
   ;;
@@ -158,12 +159,8 @@ ros2:
 YAML
   start_reader 40 /crane1 "$joints" "$command_base"
   run_replay --ros2 --telemetry-config "$work/telemetry.yaml"
-  rc=0
-  wait "$bg_pid" || rc=$?
-  bg_pid=
-  cat "$work/reader.out" "$work/reader.err"
-  grep "telemetry" "$work/replay.out"
-  [ "$rc" = 0 ] || fail "cyclone ros2 reader: exit $rc"
+  finish_reader telemetry
+  [ "$reader_rc" = 0 ] || fail "cyclone ros2 reader: exit $reader_rc"
   has replay.out "ROS 2 topics /crane1/joint_states"
   has reader.out " 0 failed checks"
   has reader.out "last positions = last craneassist q: yes"

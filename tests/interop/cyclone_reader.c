@@ -181,17 +181,10 @@ static void check_command_path(const craneassist_msg_CommandPath* m) {
 
 static dds_entity_t make_reader(dds_entity_t pp, const dds_topic_descriptor_t* desc,
                                 const char* name, bool reliable) {
-  const dds_entity_t topic = create_topic_or_exit(pp, desc, name, "cyclone reader");
   /* status: reliable and transient local like craneassist's status writer (the last status
    * comes on matching); the others best effort and volatile like craneassist's writers. */
-  dds_qos_t* qos = craneassist_qos(reliable, DDS_SECS(1), 256);
-  const dds_entity_t reader = dds_create_reader(pp, topic, qos, NULL);
-  dds_delete_qos(qos);
-  if (reader < 0) {
-    fprintf(stderr, "cyclone reader: dds_create_reader %s: %s\n", name, dds_strretcode(-reader));
-    exit(3);
-  }
-  return reader;
+  return create_endpoint_or_exit(dds_create_reader, "dds_create_reader", pp, desc, name,
+                                 craneassist_qos(reliable, DDS_SECS(1), 256), "cyclone reader");
 }
 
 /* Takes what the reader has; returns how many valid samples were checked. */
@@ -199,11 +192,8 @@ static int take_all(dds_entity_t reader, int topic) {
   enum { kMax = 64 };
   void* samples[kMax] = {NULL};
   dds_sample_info_t infos[kMax];
-  const dds_return_t n = dds_take(reader, samples, infos, kMax, kMax);
-  if (n < 0) {
-    fprintf(stderr, "cyclone reader: dds_take %s: %s\n", kNames[topic], dds_strretcode(-n));
-    exit(3);
-  }
+  const dds_return_t n = dds_or_exit(dds_take(reader, samples, infos, kMax, kMax), "cyclone reader",
+                                     "dds_take", kNames[topic]);
   int valid = 0;
   for (dds_return_t i = 0; i < n; ++i) {
     if (!infos[i].valid_data) continue;
@@ -234,11 +224,7 @@ int main(int argc, char** argv) {
   }
   const dds_domainid_t domain = (dds_domainid_t)atoi(argv[1]);
   const double seconds = atof(argv[2]);
-  const dds_entity_t pp = dds_create_participant(domain, NULL, NULL);
-  if (pp < 0) {
-    fprintf(stderr, "cyclone reader: dds_create_participant: %s\n", dds_strretcode(-pp));
-    return 3;
-  }
+  const dds_entity_t pp = create_participant_or_exit(domain, "cyclone reader");
   const dds_entity_t readers[kTopics] = {
       make_reader(pp, &craneassist_msg_Status_desc, "craneassist/status", true),
       make_reader(pp, &craneassist_msg_JointState_desc, "craneassist/joints", false),

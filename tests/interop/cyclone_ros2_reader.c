@@ -123,11 +123,8 @@ static void take_all(dds_entity_t reader, int topic) {
   enum { kMax = 64 };
   void* samples[kMax] = {NULL};
   dds_sample_info_t infos[kMax];
-  const dds_return_t n = dds_take(reader, samples, infos, kMax, kMax);
-  if (n < 0) {
-    fprintf(stderr, "cyclone ros2 reader: dds_take %s: %s\n", kNames[topic], dds_strretcode(-n));
-    exit(3);
-  }
+  const dds_return_t n = dds_or_exit(dds_take(reader, samples, infos, kMax, kMax),
+                                     "cyclone ros2 reader", "dds_take", kNames[topic]);
   for (dds_return_t i = 0; i < n; ++i) {
     if (!infos[i].valid_data) continue;
     ++g_count[topic];
@@ -149,15 +146,8 @@ static void take_all(dds_entity_t reader, int topic) {
 
 static dds_entity_t make_reader(dds_entity_t pp, const dds_topic_descriptor_t* desc,
                                 const char* name, dds_qos_t* qos) {
-  const dds_entity_t topic = create_topic_or_exit(pp, desc, name, "cyclone ros2 reader");
-  const dds_entity_t reader = dds_create_reader(pp, topic, qos, NULL);
-  dds_delete_qos(qos);
-  if (reader < 0) {
-    fprintf(stderr, "cyclone ros2 reader: dds_create_reader %s: %s\n", name,
-            dds_strretcode(-reader));
-    exit(3);
-  }
-  return reader;
+  return create_endpoint_or_exit(dds_create_reader, "dds_create_reader", pp, desc, name, qos,
+                                 "cyclone ros2 reader");
 }
 
 /* ROS 2's default subscription QoS (rmw_qos_profile_default). */
@@ -186,11 +176,7 @@ int main(int argc, char** argv) {
   snprintf(names[1], sizeof names[1], "rt%s/craneassist/tip_velocity/command", ns);
   snprintf(names[2], sizeof names[2], "rt%s/craneassist/tip_velocity/reference", ns);
 
-  const dds_entity_t pp = dds_create_participant(domain, NULL, NULL);
-  if (pp < 0) {
-    fprintf(stderr, "cyclone ros2 reader: dds_create_participant: %s\n", dds_strretcode(-pp));
-    return 3;
-  }
+  const dds_entity_t pp = create_participant_or_exit(domain, "cyclone ros2 reader");
   const dds_entity_t readers[kTopics] = {
       make_reader(pp, &sensor_msgs_msg_dds__JointState__desc, names[0], ros2_default_qos()),
       make_reader(pp, &geometry_msgs_msg_dds__TwistStamped__desc, names[1], ros2_default_qos()),

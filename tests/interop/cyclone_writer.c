@@ -26,15 +26,8 @@ static void on_signal(int sig) {
 
 static dds_entity_t make_writer(dds_entity_t pp, const dds_topic_descriptor_t* desc,
                                 const char* name, bool reliable) {
-  const dds_entity_t topic = create_topic_or_exit(pp, desc, name, "cyclone writer");
-  dds_qos_t* qos = craneassist_qos(reliable, DDS_MSECS(10), 1);
-  const dds_entity_t writer = dds_create_writer(pp, topic, qos, NULL);
-  dds_delete_qos(qos);
-  if (writer < 0) {
-    fprintf(stderr, "cyclone writer: dds_create_writer %s: %s\n", name, dds_strretcode(-writer));
-    exit(3);
-  }
-  return writer;
+  return create_endpoint_or_exit(dds_create_writer, "dds_create_writer", pp, desc, name,
+                                 craneassist_qos(reliable, DDS_MSECS(10), 1), "cyclone writer");
 }
 
 int main(int argc, char** argv) {
@@ -46,11 +39,7 @@ int main(int argc, char** argv) {
   const double seconds = atof(argv[2]);
   signal(SIGTERM, on_signal);
   signal(SIGINT, on_signal);
-  const dds_entity_t pp = dds_create_participant(domain, NULL, NULL);
-  if (pp < 0) {
-    fprintf(stderr, "cyclone writer: dds_create_participant: %s\n", dds_strretcode(-pp));
-    return 3;
-  }
+  const dds_entity_t pp = create_participant_or_exit(domain, "cyclone writer");
   const dds_entity_t w_status =
       make_writer(pp, &craneassist_msg_Status_desc, "craneassist/status", true);
   const dds_entity_t w_joints =

@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <thread>
 #include <vector>
 
 namespace craneassist::input {
@@ -266,17 +267,12 @@ EventReaderOpener libevdev_opener(std::string path, std::string name_match) {
 
 EvdevSource::EvdevSource(const JoystickMapping& mapping, EventReaderOpener opener,
                          const Options& options)
-    : mapper_(mapping), opener_(std::move(opener)), options_(options) {
-  if (options_.own_thread) {
-    thread_ = std::thread([this] {
-      while (running_.load()) service();
-    });
-  }
+    : DevicePadSource(mapping), opener_(std::move(opener)), options_(options) {
+  if (options_.own_thread) start_reader();
 }
 
 EvdevSource::~EvdevSource() {
-  running_.store(false);
-  if (thread_.joinable()) thread_.join();
+  stop_reader();
 }
 
 void EvdevSource::service() {
@@ -324,20 +320,6 @@ void EvdevSource::service() {
   // The state is confirmed now, events or not (a stick held still sends nothing).
   published_.stamp_s = steady_now_s();
   latest_.publish(published_);
-}
-
-void EvdevSource::begin_cycle(double /*now_s*/, const Eigen::Vector3d& tip_m) noexcept {
-  tip_ = tip_m;
-}
-
-SourceState EvdevSource::poll(OperatorCommand& out) noexcept {
-  latest_.try_take(taken_);
-  if (!taken_.connected) return SourceState::kDisconnected;
-  if (!taken_.has_state) return SourceState::kNoData;
-  out.v_m_s = mapper_.map(taken_.pad, tip_);
-  out.deadman = mapper_.deadman(taken_.pad);
-  out.stamp_s = taken_.stamp_s;
-  return SourceState::kOk;
 }
 
 }  // namespace craneassist::input

@@ -7,22 +7,17 @@
 
 namespace craneassist::input {
 SdlSource::SdlSource(const JoystickMapping& mapping, const Options& options)
-    : mapper_(mapping), options_(options) {
+    : DevicePadSource(mapping), options_(options) {
   SDL_SetHint(SDL_HINT_JOYSTICK_ALLOW_BACKGROUND_EVENTS, "1");
   if (SDL_InitSubSystem(SDL_INIT_GAMECONTROLLER) != 0) {
     throw std::runtime_error(std::string("SDL: cannot initialise game controllers: ") +
                              SDL_GetError());
   }
-  if (options_.own_thread) {
-    thread_ = std::thread([this] {
-      while (running_.load()) service();
-    });
-  }
+  if (options_.own_thread) start_reader();
 }
 
 SdlSource::~SdlSource() {
-  running_.store(false);
-  if (thread_.joinable()) thread_.join();
+  stop_reader();
   if (controller_ != nullptr) SDL_GameControllerClose(controller_);
   SDL_QuitSubSystem(SDL_INIT_GAMECONTROLLER);
 }
@@ -69,19 +64,6 @@ void SdlSource::service() {
   }
   published_.stamp_s = input::steady_now_s();
   latest_.publish(published_);
-}
-
-void SdlSource::begin_cycle(double /*now_s*/, const Eigen::Vector3d& tip_m) noexcept {
-  tip_ = tip_m;
-}
-
-SourceState SdlSource::poll(OperatorCommand& out) noexcept {
-  latest_.try_take(taken_);
-  if (!taken_.connected) return SourceState::kDisconnected;
-  out.v_m_s = mapper_.map(taken_.pad, tip_);
-  out.deadman = mapper_.deadman(taken_.pad);
-  out.stamp_s = taken_.stamp_s;
-  return SourceState::kOk;
 }
 
 }  // namespace craneassist::input

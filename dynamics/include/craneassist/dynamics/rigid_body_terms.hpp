@@ -126,6 +126,12 @@ class RigidBodyTerms {
 
   // Velocity motors on (unlimited force) or off (the state of compute()'s probes).
   void power_motors(bool on) noexcept;
+  // ODE parameter `param` (dParamCFM, dParamFMax, dParamVel) of joint i's motor (1-based), hinge or
+  // slider.
+  void set_motor_param(int i, int param, double value) noexcept;
+  // The start of every probe step: the crane at rest at q, no force or torque on its bodies, the
+  // velocity motors on or off.
+  void rest_at(const JointVector& q, bool motors) noexcept;
   // Motor reactions after one step from (q, 0) with motor targets qddot, gravity on or off, and,
   // when velocity_products is given, minus the velocity-product inertial wrenches at that qdot.
   // False when the step failed (effort is then left as it was).

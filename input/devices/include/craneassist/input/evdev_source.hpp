@@ -2,10 +2,10 @@
 // any device whose axes and buttons use the same codes.
 //
 // EvdevDecoder turns input_event sequences into a GamepadState (pure, testable without a device).
-// EvdevSource runs the device on a reader thread: it opens the device (a path, a name match or
-// the first gamepad), reads events non-blocking with a bounded wait, reports a device that
-// returns ENODEV as disconnected and tries to re-open it at most every reopen_interval; the loop's
-// poll() takes the latest state without waiting and maps it (joystick_mapping.hpp).
+// EvdevSource runs the device on a reader thread (device_pad_source.hpp): it opens the device (a
+// path, a name match or the first gamepad), reads events non-blocking with a bounded wait, reports
+// a device that returns ENODEV as disconnected and tries to re-open it at most every
+// reopen_interval; the loop's poll() takes the latest state without waiting and maps it.
 #pragma once
 
 #include <linux/input.h>
@@ -15,11 +15,9 @@
 #include <functional>
 #include <memory>
 #include <string>
-#include <thread>
 
-#include "craneassist/input/command_source.hpp"
-#include "craneassist/input/joystick_mapping.hpp"
-#include "craneassist/input/latest_pad.hpp"
+#include "craneassist/input/device_pad_source.hpp"
+#include "craneassist/input/gamepad.hpp"
 
 namespace craneassist::input {
 
@@ -62,7 +60,7 @@ using EventReaderOpener = std::function<std::unique_ptr<EventReader>()>;
 // `name_match` (any gamepad-like device when empty: absolute X/Y and a south button).
 EventReaderOpener libevdev_opener(std::string path, std::string name_match);
 
-class EvdevSource : public CommandSource {
+class EvdevSource : public DevicePadSource {
  public:
   struct Options {
     double reopen_interval_s = 0.5;
@@ -71,20 +69,14 @@ class EvdevSource : public CommandSource {
   };
   EvdevSource(const JoystickMapping& mapping, EventReaderOpener opener, const Options& options);
   ~EvdevSource() override;
-  EvdevSource(const EvdevSource&) = delete;
-  EvdevSource& operator=(const EvdevSource&) = delete;
 
-  void begin_cycle(double now_s, const Eigen::Vector3d& tip_m) noexcept override;
-  SourceState poll(OperatorCommand& out) noexcept override;
   const char* name() const noexcept override { return "evdev"; }
 
-  // One round of the reader's work (open attempt, or reading events for up to wait_ms); the
-  // reader thread calls it in a loop.
-  void service();
+  // One round of the reader's work: an open attempt, or reading events for up to wait_ms.
+  void service() override;
   int open_attempts() const noexcept { return open_attempts_.load(); }
 
  private:
-  JoystickMapper mapper_;
   EventReaderOpener opener_;
   Options options_;
   // Reader thread state.
@@ -93,12 +85,6 @@ class EvdevSource : public CommandSource {
   PadSnapshot published_;
   double next_open_s_ = 0.0;
   std::atomic<int> open_attempts_{0};
-  // Loop side.
-  LatestPad latest_;
-  PadSnapshot taken_;
-  Eigen::Vector3d tip_ = Eigen::Vector3d::UnitX();
-  std::atomic<bool> running_{true};
-  std::thread thread_;
 };
 
 }  // namespace craneassist::input
