@@ -337,19 +337,17 @@ TEST(Telemetry, TheWatchAssemblesThePublishedFrame) {
   EXPECT_EQ(got.t_s, want.t_s);
   EXPECT_GT(got.stamp_ns, 0);
   ASSERT_EQ(got.dof, 4);
-  for (std::size_t i = 0; i < 4; ++i) {
-    EXPECT_EQ(got.q[i], want.q[i]);
-    EXPECT_EQ(got.q_ref[i], want.q_ref[i]);
-    EXPECT_EQ(got.qdot[i], want.qdot[i]);
-    EXPECT_EQ(got.cylinder_pos_m[i], want.cylinder_pos_m[i]);
-    EXPECT_EQ(got.cylinder_vel_m_s[i], want.cylinder_vel_m_s[i]);
-    EXPECT_EQ(got.load_pressure_pa[i], want.load_pressure_pa[i]);
-    EXPECT_EQ(got.spool[i], want.spool[i]);
+  // Whole arrays: the 4 joints, and zeros past them on both sides.
+  for (auto field :
+       {&cdds::TelemetryFrame::q, &cdds::TelemetryFrame::q_ref, &cdds::TelemetryFrame::qdot,
+        &cdds::TelemetryFrame::cylinder_pos_m, &cdds::TelemetryFrame::cylinder_vel_m_s,
+        &cdds::TelemetryFrame::load_pressure_pa, &cdds::TelemetryFrame::spool}) {
+    EXPECT_EQ(got.*field, want.*field);
   }
-  EXPECT_EQ(got.tip_m, want.tip_m);
-  EXPECT_EQ(got.tip_v_m_s, want.tip_v_m_s);
-  EXPECT_EQ(got.command_m_s, want.command_m_s);
-  EXPECT_EQ(got.reference_m_s, want.reference_m_s);
+  for (auto field : {&cdds::TelemetryFrame::tip_m, &cdds::TelemetryFrame::tip_v_m_s,
+                     &cdds::TelemetryFrame::command_m_s, &cdds::TelemetryFrame::reference_m_s}) {
+    EXPECT_EQ(got.*field, want.*field);
+  }
   EXPECT_EQ(got.pump_flow_m3_s, want.pump_flow_m3_s);
   EXPECT_EQ(got.pump_pressure_pa, want.pump_pressure_pa);
   EXPECT_EQ(got.pump_power_w, want.pump_power_w);

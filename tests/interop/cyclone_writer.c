@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
   const dds_entity_t w_command_path =
       make_writer(pp, &craneassist_msg_CommandPath_desc, "craneassist/command_path", false);
 
-  /* The values `craneassist echo` must print (tests/interop/cyclone_interop.sh). */
+  /* The values `craneassist echo` must print (tests/interop/interop.sh). */
   craneassist_msg_Status status;
   memset(&status, 0, sizeof status);
   status.crane = "Cyclone test crane";

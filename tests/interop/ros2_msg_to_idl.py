@@ -2,7 +2,7 @@
 """Writes the DDS IDL of ROS 2 messages from their .msg definitions, the way ROS 2's DDS layer
 names them on the wire (rosidl_generator_dds_idl: module <pkg>::msg::dds_, type <Name>_).
 
-The ROS 2 interop test (cyclone_interop.sh ros2) builds its Cyclone DDS reader from this, from ROS 2's
+The ROS 2 interop test (interop.sh ros2) builds its Cyclone DDS reader from this, from ROS 2's
 own .msg files (the set Foxglove ships in the npm package @foxglove/rosmsg-msgs-common), not from
 craneassist's hand-written app/dds/idl/ros2_msgs.idl: a layout error there shows as a mismatch.
 
