@@ -227,8 +227,8 @@ int run_web_watch_command(const WebWatchArgs& args) {
   };
   dds::TelemetryFrame frame;
   control::LogRow row;
-  std::uint64_t seen = 0;
-  bool receiving = false, announced = false;
+  std::uint64_t seen = 0;  // 0: nothing received yet
+  bool announced = false;
   std::string last_status;
   int rc = kExitOk;
   while (!dds::stop_requested()) {
@@ -236,7 +236,6 @@ int run_web_watch_command(const WebWatchArgs& args) {
     if (watch->latest(frame, seen)) {
       from_frame(frame, row);
       view.publish(row);
-      receiving = true;
       if (!announced) {  // once the status (the crane's name) and the joints are in
         const dds::WatchedRun run = watch->run();
         if (!run.crane.empty() && !run.joint_names.empty()) {
@@ -253,7 +252,7 @@ int run_web_watch_command(const WebWatchArgs& args) {
                        frame.stop_reason);
         }
       }
-    } else if (!receiving && args.timeout_s > 0.0 && elapsed_s() > args.timeout_s) {
+    } else if (seen == 0 && args.timeout_s > 0.0 && elapsed_s() > args.timeout_s) {
       const dds::WatchedRun run = watch->run();
       spdlog::error(
           "web: no telemetry on DDS domain {} within {:g} s ({} writers discovered; is a sim "

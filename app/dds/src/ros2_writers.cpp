@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
+#include "craneassist/dds/telemetry_publisher.hpp"
 #include "participant.hpp"
 #include "ros2_msgsPubSubTypes.h"
 #include "ros2_msgsTypeObject.h"
@@ -25,13 +27,10 @@ constexpr const char* kTypeNames[Ros2Writers::kTopics] = {
 
 // The frame's monotonic stamp on the wall clock (ROS 2 stamps messages with the system time).
 builtin_interfaces::msg::dds_::Time_ wall_stamp(std::int64_t monotonic_stamp_ns) {
-  timespec mono{}, wall{};
-  clock_gettime(CLOCK_MONOTONIC, &mono);
+  timespec wall{};
   clock_gettime(CLOCK_REALTIME, &wall);
-  const std::int64_t offset_ns =
-      (static_cast<std::int64_t>(wall.tv_sec) - mono.tv_sec) * 1000000000 +
-      (wall.tv_nsec - mono.tv_nsec);
-  const std::int64_t ns = monotonic_stamp_ns + offset_ns;
+  const std::int64_t wall_ns = static_cast<std::int64_t>(wall.tv_sec) * 1000000000 + wall.tv_nsec;
+  const std::int64_t ns = monotonic_stamp_ns + (wall_ns - monotonic_ns());
   builtin_interfaces::msg::dds_::Time_ t;
   t.sec(static_cast<std::int32_t>(ns / 1000000000));
   t.nanosec(static_cast<std::uint32_t>(ns % 1000000000));
@@ -67,29 +66,30 @@ Ros2Writers::Ros2Writers(fdds::DomainParticipant& participant, fdds::Publisher& 
 
 bool Ros2Writers::publish(const TelemetryFrame& f, bool force) {
   bool ok = true;
+  std::optional<builtin_interfaces::msg::dds_::Time_> stamp;  // one per frame, when one is due
   for (int i = 0; i < kTopics; ++i) {
     if (!pacers_[i].due(f, force)) continue;
-    const bool wrote = i == 0   ? write_joint_states(f)
-                       : i == 1 ? write_twist(i, f.command_m_s, f)
-                                : write_twist(i, f.reference_m_s, f);
+    if (!stamp) stamp = wall_stamp(f.stamp_ns);
+    const bool wrote = i == 0   ? write_joint_states(f, *stamp)
+                       : i == 1 ? write_twist(i, f.command_m_s, *stamp)
+                                : write_twist(i, f.reference_m_s, *stamp);
     if (wrote) written_[i].fetch_add(1, std::memory_order_relaxed);
     ok = ok && wrote;
   }
   return ok;
 }
 
-bool Ros2Writers::write_joint_states(const TelemetryFrame& f) {
+bool Ros2Writers::write_joint_states(const TelemetryFrame& f, const Stamp& stamp) {
   const auto n = static_cast<std::size_t>(std::min(f.dof, kMaxJoints));
-  joint_state_.header().stamp(wall_stamp(f.stamp_ns));
+  joint_state_.header().stamp(stamp);
   joint_state_.position().assign(f.q.begin(), f.q.begin() + static_cast<std::ptrdiff_t>(n));
   joint_state_.velocity().assign(f.qdot.begin(), f.qdot.begin() + static_cast<std::ptrdiff_t>(n));
   return writers_[0]->write(&joint_state_);
 }
 
-bool Ros2Writers::write_twist(int topic, const std::array<double, 3>& v_crane,
-                              const TelemetryFrame& f) {
+bool Ros2Writers::write_twist(int topic, const std::array<double, 3>& v_crane, const Stamp& stamp) {
   const auto& r = base_from_crane_;
-  twist_.header().stamp(wall_stamp(f.stamp_ns));
+  twist_.header().stamp(stamp);
   auto& linear = twist_.twist().linear();
   linear.x(r[0] * v_crane[0] + r[1] * v_crane[1] + r[2] * v_crane[2]);
   linear.y(r[3] * v_crane[0] + r[4] * v_crane[1] + r[5] * v_crane[2]);

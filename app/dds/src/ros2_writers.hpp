@@ -38,8 +38,9 @@ class Ros2Writers {
   int matched_readers() const;
 
  private:
-  bool write_joint_states(const TelemetryFrame& f);
-  bool write_twist(int topic, const std::array<double, 3>& v_crane, const TelemetryFrame& f);
+  using Stamp = builtin_interfaces::msg::dds_::Time_;
+  bool write_joint_states(const TelemetryFrame& f, const Stamp& stamp);
+  bool write_twist(int topic, const std::array<double, 3>& v_crane, const Stamp& stamp);
 
   eprosima::fastdds::dds::DataWriter* writers_[kTopics] = {};
   TopicPacer pacers_[kTopics];

@@ -163,9 +163,7 @@ struct TelemetryWatch::Impl {
 TelemetryWatch::TelemetryWatch(const WatchOptions& options)
     : impl_(std::make_unique<Impl>(options)) {}
 
-TelemetryWatch::~TelemetryWatch() {
-  impl_->session.reset();
-}
+TelemetryWatch::~TelemetryWatch() = default;
 
 bool TelemetryWatch::latest(TelemetryFrame& out, std::uint64_t& seen) const {
   std::lock_guard<std::mutex> lock(impl_->mutex);
