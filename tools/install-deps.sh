@@ -14,6 +14,7 @@ packages=(
   clang libclang-rt-14-dev llvm  # the clang sanitizer build and libFuzzer (docs/fuzzing.md)
   libboost-dev nlohmann-json3-dev chromium  # the web view (docs/web.md) and its browser test
   liburdfdom-dev liburdfdom-tools  # reads back the URDF of craneassist urdf (docs/ros.md)
+  python3-can python3-canmatrix  # decode craneassist's CAN logs through its DBC (docs/can.md)
 )
 # npm bundles the web page at build time (Debian's npm, unless node and npm are already there).
 command -v npm >/dev/null || packages+=(npm)

@@ -13,6 +13,7 @@
 #include "bound_command.hpp"
 #include "calibrate_command.hpp"
 #include "can_commands.hpp"
+#include "can_tool_command.hpp"
 #include "energy_command.hpp"
 #include "exit_codes.hpp"
 #include "experiment_command.hpp"
@@ -57,6 +58,7 @@ int main(int argc, char** argv) {
   add(commands, cli, add_experiment_command, run_experiment_command);
   add(commands, cli, add_plan_command, run_plan_command);
   add(commands, cli, add_emulate_command, run_emulate_command);
+  add(commands, cli, add_can_tool_command, run_can_tool_command);
   add(commands, cli, add_energy_command, run_energy_command);
   add(commands, cli, add_calibrate_command, run_calibrate_command);
   add(commands, cli, add_sim_command, run_sim_command);

@@ -93,6 +93,25 @@ write("fuzz_telemetry_config", "type_propagation.yaml",
       "type_information: true}\n")
 for path in files("config/can/*.yaml"):
     write("fuzz_can_mapping", os.path.basename(path), open(path, "rb").read())
+for path in files("config/can/*.dbc"):
+    write("fuzz_dbc", os.path.basename(path), open(path, "rb").read())
+write("fuzz_dbc", "vendor.dbc",
+      'VERSION "1"\n\nNS_ :\n\tCM_\n\tBA_\n\nBS_: 250000 : 0,0\n\nBU_: ECU1 Valves\n'
+      'VAL_TABLE_ OnOff 1 "on" 0 "off" ;\n'
+      'BO_ 2566848513 BoomAngles: 8 ECU1\n'
+      ' SG_ Boom1Angle : 0|16@1- (0.01,-10) [-190|170] "deg" Valves,ECU1\n'
+      ' SG_ ArmAngle : 39|16@0+ (0.1,0) [0|3600] "deg"  Valves\n'
+      'BO_ 1280 Muxed: 8 ECU1\n'
+      ' SG_ Selector M : 0|8@1+ (1,0) [0|3] "" Valves\n'
+      ' SG_ PressureA m0 : 8|16@1+ (0.1,0) [0|500] "bar" Valves\n'
+      ' SG_ Temperature : 24|32@1- (1,0) [0|0] "degC" Valves\n'
+      'BO_TX_BU_ 1280 : ECU1,Valves;\n'
+      'CM_ BO_ 2566848513 "two\nlines, with a \\" quote";\n'
+      'BA_DEF_ BO_  "GenMsgCycleTime" INT 0 10000;\n'
+      'BA_ "GenMsgCycleTime" BO_ 2566848513 10;\n'
+      'BA_ "VFrameFormat" BO_ 2566848513 3;\n'
+      'VAL_ 1280 Selector 0 "a" 1 "b" ;\n'
+      'SIG_VALTYPE_ 1280 Temperature : 1;\n')
 for name, text in (("flow_block.yaml", "[[[[{a: [b, {c: d}]}]]]]\n"),
                    ("anchors.yaml", "a: &x [1, 2]\nb: *x\n? [complex]\n: key\n"),
                    ("tags.yaml", "!!binary aGVsbG8=\n--- !custom {x: 1}\n")):

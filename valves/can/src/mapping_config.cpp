@@ -2,12 +2,15 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
+#include <optional>
 #include <sstream>
 
+#include "craneassist/can/dbc.hpp"
 #include "craneassist/can/valve_frames.hpp"
 #include "craneassist/config/config_error.hpp"
 #include "craneassist/config/quantity.hpp"
@@ -25,6 +28,62 @@ enum class SignalUse { kPosition, kPressure, kCommand, kFlow };
 class Reader : public config::YamlReader {
  public:
   using YamlReader::YamlReader;
+
+  // The mapping's DBC file (top-level `dbc:`), when it has one: signals may name its signals.
+  std::optional<Dbc> dbc;
+
+  // The DBC message and signal a `{dbc: Message.Signal}` entry names (signal null for a message
+  // reference `{dbc: Message}`); fails naming the entry when the DBC has no such thing.
+  std::pair<const DbcMessage*, const DbcSignal*> dbc_entry(const YAML::Node& node,
+                                                           const std::string& path,
+                                                           bool signal_wanted) const {
+    const YAML::Node ref = node["dbc"];
+    const std::string field = join(path, "dbc");
+    const std::string name = text(ref, field);
+    if (!dbc) fail(ref, field, "names a DBC entry, but the mapping has no top-level 'dbc: FILE'");
+    const auto dot = name.find('.');
+    if (signal_wanted == (dot == std::string::npos)) {
+      fail(ref, field,
+           signal_wanted ? "expected MESSAGE.SIGNAL, got '" + name + "'"
+                         : "expected a message name, got '" + name + "'");
+    }
+    const std::string message_name = name.substr(0, dot);
+    const DbcMessage* m = dbc->message(message_name);
+    if (m == nullptr) {
+      std::string known;
+      for (const auto& other : dbc->messages) {
+        if (known.size() > 200) {
+          known += ", ...";
+          break;
+        }
+        known += (known.empty() ? "" : ", ") + other.name;
+      }
+      fail(ref, field,
+           "no message '" + message_name + "' in " + dbc->source + " (it has " +
+               (known.empty() ? std::string("none") : known) + ")");
+    }
+    if (!signal_wanted) return {m, nullptr};
+    const std::string signal_name = name.substr(dot + 1);
+    for (const auto& s : m->signals) {
+      if (s.name != signal_name) continue;
+      if (s.multiplexed) {
+        fail(ref, field,
+             dbc->source + ":" + std::to_string(s.line) + ": signal '" + name +
+                 "' is multiplexed; multiplexed signals are not supported");
+      }
+      if (s.value_type != 0) {
+        fail(ref, field,
+             dbc->source + ":" + std::to_string(s.line) + ": signal '" + name +
+                 "' is a floating-point value (SIG_VALTYPE_); not supported");
+      }
+      return {m, &s};
+    }
+    std::string known;
+    for (const auto& s : m->signals) known += (known.empty() ? "" : ", ") + s.name;
+    fail(ref, field,
+         "message '" + message_name + "' in " + dbc->source + " has no signal '" + signal_name +
+             "' (it has " + (known.empty() ? "none" : known) + ")");
+  }
 
   std::string text(const YAML::Node& node, const std::string& field) const {
     if (!node.IsScalar()) fail(node, field, "expected a single value");
@@ -132,9 +191,48 @@ const char* units_text(SignalUse use) {
   return "";
 }
 
+// A signal named in the mapping's DBC: `{dbc: Message.Signal}`, optionally with `unit:` when the
+// DBC's unit is not one craneassist knows (a DBC may write "°" or nothing at all), and the keys
+// of the entry that are not layout (a valve signal's `cycle`).
+SignalSpec read_dbc_signal(const Reader& r, const YAML::Node& node, const std::string& path,
+                           SignalUse use, std::initializer_list<const char*> keys,
+                           PositionKind* kind_out) {
+  const bool has_cycle = std::any_of(keys.begin(), keys.end(),
+                                     [](const char* k) { return std::string(k) == "cycle"; });
+  if (has_cycle) {
+    r.check_keys(node, path, {"dbc", "unit", "cycle"});
+  } else {
+    r.check_keys(node, path, {"dbc", "unit"});
+  }
+  const auto [message, signal] = r.dbc_entry(node, path, true);
+  SignalSpec s = signal->spec;
+  std::string where = r.dbc->source + ":" + std::to_string(signal->line);
+  if (node["unit"].IsDefined()) {
+    s.unit = r.text(node["unit"], Reader::join(path, "unit"));
+    where = "unit";
+  }
+  double factor = 1.0;
+  PositionKind kind = PositionKind::kAngle;
+  if (!unit_factor(s.unit, use, factor, kind)) {
+    r.fail(node, path,
+           "unit '" + s.unit + "' (" + where + ") is not " + units_text(use) +
+               (node["unit"].IsDefined() ? "" : "; give 'unit:' to say what the DBC's unit is"));
+  }
+  if (kind_out) *kind_out = kind;
+  s.scale *= factor;
+  s.offset *= factor;
+  if (s.minimum) *s.minimum *= factor;
+  if (s.maximum) *s.maximum *= factor;
+  s.unit_si = factor;
+  (void)message;
+  return s;
+}
+
 SignalSpec read_signal(const Reader& r, const YAML::Node& node, const std::string& path,
                        SignalUse use, std::initializer_list<const char*> keys,
                        PositionKind* kind_out) {
+  if (node.IsMap() && node["dbc"].IsDefined())
+    return read_dbc_signal(r, node, path, use, keys, kind_out);
   r.check_keys(node, path, keys);
   SignalSpec s;
   s.extended = r.flag(node, "extended", path, false);
@@ -175,6 +273,7 @@ SignalSpec read_signal(const Reader& r, const YAML::Node& node, const std::strin
   const double scale = r.number(scale_node, Reader::join(path, "scale"));
   if (scale == 0.0) r.fail(scale_node, Reader::join(path, "scale"), "must be nonzero");
   s.scale = scale * factor;
+  s.unit_si = factor;
   if (node["offset"].IsDefined()) {
     s.offset = r.number(node["offset"], Reader::join(path, "offset")) * factor;
   }
@@ -235,7 +334,22 @@ ValveOutput read_valve(const Reader& r, const YAML::Node& node, const std::strin
                                                "unit",       "min",      "max",       "cycle"};
     out.kind = ValveOutputKind::kSignal;
     out.signal.signal = read_signal(r, s, p, SignalUse::kCommand, keys, nullptr);
-    out.signal.cycle_s = r.time(s, "cycle", p, 0.001, 0.1, "between 1 ms and 100 ms");
+    if (s.IsMap() && s["dbc"].IsDefined() && !s["cycle"].IsDefined()) {
+      // The DBC's GenMsgCycleTime, when it gives one.
+      const DbcMessage* m = r.dbc_entry(s, p, true).first;
+      if (!m->cycle_s) {
+        r.fail(s, Reader::join(p, "cycle"),
+               "missing, and " + r.dbc->source + " gives no cycle time (GenMsgCycleTime) for " +
+                   m->name);
+      }
+      out.signal.cycle_s = *m->cycle_s;
+      if (!(out.signal.cycle_s >= 0.001 && out.signal.cycle_s <= 0.1)) {
+        r.fail(s["dbc"], Reader::join(p, "dbc"),
+               "the DBC's cycle time of " + m->name + " must be between 1 ms and 100 ms");
+      }
+    } else {
+      out.signal.cycle_s = r.time(s, "cycle", p, 0.001, 0.1, "between 1 ms and 100 ms");
+    }
   }
   return out;
 }
@@ -261,11 +375,23 @@ std::uint64_t occupied_bits(const SignalSpec& spec) {
   return bits;
 }
 
-CanMapping read_mapping(const Reader& r, const YAML::Node& root) {
-  r.check_keys(root, "", {"format", "note", "joints", "heartbeat", "pump"});
+CanMapping read_mapping(Reader& r, const YAML::Node& root) {
+  r.check_keys(root, "", {"format", "note", "dbc", "joints", "heartbeat", "pump"});
   const YAML::Node format = r.child(root, "format", "");
   if (r.text(format, "format") != kMappingFormat) {
     r.fail(format, "format", std::string("expected ") + kMappingFormat);
+  }
+  if (root["dbc"].IsDefined()) {
+    // Relative to the mapping file, like the crane config's paths.
+    const std::filesystem::path file = r.text(root["dbc"], "dbc");
+    const std::filesystem::path path =
+        file.is_absolute() ? file : std::filesystem::path(r.file()).parent_path() / file;
+    try {
+      r.dbc = load_dbc(path);
+    } catch (const ConfigError& e) {
+      if (e.line() > 0) throw;  // an error inside the DBC names the DBC's own line
+      r.fail(root["dbc"], "dbc", "cannot read " + path.string() + ": " + e.reason());
+    }
   }
   const YAML::Node joints = r.child(root, "joints", "");
   if (!joints.IsSequence() || joints.size() == 0) {
@@ -339,12 +465,29 @@ CanMapping read_mapping(const Reader& r, const YAML::Node& root) {
   }
   if (root["heartbeat"].IsDefined()) {
     const YAML::Node h = root["heartbeat"];
-    r.check_keys(h, "heartbeat", {"id", "extended", "cycle", "timeout"});
     HeartbeatSpec hb;
-    hb.extended = r.flag(h, "extended", "heartbeat", true);
-    hb.id = static_cast<std::uint32_t>(
-        r.integer(h, "id", "heartbeat", hb.extended ? kMaxExtendedId : kMaxStandardId));
-    hb.cycle_s = r.time(h, "cycle", "heartbeat", 0.001, 0.1, "between 1 ms and 100 ms");
+    if (h.IsMap() && h["dbc"].IsDefined()) {
+      // {dbc: Message, timeout: 100 ms[, cycle: 20 ms]}: identifier and cycle from the DBC.
+      r.check_keys(h, "heartbeat", {"dbc", "cycle", "timeout"});
+      const DbcMessage* m = r.dbc_entry(h, "heartbeat", false).first;
+      hb.id = m->id;
+      hb.extended = m->extended;
+      if (h["cycle"].IsDefined()) {
+        hb.cycle_s = r.time(h, "cycle", "heartbeat", 0.001, 0.1, "between 1 ms and 100 ms");
+      } else if (m->cycle_s && *m->cycle_s >= 0.001 && *m->cycle_s <= 0.1) {
+        hb.cycle_s = *m->cycle_s;
+      } else {
+        r.fail(
+            h, "heartbeat.cycle",
+            "missing, and " + r.dbc->source + " gives no cycle time of 1..100 ms for " + m->name);
+      }
+    } else {
+      r.check_keys(h, "heartbeat", {"id", "extended", "cycle", "timeout"});
+      hb.extended = r.flag(h, "extended", "heartbeat", true);
+      hb.id = static_cast<std::uint32_t>(
+          r.integer(h, "id", "heartbeat", hb.extended ? kMaxExtendedId : kMaxStandardId));
+      hb.cycle_s = r.time(h, "cycle", "heartbeat", 0.001, 0.1, "between 1 ms and 100 ms");
+    }
     hb.timeout_s = r.time(h, "timeout", "heartbeat", 0.01, 1.0, "between 10 ms and 1 s");
     if (hb.timeout_s < 2.0 * hb.cycle_s) {
       r.fail(h["timeout"], "heartbeat.timeout", "must be at least two cycles");
@@ -353,7 +496,7 @@ CanMapping read_mapping(const Reader& r, const YAML::Node& root) {
       CanFrame avc;
       if (jm.valve.kind == ValveOutputKind::kIso11783Avc && encode_valve_block(jm.valve, avc) &&
           avc.id == hb.id && avc.extended == hb.extended) {
-        r.fail(h["id"], "heartbeat.id",
+        r.fail(h["id"].IsDefined() ? h["id"] : h, "heartbeat.id",
                "is the valve command identifier of joint '" + jm.name + "'");
       }
     }
@@ -381,7 +524,7 @@ CanMapping read_mapping(const Reader& r, const YAML::Node& root) {
 }  // namespace
 
 CanMapping parse_can_mapping(std::string_view yaml_text, std::string_view source_name) {
-  const Reader reader{std::string(source_name)};
+  Reader reader{std::string(source_name)};
   return config::read_yaml(yaml_text, source_name,
                            [&](const YAML::Node& root) { return read_mapping(reader, root); });
 }

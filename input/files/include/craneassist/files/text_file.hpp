@@ -19,6 +19,8 @@ inline constexpr std::size_t kMiB = std::size_t{1} << 20;
 // recording.
 inline constexpr std::size_t kMaxYamlBytes = 1 * kMiB;
 inline constexpr std::size_t kMaxCsvBytes = 64 * kMiB;
+// A DBC file (CAN database) of a whole vehicle runs to a few hundred kB.
+inline constexpr std::size_t kMaxDbcBytes = 4 * kMiB;
 
 // A file that could not be read, or is over its limit. what() is "FILE: REASON"; the readers of
 // the file formats turn it into their own error (config::ConfigError, input::FileError).
