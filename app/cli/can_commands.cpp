@@ -98,9 +98,15 @@ CLI::App* add_emulate_command(CLI::App& cli, EmulateArgs& args) {
       "simulator in real time, send joint position and pressure frames");
   cmd->add_option("--can", args.iface, "CAN interface, e.g. vcan0 or can0")->required();
   add_config_option(*cmd, args.config_file);
+  add_payload_option(*cmd, args.payload_kg);
   cmd->add_option("--mapping", args.mapping_file,
                   "CAN mapping YAML (default: the embedded config/can/k70m_can.yaml)")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--lag-warning", args.lag_warning_s,
+                  "Say so (at most once a second) when the simulation falls this many seconds "
+                  "behind the wall clock")
+      ->check(FiniteRange(0.001, 10.0))
+      ->capture_default_str();
   cmd->add_option("--feedback-period", args.feedback_period_s, "Seconds between feedback frames")
       ->check(FiniteRange(0.001, 1.0))
       ->capture_default_str();
@@ -114,6 +120,7 @@ int run_emulate_command(const EmulateArgs& args) {
   can::CanMapping mapping;
   try {
     cfg = load_crane(args.config_file);
+    apply_crane_options(cfg, {.payload_kg = args.payload_kg});
     mapping = load_mapping_or_default(args.mapping_file);
     can::check_mapping_fits(mapping, cfg.model);  // before the bus is opened
   } catch (const std::exception& e) {
@@ -168,9 +175,16 @@ int run_emulate_command(const EmulateArgs& args) {
     const std::int64_t start = mono_ns();
     std::int64_t sim_ns = 0;  // simulated time, locked to the wall clock
     std::int64_t next_feedback = 0;
-    std::printf("craneassist emulate: %s on %s, mapping %s, feedback every %.0f ms\n",
-                cfg.model.name.c_str(), args.iface.c_str(), mapping.source.c_str(),
-                args.feedback_period_s * 1e3);
+    // Lag: how far the simulated time trails the wall clock after stepping. Up to 100 steps are
+    // taken per pass; a simulation slower than real time trails more and more, and beyond that it
+    // jumps ahead (counted as "fell behind"). Either way the machine the controller drives runs
+    // slow or stutters, so it is said while it happens, not only at the end.
+    const auto lag_warning_ns = static_cast<std::int64_t>(args.lag_warning_s * 1e9);
+    std::int64_t max_lag_ns = 0, lagging_ns = 0, last_lag_report = -1000000000;
+    std::printf(
+        "craneassist emulate: %s on %s, mapping %s, payload %.0f kg, feedback every %.0f ms\n",
+        cfg.model.name.c_str(), args.iface.c_str(), mapping.source.c_str(),
+        cfg.model.bodies.back().mass_kg, args.feedback_period_s * 1e3);
     std::fflush(stdout);
     while (!g_stop.load()) {
       const std::int64_t now = mono_ns() - start;
@@ -221,6 +235,20 @@ int run_emulate_command(const EmulateArgs& args) {
         sim_ns += step_ns;
         ++steps;
       }
+      const std::int64_t lag = now - sim_ns;
+      max_lag_ns = std::max(max_lag_ns, lag);
+      if (lag > lag_warning_ns) {
+        lagging_ns += step_ns * std::max(steps, 1);
+        if (now - last_lag_report >= 1000000000) {
+          std::printf(
+              "craneassist emulate: %.3f s: the simulation is %.0f ms behind the wall clock "
+              "(the machine runs slow; %s)\n",
+              static_cast<double>(now) * 1e-9, static_cast<double>(lag) * 1e-6,
+              steps >= 100 ? "skipping ahead" : "catching up");
+          std::fflush(stdout);
+          last_lag_report = now;
+        }
+      }
       if (sim_ns + step_ns <= now) {  // too slow to keep up: skip ahead, counted
         ++behind;
         sim_ns = now;
@@ -256,9 +284,11 @@ int run_emulate_command(const EmulateArgs& args) {
     }
     std::printf(
         "craneassist emulate: stopped after %.2f s: %llu valve commands, %llu bad, %llu other "
-        "frames; %llu feedback frames sent, %llu failed; fell behind %llu times\n",
+        "frames; %llu feedback frames sent, %llu failed; fell behind %llu times; lag max %.1f ms, "
+        "over %.0f ms for %.2f s\n",
         static_cast<double>(mono_ns() - start) * 1e-9, commands, bad, other, sent, send_failed,
-        behind);
+        behind, static_cast<double>(max_lag_ns) * 1e-6, args.lag_warning_s * 1e3,
+        static_cast<double>(lagging_ns) * 1e-9);
     if (heartbeat) {
       std::printf(
           "craneassist emulate: heartbeat: %llu messages, %llu sequence errors, %llu malformed, "

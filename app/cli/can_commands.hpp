@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "craneassist/can/can_backend.hpp"
@@ -36,8 +37,10 @@ struct EmulateArgs {
   std::string iface;
   std::string config_file;
   std::string mapping_file;
+  std::optional<double> payload_kg;  // the load in the emulated crane's grapple
   double feedback_period_s = 0.01;
-  double duration_s = 0.0;  // 0: until killed
+  double lag_warning_s = 0.02;  // say so when the simulation is this far behind the wall clock
+  double duration_s = 0.0;      // 0: until killed
   double command_timeout_s = 0.2;
 };
 

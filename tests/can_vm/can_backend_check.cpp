@@ -20,11 +20,13 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -133,6 +135,71 @@ int compare(const char* sim_path, const char* can_path, double tol, bool with_pu
     pump_ok = ea > 0.0 && std::abs(eb - ea) <= 0.15 * ea;
   }
   return (max_d <= tol && a.size() == b.size() && pump_ok) ? 0 : 1;
+}
+
+// The tip direction error of a run log, two ways: from the logged tip velocity (what the run's
+// summary reports: on the CAN backend that velocity is differentiated from quantised encoder
+// frames) and from the logged tip positions, the displacement over +-window_s (what the tip did,
+// with the estimator's noise averaged out). Rows count once the command has been the same for
+// 0.5 s and the tip moves faster than 0.05 m/s, as in the summary.
+int direction(const char* path, double window_s) {
+  std::vector<std::string> h;
+  const auto rows = read_csv(path, h);
+  const auto col = [&](const char* name) {
+    for (std::size_t i = 0; i < h.size(); ++i) {
+      if (h[i] == name) return i;
+    }
+    return h.size();
+  };
+  const std::size_t t = col("t"), cx = col("cmd_vx"), tx = col("tip_x"), vx = col("tip_vx");
+  if (t == h.size() || cx == h.size() || tx == h.size() || vx == h.size() || rows.size() < 3) {
+    std::printf("direction: %s has no t, cmd_v*, tip_* or tip_v* columns\n", path);
+    return 1;
+  }
+  const auto angle = [](const double* a, const double* b) {
+    const double dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    const double na = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    const double nb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    return std::acos(std::clamp(dot / (na * nb), -1.0, 1.0)) * 180.0 / std::numbers::pi;
+  };
+  const double dt = rows[1][t] - rows[0][t];
+  const auto w = static_cast<std::size_t>(std::max(1.0, std::round(window_s / dt)));
+  double since = 0.0, max_v = 0.0, sq_v = 0.0, max_p = 0.0, sq_p = 0.0;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const double cmd[3] = {rows[k][cx], rows[k][cx + 1], rows[k][cx + 2]};
+    if (k == 0 || cmd[0] != rows[k - 1][cx] || cmd[1] != rows[k - 1][cx + 1] ||
+        cmd[2] != rows[k - 1][cx + 2]) {
+      since = rows[k][t];
+    }
+    const double v[3] = {rows[k][vx], rows[k][vx + 1], rows[k][vx + 2]};
+    const double speed = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    const bool moving_cmd =
+        std::isfinite(cmd[0]) && std::abs(cmd[0]) + std::abs(cmd[1]) + std::abs(cmd[2]) > 0.0;
+    if (!moving_cmd || speed <= 0.05 || rows[k][t] - since < 0.5 || k < w || k + w >= rows.size()) {
+      continue;
+    }
+    const double d[3] = {rows[k + w][tx] - rows[k - w][tx],
+                         rows[k + w][tx + 1] - rows[k - w][tx + 1],
+                         rows[k + w][tx + 2] - rows[k - w][tx + 2]};
+    const double ev = angle(cmd, v), ep = angle(cmd, d);
+    max_v = std::max(max_v, ev);
+    sq_v += ev * ev;
+    max_p = std::max(max_p, ep);
+    sq_p += ep * ep;
+    ++n;
+  }
+  if (n == 0) {
+    std::printf("direction: %s: no steady moving rows\n", path);
+    return 1;
+  }
+  const double cnt = static_cast<double>(n);
+  std::printf(
+      "direction error %s over %zu rows: from the tip velocity max %.2f deg, rms %.2f deg; from "
+      "the tip positions (+-%.0f ms) max %.2f deg, rms %.2f deg\n",
+      path, n, max_v, std::sqrt(sq_v / cnt), static_cast<double>(w) * dt * 1e3, max_p,
+      std::sqrt(sq_p / cnt));
+  return 0;
 }
 
 // Reports the period statistics; only the mean is asserted, within tol of nominal (TCG timing).
@@ -394,10 +461,12 @@ int main(int argc, char** argv) {
                    argc == 6 && std::string(argv[5]) == "pump");
   }
   if (mode == "traffic" && argc == 3) return traffic(argv[2]);
+  if (mode == "direction" && argc == 4) return direction(argv[2], std::strtod(argv[3], nullptr));
   if (mode == "safe" && argc == 5) return safe(argv[2], argv[3], std::strtod(argv[4], nullptr));
   if (mode == "stop" && argc == 4) return stop(argv[2], std::strtod(argv[3], nullptr));
   if (mode == "wait-motion" && argc == 4)
     return wait_motion(argv[2], std::strtod(argv[3], nullptr));
-  std::fprintf(stderr, "usage: can_backend_check compare|traffic|safe|stop|wait-motion ...\n");
+  std::fprintf(stderr,
+               "usage: can_backend_check compare|traffic|direction|safe|stop|wait-motion ...\n");
   return 2;
 }

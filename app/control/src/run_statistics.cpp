@@ -15,7 +15,14 @@ double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 }
 
 RunStatistics::RunStatistics(double period_s, const RunStatisticsOptions& options)
-    : period_s_(period_s), options_(options), quality_(period_s) {}
+    : period_s_(period_s), options_(options), quality_(period_s) {
+  const double window =
+      period_s > 0.0
+          ? std::round(std::min(options.position_window_s, options.steady_after_s) / period_s)
+          : 1.0;
+  window_ = static_cast<int>(std::clamp(window, 1.0, static_cast<double>(kMaxPositionWindow)));
+  s_.position_window_s = window_ * period_s;
+}
 
 void RunStatistics::on_cycle(const CycleRecord& c) noexcept {
   const LogRow& row = c.row;
@@ -37,6 +44,12 @@ void RunStatistics::on_cycle(const CycleRecord& c) noexcept {
   if (c.time.k > 0 && c.state.valid && last_tip_valid_) s_.tip_path_m += (tip - last_tip_).norm();
   last_tip_ = tip;
   last_tip_valid_ = c.state.valid;
+  const auto slot = [](long k) {
+    return static_cast<std::size_t>(k % static_cast<long>(kMaxPositionWindow + 1));
+  };
+  tips_[slot(tip_count_)] = tip;
+  tips_valid_[slot(tip_count_)] = c.state.valid && tip.allFinite();
+  ++tip_count_;
   quality_.add(t, cmd, tip, tip_v);
 
   const ControllerOutput* out = c.controller;
@@ -58,6 +71,14 @@ void RunStatistics::on_cycle(const CycleRecord& c) noexcept {
     s_.max_direction_error_deg = std::max(s_.max_direction_error_deg, err);
     sum_sq_direction_ += err * err;
     ++s_.direction_samples;
+    // The displacement over the window lies within the steady command (window <= steady_after).
+    const long now = tip_count_ - 1, then = now - window_;
+    if (then >= 0 && tips_valid_[slot(now)] && tips_valid_[slot(then)]) {
+      const double perr = angle_deg(cmd, tips_[slot(now)] - tips_[slot(then)]);
+      s_.max_position_direction_error_deg = std::max(s_.max_position_direction_error_deg, perr);
+      sum_sq_position_direction_ += perr * perr;
+      ++position_samples_;
+    }
   }
   if (moving_cmd && out->ref_tip_velocity_m_s.norm() > 1e-9) {
     s_.max_reference_direction_error_deg =
@@ -82,6 +103,10 @@ RunSummary RunStatistics::summary(const LoopSummary& loop) const {
   s.rms_direction_error_deg =
       s.direction_samples > 0
           ? std::sqrt(sum_sq_direction_ / static_cast<double>(s.direction_samples))
+          : 0.0;
+  s.rms_position_direction_error_deg =
+      position_samples_ > 0
+          ? std::sqrt(sum_sq_position_direction_ / static_cast<double>(position_samples_))
           : 0.0;
   return s;
 }

@@ -19,7 +19,14 @@ struct RunStatisticsOptions {
   // than min_speed_m_s.
   double steady_after_s = 0.5;
   double min_speed_m_s = 0.05;
+  // The second direction figure takes the tip's displacement over this window instead of the
+  // measured velocity: on a real machine the velocity is differentiated from quantised encoder
+  // frames and its noise is not the tip's motion (docs/can.md, "CAN versus sim"). At most
+  // kMaxPositionWindow cycles; no longer than steady_after_s.
+  double position_window_s = 0.1;
 };
+
+inline constexpr int kMaxPositionWindow = 64;
 
 struct RunSummary {
   long cycles = 0;
@@ -34,6 +41,11 @@ struct RunSummary {
   double max_direction_error_deg = 0.0;
   double rms_direction_error_deg = 0.0;
   long direction_samples = 0;
+  // The same cycles, the angle between the command and the tip's displacement over the last
+  // position_window_s (what the tip did, free of the velocity estimate's noise).
+  double max_position_direction_error_deg = 0.0;
+  double rms_position_direction_error_deg = 0.0;
+  double position_window_s = 0.0;
   // Angle between commanded and reference tip velocity (what the controller asked for).
   double max_reference_direction_error_deg = 0.0;
   long pump_saturated_cycles = 0;
@@ -70,6 +82,13 @@ class RunStatistics final : public CycleObserver {
   double cmd_since_s_ = 0.0;
   Eigen::Vector3d last_tip_ = Eigen::Vector3d::Zero();
   bool last_tip_valid_ = false;
+  // The last window_ + 1 tips (a ring; valid flags beside), for the displacement.
+  int window_ = 1;
+  std::array<Eigen::Vector3d, kMaxPositionWindow + 1> tips_{};
+  std::array<bool, kMaxPositionWindow + 1> tips_valid_{};
+  long tip_count_ = 0;
+  double sum_sq_position_direction_ = 0.0;
+  long position_samples_ = 0;
 };
 
 // Angle between two vectors in degrees (0 when either is zero).
