@@ -60,7 +60,9 @@ class SweepTask final : public control::CycleTask {
         settle_(static_cast<int>(std::lround(options.settle_s / period_s_))),
         measure_(std::max(1, static_cast<int>(std::lround(options.measure_s / period_s_)))),
         half_(settle_ + measure_ / 2),
-        tolerance_(options.settled_tolerance),
+        tolerance_(mode == Mode::kMachine ? options.machine_settled_tolerance
+                                          : options.settled_tolerance),
+        retries_(mode == Mode::kMachine ? std::max(0, options.machine_retries) : 0),
         log_(log) {
     const auto& joint = config.model.joints[static_cast<std::size_t>(section)];
     const double c_a = dynamics::cylinder_length(cyl_, joint.q_min);
@@ -88,8 +90,8 @@ class SweepTask final : public control::CycleTask {
     target_.setZero(dof);
     points_.reserve(commands_.size());
     if (log_ != nullptr) {
-      log_->reserve(log_->size() +
-                    commands_.size() * static_cast<std::size_t>(settle_ + measure_ + 1));
+      log_->reserve(log_->size() + commands_.size() * static_cast<std::size_t>(1 + retries_) *
+                                       static_cast<std::size_t>(settle_ + measure_ + 1));
     }
     phase_ = mode_ == Mode::kMachine ? Phase::kMove : Phase::kLevel;
   }
@@ -171,6 +173,7 @@ class SweepTask final : public control::CycleTask {
     phase_ = Phase::kLevel;
     level_k_ = 0;
     level_valid_ = true;
+    v_sum_1_ = v_sum_2_ = 0.0;
   }
 
   // One cycle of the level in progress: the command held, the window's samples, the log row.
@@ -179,29 +182,57 @@ class SweepTask final : public control::CycleTask {
     const int k = level_k_;
     const double q = state.q[section_];
     const double length = dynamics::cylinder_length(cyl_, q);
+    const double velocity = dynamics::cylinder_arm(cyl_, q) * state.qdot[section_];
     const bool measuring = k >= settle_;
     if (k == settle_) c_start_ = length;
     if (k == half_) c_half_ = length;
+    if (k > settle_) (k <= half_ ? v_sum_1_ : v_sum_2_) += velocity;
     if (measuring && (length < c_lo_ || length > c_hi_)) level_valid_ = false;
     bool cut = false;
     if (mode_ == Mode::kMachine) {
       // Keep the stroke margins on a machine: end the level while the cylinder can still stop
       // short of them (running into an end stop at full command is what must not happen).
-      const double ahead =
-          length + dynamics::cylinder_arm(cyl_, q) * state.qdot[section_] * stop_lookahead_s_;
+      const double ahead = length + velocity * stop_lookahead_s_;
       cut = !state.valid || ahead < c_lo_ || ahead > c_hi_;
     }
     target_[section_] = cut ? 0.0 : command;
     if (log_ != nullptr) {
-      log_->push_back({section_, command, static_cast<double>(k) * period_s_, length,
-                       dynamics::cylinder_arm(cyl_, q) * state.qdot[section_], measuring});
+      log_->push_back(
+          {section_, command, static_cast<double>(k) * period_s_, length, velocity, measuring});
     }
     if (k == settle_ + measure_) {
-      SweepPoint point{command, (length - c_start_) / (measure_ * period_s_), level_valid_};
-      const double v1 = (c_half_ - c_start_) / ((half_ - settle_) * period_s_);
-      const double v2 = (length - c_half_) / ((settle_ + measure_ - half_) * period_s_);
+      // The mean velocity over the window and over its two halves. On the simulator every read
+      // is a fresh sample taken at the cycle's time, so the position differences are exact. On
+      // a machine the positions arrive at the sensors' own cycle (10 ms over CAN) and a read
+      // gets the latest one, up to a cycle old: over a 0.15 s half window that moves the
+      // difference by several per cent. The machine's joint rate is differentiated between the
+      // frames' own time stamps (can::CanBackend), so there the mean of the rates is used.
+      const double t_1 = (half_ - settle_) * period_s_,
+                   t_2 = (settle_ + measure_ - half_) * period_s_;
+      SweepPoint point{command, 0.0, level_valid_};
+      double v1 = 0.0, v2 = 0.0;
+      if (mode_ == Mode::kMachine) {
+        point.velocity_m_s = (v_sum_1_ + v_sum_2_) / measure_;
+        v1 = v_sum_1_ / (half_ - settle_);
+        v2 = v_sum_2_ / (settle_ + measure_ - half_);
+      } else {
+        point.velocity_m_s = (length - c_start_) / (measure_ * period_s_);
+        v1 = (c_half_ - c_start_) / t_1;
+        v2 = (length - c_half_) / t_2;
+      }
       const double scale = std::max(std::abs(point.velocity_m_s), 1e-3 * cyl_.v_max_m_s);
-      if (std::abs(v2 - v1) > tolerance_ * scale) point.valid = false;
+      if (std::abs(v2 - v1) > tolerance_ * scale) {
+        point.valid = false;
+        // Not settled on a machine: a disturbance (a stalled sensor frame, a load swing) is
+        // likelier than a level that never settles; measure it again while tries remain.
+        if (level_valid_ && tries_ < retries_) {
+          ++tries_;
+          phase_ = Phase::kMove;
+          move_cycles_ = 0;
+          rest_count_ = 0;
+          return;
+        }
+      }
       end_level(point);
     } else if (cut) {
       end_level({command, 0.0, false});
@@ -215,14 +246,14 @@ class SweepTask final : public control::CycleTask {
   void end_level(const SweepPoint& point) noexcept {
     points_.push_back(point);  // reserved for every command
     ++next_;
+    tries_ = 0;
     if (next_ < commands_.size()) {
       if (mode_ == Mode::kMachine) {
         phase_ = Phase::kMove;
         move_cycles_ = 0;
         rest_count_ = 0;
       } else {
-        level_k_ = 0;
-        level_valid_ = true;
+        start_level();
       }
     } else if (mode_ == Mode::kMachine) {
       phase_ = Phase::kEnd;  // spools ramp to neutral, then the run ends
@@ -239,6 +270,7 @@ class SweepTask final : public control::CycleTask {
   double period_s_;
   int settle_, measure_, half_;
   double tolerance_;
+  int retries_;
   std::vector<SweepLogRow>* log_;
   double c_lo_ = 0.0, c_hi_ = 0.0, c_mid_ = 0.0;
   double gain_1_s_ = 0.0, speed_cap_m_s_ = 0.0, spool_max_ = 0.0, position_tolerance_m_ = 0.0;
@@ -251,8 +283,10 @@ class SweepTask final : public control::CycleTask {
   int level_k_ = 0;       // cycle within the level
   bool level_valid_ = true;
   double c_start_ = 0.0, c_half_ = 0.0;
+  double v_sum_1_ = 0.0, v_sum_2_ = 0.0;  // cylinder velocity over the window's halves
   long move_cycles_ = 0;
   int rest_count_ = 0;
+  int tries_ = 0;  // repeats of the level in progress
   bool not_positioned_ = false;
   bool finished_ = false;
   dynamics::JointVector spool_, target_;
@@ -310,7 +344,11 @@ std::string check_levels(const std::vector<double>& levels) {
   if (levels.empty()) return "no level given";
   for (std::size_t k = 0; k < levels.size(); ++k) {
     const double l = levels[k];
-    if (!(l > 0.0 && l <= 1.0)) return "each level must be in (0, 1], got " + std::to_string(l);
+    if (!(l > 0.0 && l <= 1.0)) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "each level must be in (0, 1], got %g", l);
+      return buf;
+    }
     if (k > 0 && !(l > levels[k - 1])) return "the levels must be strictly ascending";
   }
   return {};
