@@ -121,16 +121,20 @@ std::vector<double> lift_commands(FakeCanBus& bus, const can::CanMapping& map) {
   return out;
 }
 
-// No frame takes the lift's spool further than the ramp allows (10 /s over its 20 ms cycle) ...
-// except a step from neutral into the dead band's far side, which moves nothing.
-double largest_step_out_of_flow(const std::vector<double>& commands, double dead_zone) {
+// The largest step by which a frame closes the lift's spool (towards neutral, or through it)
+// while it meters flow. The sweep ramps closing at 2 /s: 0.02 per 10 ms loop cycle, a frame every
+// 20 ms (30 ms when the loop's ticks and the frame cycle slip). A stop thrown to neutral would
+// step by the dead band, 0.53, or more. (Opening is a step, as a sweep level starts.)
+double largest_closing_step(const std::vector<double>& commands, double dead_zone) {
   double worst = 0.0;
   for (std::size_t k = 1; k < commands.size(); ++k) {
-    const bool was_flowing = std::abs(commands[k - 1]) > dead_zone;
-    if (was_flowing) worst = std::max(worst, std::abs(commands[k] - commands[k - 1]));
+    const double before = commands[k - 1], after = commands[k];
+    const bool closes = after * before < 0.0 || std::abs(after) < std::abs(before);
+    if (std::abs(before) > dead_zone && closes) worst = std::max(worst, std::abs(after - before));
   }
   return worst;
 }
+constexpr double kClosingStepMax = 0.1;
 
 struct Rig {
   config::CraneConfig cfg = config::default_crane_config();
@@ -181,7 +185,7 @@ TEST(CalibrationOverCan, TheSweepThroughTheCanBackendGivesTheSimulatorsTable) {
   const auto commands = lift_commands(rig.bus, rig.map);
   ASSERT_FALSE(commands.empty());
   EXPECT_EQ(commands.back(), 0.0) << "blocked at the end";
-  EXPECT_LE(largest_step_out_of_flow(commands, rig.cfg.model.valves.dead_zone), 0.2 + 1e-3);
+  EXPECT_LE(largest_closing_step(commands, rig.cfg.model.valves.dead_zone), kClosingStepMax);
 }
 
 TEST(CalibrationOverCan, AStopRequestRampsTheSpoolsToNeutral) {
@@ -211,7 +215,7 @@ TEST(CalibrationOverCan, AStopRequestRampsTheSpoolsToNeutral) {
   for (double c : commands) top = std::max(top, std::abs(c));
   EXPECT_GT(top, 0.99) << "the lift was at full command when the stop came";
   EXPECT_EQ(commands.back(), 0.0);
-  EXPECT_LE(largest_step_out_of_flow(commands, rig.cfg.model.valves.dead_zone), 0.2 + 1e-3);
+  EXPECT_LE(largest_closing_step(commands, rig.cfg.model.valves.dead_zone), kClosingStepMax);
 }
 
 TEST(CalibrationOverCan, LostFeedbackEndsTheSweepWithTheMachinesReason) {

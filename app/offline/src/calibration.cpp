@@ -81,10 +81,8 @@ class SweepTask final : public control::CycleTask {
     rest_cycles_ = std::max(1, static_cast<int>(std::lround(move.rest_s / period_s_)));
     move_timeout_cycles_ = static_cast<long>(std::ceil(move.timeout_s / period_s_));
     spool_step_ = move.spool_rate_1_s * period_s_;
-    // From the decision to stop a level to a still cylinder: the ramp to neutral, the valve's
-    // dead time and its lag.
-    stop_lookahead_s_ = 1.0 / move.spool_rate_1_s + config.model.valves.delay_s +
-                        config.model.valves.time_constant_s;
+    spool_rate_1_s_ = move.spool_rate_1_s;
+    valve_lag_s_ = config.model.valves.delay_s + config.model.valves.time_constant_s;
     const int dof = config.model.dof();
     spool_.setZero(dof);
     target_.setZero(dof);
@@ -107,7 +105,11 @@ class SweepTask final : public control::CycleTask {
     if (phase_ == Phase::kLevel) level_step(state);
     if (mode_ == Mode::kMachine) {
       for (Eigen::Index j = 0; j < spool_.size(); ++j) {
-        spool_[j] += std::clamp(target_[j] - spool_[j], -spool_step_, spool_step_);
+        const double now = spool_[j], wanted = target_[j];
+        const bool opens = now == 0.0 || (wanted * now > 0.0 && std::abs(wanted) >= std::abs(now));
+        double next = opens ? wanted : now + std::clamp(wanted - now, -spool_step_, spool_step_);
+        if (next * now < 0.0) next = 0.0;  // reversing: neutral first, the other side opens next
+        spool_[j] = next;
       }
     } else {
       spool_ = target_;
@@ -169,6 +171,16 @@ class SweepTask final : public control::CycleTask {
     if (rest_count_ >= rest_cycles_) start_level();
   }
 
+  // How far the cylinder still goes when its level ends now: the spool ramps from the level to
+  // the dead-band edge (the flow falling about linearly to zero), then the valve's dead time and
+  // lag pass.
+  double stopping_distance_m(double velocity_m_s) const noexcept {
+    const double spool = spool_[section_];
+    const double open = std::abs(spool) - std::abs(valves_.dead_band_edge(section_, spool));
+    const double ramp_s = std::max(open, 0.0) / spool_rate_1_s_;
+    return velocity_m_s * (0.5 * ramp_s + valve_lag_s_);
+  }
+
   void start_level() noexcept {
     phase_ = Phase::kLevel;
     level_k_ = 0;
@@ -192,7 +204,7 @@ class SweepTask final : public control::CycleTask {
     if (mode_ == Mode::kMachine) {
       // Keep the stroke margins on a machine: end the level while the cylinder can still stop
       // short of them (running into an end stop at full command is what must not happen).
-      const double ahead = length + velocity * stop_lookahead_s_;
+      const double ahead = length + stopping_distance_m(velocity);
       cut = !state.valid || ahead < c_lo_ || ahead > c_hi_;
     }
     target_[section_] = cut ? 0.0 : command;
@@ -274,7 +286,7 @@ class SweepTask final : public control::CycleTask {
   std::vector<SweepLogRow>* log_;
   double c_lo_ = 0.0, c_hi_ = 0.0, c_mid_ = 0.0;
   double gain_1_s_ = 0.0, speed_cap_m_s_ = 0.0, spool_max_ = 0.0, position_tolerance_m_ = 0.0;
-  double rest_speed_m_s_ = 0.0, spool_step_ = 0.0, stop_lookahead_s_ = 0.0;
+  double rest_speed_m_s_ = 0.0, spool_step_ = 0.0, spool_rate_1_s_ = 1.0, valve_lag_s_ = 0.0;
   int rest_cycles_ = 1;
   long move_timeout_cycles_ = 0;
 

@@ -21,9 +21,10 @@ namespace craneassist::offline {
 // How a sweep on a machine brings the section back to mid-stroke before each level, and how it
 // handles the spools there: a P loop on the cylinder position through the config's valve model
 // (its table, or the straight line through dead_zone and max_speed), with a speed cap and a spool
-// limit, stopped within a tolerance; then neutral until the cylinder is at rest. Every spool of
-// a machine sweep changes at most at spool_rate_1_s, so neither a level's end nor a stop takes a
-// moving section from flow to neutral in one cycle.
+// limit, stopped within a tolerance; then neutral until the cylinder is at rest. A spool of a
+// machine sweep closes (towards neutral, or through it) at most at spool_rate_1_s, so neither a
+// level's end nor a stop takes a moving section from flow to neutral in one cycle; it opens as
+// commanded (a level starts with a step, as on the simulator).
 struct MidStrokeMove {
   double gain_1_s = 2.0;              // cylinder velocity reference per metre of position error
   double speed_fraction = 0.5;        // speed cap: this share of the cylinder's max_speed
@@ -32,7 +33,7 @@ struct MidStrokeMove {
   double rest_speed_fraction = 0.03;  // at rest below this share of max_speed
   double rest_s = 0.3;                // within the tolerance, neutral and at rest this long
   double timeout_s = 30.0;            // a move that takes longer fails the sweep
-  double spool_rate_1_s = 10.0;       // spool slew rate limit (full to neutral in 0.1 s)
+  double spool_rate_1_s = 2.0;        // closing rate limit (full to neutral in 0.5 s)
 };
 
 struct CalibrationOptions {
