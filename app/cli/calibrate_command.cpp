@@ -178,8 +178,8 @@ int run_calibrate_command(const CalibrateArgs& args) {
       }
       if (machines.finish() != kExitOk) rc = kExitRuntime;  // prints the reason of a fault
       if (sweep.end != offline::SweepEnd::kComplete) {
-        spdlog::error("calibration stopped ({}): {}; {} of {} sections calibrated",
-                      offline::to_string(sweep.end), sweep.reason, results.size(), sections.size());
+        spdlog::error("calibration stopped: {}; {} of {} sections calibrated", sweep.reason,
+                      results.size(), sections.size());
         rc = kExitRuntime;
       }
     } catch (const std::exception& e) {

@@ -430,11 +430,11 @@ MachineSweep calibrate_section_on_machine(const config::CraneConfig& config,
   const auto& name = config.model.joints[static_cast<std::size_t>(section)].name;
   if (summary.machine_fault) {
     out.end = SweepEnd::kMachineFault;
-    out.reason = machine.fault_text();
-    if (out.reason.empty()) out.reason = "the machine reported a fault";
+    const std::string why = machine.fault_text();
+    out.reason = "machine fault: " + (why.empty() ? std::string("(no reason given)") : why);
   } else if (summary.stop_requested) {
     out.end = SweepEnd::kStopRequested;
-    out.reason = "stopped on request during the sweep of " + name;
+    out.reason = "stop requested during the sweep of " + name;
   } else if (task.not_positioned()) {
     char buf[256];
     std::snprintf(buf, sizeof buf,
