@@ -12,7 +12,7 @@
 // a machine fault, BackendStatus::kFault) is handed to the task, which brings the machine to
 // rest (the controller's jerk-limited stop, then neutral valves); the loop keeps cycling until
 // the task reports kStopped, at most stop_settle_max_s (then it calls the machine's safe_stop()),
-// and ends. A run also ends after max_cycles.
+// and ends. A run also ends after max_cycles, or when its task has finished (a calibration sweep).
 //
 // The loop allocates nothing and throws nothing once running: the task's step() and the
 // observers' on_cycle() are noexcept and allocation-free (their contract), the log is a ring.
