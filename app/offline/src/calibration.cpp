@@ -38,13 +38,15 @@ double mid_stroke_q(const dynamics::CraneModel& model, int i) {
 // hold the command for settle + measure cycles with every other valve neutral and measure the
 // steady cylinder velocity: the mean over the window after the settle time, invalid when the two
 // halves of the window differ or the cylinder comes near an end stop. The velocity comes from
-// the joint positions through the model's joint-to-cylinder kinematics (cylinder_length), the
-// same on both, so a machine's table and the simulator's compare.
+// the joint feedback (positions on the simulator, rates on a machine: level_step) through the
+// model's joint-to-cylinder kinematics, the same on both, so a machine's table and the
+// simulator's compare.
 //
 // Placed (the simulator): the machine starts each level at mid-stroke and at rest, so the task
 // holds its one level from the first cycle and finishes after the window; the spool steps.
-// On a machine: the moves, a spool slew rate limit, a level cut short before the cylinder can
-// reach the end margin, and neutral spools at the end or on a stop request.
+// On a machine: the moves, spools closed at a limited rate, a level cut short before the
+// cylinder can reach the end margin, a level that did not settle measured again, and neutral
+// spools at the end or on a stop request.
 class SweepTask final : public control::CycleTask {
  public:
   enum class Mode { kPlaced, kMachine };
@@ -103,7 +105,7 @@ class SweepTask final : public control::CycleTask {
     target_.setZero();
     if (phase_ == Phase::kMove) move_step(state);
     if (phase_ == Phase::kLevel) level_step(state);
-    if (mode_ == Mode::kMachine) {
+    if (mode_ == Mode::kMachine) {  // closing ramped, opening as commanded (MidStrokeMove)
       for (Eigen::Index j = 0; j < spool_.size(); ++j) {
         const double now = spool_[j], wanted = target_[j];
         const bool opens = now == 0.0 || (wanted * now > 0.0 && std::abs(wanted) >= std::abs(now));
@@ -191,6 +193,10 @@ class SweepTask final : public control::CycleTask {
   // One cycle of the level in progress: the command held, the window's samples, the log row.
   void level_step(const valves::MachineState& state) noexcept {
     const double command = commands_[next_];
+    if (!state.valid) {  // no measurement (a machine's lost feedback): neutral, level dropped
+      end_level({command, 0.0, false});
+      return;
+    }
     const int k = level_k_;
     const double q = state.q[section_];
     const double length = dynamics::cylinder_length(cyl_, q);
@@ -205,7 +211,7 @@ class SweepTask final : public control::CycleTask {
       // Keep the stroke margins on a machine: end the level while the cylinder can still stop
       // short of them (running into an end stop at full command is what must not happen).
       const double ahead = length + stopping_distance_m(velocity);
-      cut = !state.valid || ahead < c_lo_ || ahead > c_hi_;
+      cut = ahead < c_lo_ || ahead > c_hi_;
     }
     target_[section_] = cut ? 0.0 : command;
     if (log_ != nullptr) {
