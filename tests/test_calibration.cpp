@@ -131,3 +131,38 @@ TEST(Calibration, CalibratedTablesTrackLikeTheStraightLine) {
 }
 
 }  // namespace
+
+namespace {
+
+// The sweep a machine gets (moves to mid-stroke in between, ramped spools, levels cut short
+// before the end margin), run on the simulator as the machine: one crane for the whole sweep,
+// from the config's initial pose. It must give the placed sweep's tables.
+TEST(Calibration, MachineSweepOnTheSimulatorGivesThePlacedTables) {
+  const auto cfg = config::default_crane_config();
+  sim_backend::SimBackend machine(cfg.model, {cfg.simulation.step_s, cfg.simulation.q_initial});
+  for (const auto& placed : k70m_calibration()) {
+    const auto& cyl = cfg.model.cylinders[static_cast<std::size_t>(placed.section)];
+    SCOPED_TRACE(cyl.name);
+    std::vector<offline::SweepLogRow> log;
+    const auto sweep = offline::calibrate_section_on_machine(
+        cfg, machine, placed.section, offline::CalibrationOptions{}, nullptr, &log);
+    ASSERT_EQ(sweep.end, offline::SweepEnd::kComplete) << sweep.reason;
+    const auto& r = sweep.section;
+    ASSERT_EQ(dynamics::check_valve_table(r.table), "");
+    for (const auto& p : r.points) EXPECT_TRUE(p.valid) << p.command;
+    EXPECT_NEAR(r.dead_band_extend, placed.dead_band_extend, kDeadBandTolerance);
+    EXPECT_NEAR(r.dead_band_retract, placed.dead_band_retract, kDeadBandTolerance);
+    EXPECT_NEAR(r.max_extend_m_s, placed.max_extend_m_s, kSpeedTolerance * cyl.v_max_m_s);
+    EXPECT_NEAR(r.max_retract_m_s, placed.max_retract_m_s, kSpeedTolerance * cyl.v_max_m_s);
+    double worst = 0.0;
+    for (std::size_t k = 0; k < r.points.size(); ++k) {
+      ASSERT_EQ(r.points[k].command, placed.points[k].command);
+      worst = std::max(worst, std::abs(r.points[k].velocity_m_s - placed.points[k].velocity_m_s));
+    }
+    EXPECT_LT(worst, 0.001 * cyl.v_max_m_s);
+    std::printf("%s: sweep %.1f s of machine time, worst level %.3g %% of max_speed\n",
+                cyl.name.c_str(), sweep.duration_s, 100.0 * worst / cyl.v_max_m_s);
+  }
+}
+
+}  // namespace

@@ -81,6 +81,7 @@ class StoppingTask final : public control::CycleTask {
                             const char* stop_cause, valves::ValveCommand&,
                             control::LogRow& row) noexcept override {
     row.t = time.t_s;
+    k_ = time.k;
     if (stop_cause == nullptr) {
       return idle_from >= 0 && time.k >= idle_from ? control::CycleStatus::kStopped
                                                    : control::CycleStatus::kRunning;
@@ -90,13 +91,16 @@ class StoppingTask final : public control::CycleTask {
     return time.k - stop_seen_at >= stop_cycles_ ? control::CycleStatus::kStopped
                                                  : control::CycleStatus::kStopping;
   }
+  bool finished() const noexcept override { return finished_from >= 0 && k_ >= finished_from; }
   int starts = 0;
-  long idle_from = -1;  // from this cycle on at rest without a stop request (a stale input)
+  long idle_from = -1;      // from this cycle on at rest without a stop request (a stale input)
+  long finished_from = -1;  // from this cycle on the task's work is done (finished())
   long stop_seen_at = -1;
   std::string cause;
 
  private:
   long stop_cycles_;
+  long k_ = -1;
 };
 
 class Recorder final : public control::CycleObserver {
@@ -214,6 +218,27 @@ TEST(ControlLoop, ARunAlreadyStoppedOrASegmentEndsAtItsLength) {
   EXPECT_EQ(s.cycles, 20);
   EXPECT_FALSE(s.end_stop);
   EXPECT_EQ(segment.stop_seen_at, -1);
+}
+
+// A task that finishes its work (a calibration sweep on a machine) ends the run there, before
+// max_cycles: at once when it is at rest, else through the end-of-run stop.
+TEST(ControlLoop, ATaskThatHasFinishedEndsTheRun) {
+  CountingMachine machine;
+  StoppingTask at_rest(30);
+  at_rest.idle_from = 10;
+  at_rest.finished_from = 10;
+  const auto s = control::run_control_loop(at_rest, machine, run_of(1000));
+  EXPECT_EQ(s.cycles, 11) << "cycle 10 reports kStopped and finished; the run ends after it";
+  EXPECT_FALSE(s.end_stop);
+  EXPECT_EQ(at_rest.stop_seen_at, -1);
+
+  StoppingTask moving(30);
+  moving.finished_from = 10;
+  const auto m = control::run_control_loop(moving, machine, run_of(1000));
+  EXPECT_TRUE(m.end_stop);
+  EXPECT_EQ(moving.cause, "end of run");
+  EXPECT_EQ(moving.stop_seen_at, 11);
+  EXPECT_EQ(m.cycles, 42) << "cycles 11..41 stopping, 41 reports kStopped";
 }
 
 // A run length computed from outside numbers never converts out of range.

@@ -1,9 +1,12 @@
-// `craneassist calibrate`: sweep each valve section on the simulator and write the fitted
-// velocity-vs-command tables (docs/valves.md).
+// `craneassist calibrate`: sweep each valve section on the simulator or on a machine (--backend
+// can) and write the fitted velocity-vs-command tables (docs/valves.md).
 #pragma once
 
 #include <CLI/CLI.hpp>
 #include <string>
+#include <vector>
+
+#include "machine_setup.hpp"
 
 namespace craneassist::cli {
 
@@ -12,6 +15,8 @@ struct CalibrateArgs {
   std::string section = "all";
   std::string out_file = "craneassist-valve-tables.yaml";
   std::string log_file = "craneassist-sweep.csv";
+  std::vector<double> levels;  // empty: offline::CalibrationOptions' levels
+  BackendArgs machine;
   bool quiet = false;
 };
 

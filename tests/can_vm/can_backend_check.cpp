@@ -12,6 +12,9 @@
 //                                       least MIN_FALL_MS (an abrupt block: about 100 ms)
 //   wait-motion IFACE TIMEOUT_S         waits until a command that is not block is on the bus:
 //                                       the run is moving
+//   tables SIM.yaml CAN.yaml TOL        valve tables of `craneassist calibrate` on the two
+//                                       backends: each section's velocity at every command of the
+//                                       sim table, within TOL of the sim table's top speed
 // Prints the figures; exit 0 when they are within the bounds.
 #include <linux/can.h>
 #include <linux/can/raw.h>
@@ -34,6 +37,7 @@
 
 #include "craneassist/can/can_frame.hpp"
 #include "craneassist/can/iso11783_valve.hpp"
+#include "craneassist/dynamics/valve_table.hpp"
 
 using namespace craneassist::can;
 
@@ -418,6 +422,67 @@ int stop(const char* path, double min_fall_ms) {
   return peak > 10.0 && fall_ms >= min_fall_ms ? 0 : 1;
 }
 
+// The tables of a `craneassist calibrate` YAML block, by joint name: "      NAME:" then
+// "        command: ..., measured" and "        velocity: ... m/s, measured".
+std::map<std::string, craneassist::dynamics::ValveTable> read_tables(const char* path) {
+  std::map<std::string, craneassist::dynamics::ValveTable> out;
+  std::ifstream in(path);
+  std::string line, joint;
+  auto numbers = [](const std::string& text) {
+    std::vector<double> v;
+    std::istringstream ss(text.substr(0, text.find_first_of(",m")));
+    for (double x = 0.0; ss >> x;) v.push_back(x);
+    return v;
+  };
+  while (std::getline(in, line)) {
+    const auto first = line.find_first_not_of(' ');
+    if (first == 6 && line.back() == ':') joint = line.substr(6, line.size() - 7);
+    if (line.compare(first == std::string::npos ? 0 : first, 8, "command:") == 0) {
+      out[joint].command = numbers(line.substr(first + 8));
+    }
+    if (line.compare(first == std::string::npos ? 0 : first, 9, "velocity:") == 0) {
+      out[joint].velocity_m_s = numbers(line.substr(first + 9));
+    }
+  }
+  return out;
+}
+
+int tables(const char* sim_path, const char* can_path, double tolerance) {
+  namespace dyn = craneassist::dynamics;
+  const auto sim = read_tables(sim_path), can = read_tables(can_path);
+  if (sim.empty()) {
+    std::printf("tables: none in %s\n", sim_path);
+    return 1;
+  }
+  bool ok = true;
+  for (const auto& [joint, s] : sim) {
+    const auto it = can.find(joint);
+    if (it == can.end() || !dyn::check_valve_table(s).empty() ||
+        !dyn::check_valve_table(it->second).empty()) {
+      std::printf("tables: %s missing or not usable\n", joint.c_str());
+      ok = false;
+      continue;
+    }
+    const auto& c = it->second;
+    const double top = std::max(-s.velocity_m_s.front(), s.velocity_m_s.back());
+    double worst = 0.0;
+    for (double u : s.command) {
+      const double vs = dyn::valve_table_velocity(s, u), vc = dyn::valve_table_velocity(c, u);
+      worst = std::max(worst, std::abs(vc - vs));
+      std::printf("  %s command %+.3f: sim %+.5f m/s, can %+.5f m/s (%+.2f %% of %.3f m/s)\n",
+                  joint.c_str(), u, vs, vc, 100.0 * (vc - vs) / top, top);
+    }
+    std::printf(
+        "tables: %s: dead band sim %.4f/%.4f, can %.4f/%.4f; worst velocity difference %.2f %% "
+        "of the top speed (at most %.1f %%)\n",
+        joint.c_str(), dyn::valve_table_dead_band_edge(s, -1.0),
+        dyn::valve_table_dead_band_edge(s, 1.0), dyn::valve_table_dead_band_edge(c, -1.0),
+        dyn::valve_table_dead_band_edge(c, 1.0), 100.0 * worst / top, 100.0 * tolerance);
+    ok = ok && worst <= tolerance * top;
+  }
+  return ok ? 0 : 1;
+}
+
 }  // namespace
 
 // Fault injection must wait for the run to move: a fixed sleep does not, when a loaded host
@@ -466,7 +531,9 @@ int main(int argc, char** argv) {
   if (mode == "stop" && argc == 4) return stop(argv[2], std::strtod(argv[3], nullptr));
   if (mode == "wait-motion" && argc == 4)
     return wait_motion(argv[2], std::strtod(argv[3], nullptr));
-  std::fprintf(stderr,
-               "usage: can_backend_check compare|traffic|direction|safe|stop|wait-motion ...\n");
+  if (mode == "tables" && argc == 5) return tables(argv[2], argv[3], std::strtod(argv[4], nullptr));
+  std::fprintf(
+      stderr,
+      "usage: can_backend_check compare|traffic|direction|safe|stop|wait-motion|tables ...\n");
   return 2;
 }

@@ -53,6 +53,8 @@ expect can_narrow_mapping "$narrow" replay --backend can --can vcan0 --mapping "
 expect sim_narrow_mapping "$narrow" sim --backend can --can vcan0 --mapping "$work/narrow_map.yaml" \
   --input replay "$demo"
 expect emulate_narrow_mapping "$narrow" emulate --can vcan0 --mapping "$work/narrow_map.yaml"
+expect calibrate_narrow_mapping "$narrow" calibrate --backend can --can vcan0 \
+  --mapping "$work/narrow_map.yaml" --out "$work/tables.yaml" --log "$work/sweep.csv"
 # Every file is read with its format's size bound (YAML 1 MiB, CSV 64 MiB): a file without an
 # end (/dev/zero) and a larger regular file (sparse, nothing written) are refused, not read
 # until the memory runs out.
@@ -118,5 +120,11 @@ expect negative_supply "--supply-pressure: must be positive and at most max_pres
 expect big_payload "--payload: must be between 0 and 100000 kg" replay --payload 1e6 --no-log
 expect big_feedback_timeout "--can-feedback-timeout: must be between 1 ms and 1 s" \
   replay --can-feedback-timeout 30 --no-log
+expect calibrate_feedback_timeout "--can-feedback-timeout: must be between 1 ms and 1 s" \
+  calibrate --backend can --can vcan0 --can-feedback-timeout 30
+expect calibrate_nan_level "--levels: 'nan' is not a finite number" calibrate --levels 0.5,nan
+expect calibrate_zero_level "--levels: each level must be in (0, 1], got 0" calibrate --levels 0,1
+expect calibrate_level_order "--levels: the levels must be strictly ascending" \
+  calibrate --levels 0.6,0.3
 [ "$failed" -eq 0 ] && echo "bad input files OK"
 exit "$failed"

@@ -86,7 +86,7 @@ LoopSummary run_control_loop(CycleTask& task, valves::MachineInterface& machine,
   long k = 0;
   CycleStatus last_status = CycleStatus::kRunning;
   for (;; ++k) {
-    if (stop_cause == nullptr && k >= options.max_cycles) {
+    if (stop_cause == nullptr && (k >= options.max_cycles || task.finished())) {
       // The end of the run: stop the machine, never leave it moving (unless it already is).
       if (k == 0 || !options.stop_at_end || last_status == CycleStatus::kStopped) break;
       stop_requested_at = k;

@@ -12,7 +12,7 @@
 // a machine fault, BackendStatus::kFault) is handed to the task, which brings the machine to
 // rest (the controller's jerk-limited stop, then neutral valves); the loop keeps cycling until
 // the task reports kStopped, at most stop_settle_max_s (then it calls the machine's safe_stop()),
-// and ends. A run also ends after max_cycles.
+// and ends. A run also ends after max_cycles, or when its task has finished (a calibration sweep).
 //
 // The loop allocates nothing and throws nothing once running: the task's step() and the
 // observers' on_cycle() are noexcept and allocation-free (their contract), the log is a ring.
@@ -61,6 +61,11 @@ class CycleTask {
   // The tip controller's output of the last step(), for statistics; nullptr for tasks without
   // one (trajectory execution, calibration).
   virtual const ControllerOutput* controller_output() const noexcept { return nullptr; }
+  // True once the task has done its work, when that is not a fixed number of cycles (a valve
+  // calibration sweep on a machine: it moves the section between levels for as long as that
+  // takes). The loop then ends the run as at LoopOptions::max_cycles. Tasks that run for a given
+  // time never finish.
+  virtual bool finished() const noexcept { return false; }
 };
 
 // One finished cycle, as the observers see it (after the valves are written).
@@ -93,7 +98,8 @@ class CycleObserver {
 struct LoopOptions {
   double period_s = 0.01;
   double t0_s = 0.0;  // machine time of cycle 0
-  // The run's length in cycles; a stop request may end it earlier. When the run reaches it with
+  // The run's length in cycles (or less: CycleTask::finished()); a stop request may end it
+  // earlier. When the run reaches it with
   // the machine not stopped, the loop stops it as for a stop request (cause "end of run"): a
   // jerk-limited stop, then the task's neutral valves, or safe_stop() after stop_settle_max_s.
   // Build it with run_cycles().

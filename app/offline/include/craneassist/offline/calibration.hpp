@@ -1,16 +1,40 @@
 // Valve calibration (`craneassist calibrate`, docs/valves.md): a command sweep on one section at
 // a time, the steady cylinder velocity at every level in both directions, and the monotone table
-// (hydraulics.valves.tables) fitted to it. Runs on the simulator; offline, so it allocates freely.
+// (hydraulics.valves.tables) fitted to it. One sweep task (calibration.cpp) drives any
+// valves::MachineInterface: on the simulator each level starts on a fresh crane placed at
+// mid-stroke; on a machine (the CAN backend, or the simulator standing in for one) the task moves
+// the section back to mid-stroke itself before every level. The sweep is offline and allocates
+// freely before and after its control loop; the loop's cycles allocate nothing.
 #pragma once
 
+#include <atomic>
 #include <iosfwd>
 #include <string>
 #include <vector>
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/dynamics/model.hpp"
+#include "craneassist/valves/machine_interface.hpp"
 
 namespace craneassist::offline {
+
+// How a sweep on a machine brings the section back to mid-stroke before each level, and how it
+// handles the spools there: a P loop on the cylinder position through the config's valve model
+// (its table, or the straight line through dead_zone and max_speed), with a speed cap and a spool
+// limit, stopped within a tolerance; then neutral until the cylinder is at rest. A spool of a
+// machine sweep closes (towards neutral, or through it) at most at spool_rate_1_s, so neither a
+// level's end nor a stop takes a moving section from flow to neutral in one cycle; it opens as
+// commanded (a level starts with a step, as on the simulator).
+struct MidStrokeMove {
+  double gain_1_s = 2.0;              // cylinder velocity reference per metre of position error
+  double speed_fraction = 0.5;        // speed cap: this share of the cylinder's max_speed
+  double spool_max = 0.8;             // |spool| limit while moving
+  double tolerance = 0.01;            // share of the stroke: close enough to mid-stroke
+  double rest_speed_fraction = 0.03;  // at rest below this share of max_speed
+  double rest_s = 0.3;                // within the tolerance, neutral and at rest this long
+  double timeout_s = 30.0;            // a move that takes longer fails the sweep
+  double spool_rate_1_s = 2.0;        // closing rate limit (full to neutral in 0.5 s)
+};
 
 struct CalibrationOptions {
   // Command magnitudes stepped through, each in both directions (ascending, in (0, 1]).
@@ -23,12 +47,22 @@ struct CalibrationOptions {
   // A level whose mean velocities over the two halves of the window differ by more than this
   // share is recorded as not settled (invalid, not fitted).
   double settled_tolerance = 0.01;
+  // On a machine the window is judged with this tolerance instead: at a steady speed the
+  // halves of a window measured over CAN differ by up to 3 % (the encoders' resolution, the
+  // bus's and the machine's timing; tests/test_calibration_can.cpp), and a level found not
+  // settled is measured again, from mid-stroke, up to machine_retries times.
+  double machine_settled_tolerance = 0.03;
+  int machine_retries = 2;
   // Share of the stroke kept clear of either end stop: a level whose measurement window would
   // come closer is recorded as invalid (not fitted).
   double end_margin = 0.05;
   // Below this share of the section's top measured speed a velocity counts as zero (dead band).
   double zero_fraction = 1e-3;
+  MidStrokeMove move;  // on a machine only
 };
+
+// "" when `levels` can be swept (at least one, each in (0, 1], strictly ascending), else why not.
+std::string check_levels(const std::vector<double>& levels);
 
 // One level held in one direction.
 struct SweepPoint {
@@ -55,11 +89,42 @@ struct SectionCalibration {
   double max_retract_m_s = 0.0, max_extend_m_s = 0.0;      // at the extreme levels
 };
 
-// Sweeps section `section` of the crane in the simulator, starting every level at mid-stroke with
-// the other joints at the config's initial position; appends to `log` when given.
+// Sweeps section `section` of the crane in the simulator, starting every level on a fresh
+// simulated crane with that joint at mid-stroke and the others at the config's initial position;
+// appends to `log` when given. Throws std::invalid_argument for a section the crane lacks.
 SectionCalibration calibrate_section(const config::CraneConfig& config, int section,
                                      const CalibrationOptions& options,
                                      std::vector<SweepLogRow>* log = nullptr);
+
+// How a sweep on a machine ended.
+enum class SweepEnd {
+  kComplete,
+  kStopRequested,  // the stop flag (SIGINT): spools ramped to neutral
+  kMachineFault,   // the machine latched a fault (it blocked its valves itself)
+  kNotPositioned,  // the section did not reach mid-stroke within move.timeout_s
+};
+const char* to_string(SweepEnd end);
+
+struct MachineSweep {
+  SectionCalibration section;  // fitted only when complete
+  SweepEnd end = SweepEnd::kComplete;
+  std::string reason;        // why it ended early; "" when complete
+  double duration_s = 0.0;   // machine time of the sweep
+  double wall_time_s = 0.0;  // computer time (the same on a real-time machine)
+};
+
+// Sweeps section `section` on an active machine in one control loop, paced at real time when
+// the machine is (MachineInterface::real_time): before every level the section is moved to
+// mid-stroke (options.move) with every other section neutral; a level ends early, as invalid,
+// when the cylinder would pass the end margin before it can stop. The loop stops when `stop`
+// becomes true or the machine faults, the spools ramping to neutral; at the end every spool is
+// neutral. The caller deactivates the machine. Appends the levels' cycles to `log` when given.
+// Throws std::invalid_argument for a section the crane lacks.
+MachineSweep calibrate_section_on_machine(const config::CraneConfig& config,
+                                          valves::MachineInterface& machine, int section,
+                                          const CalibrationOptions& options,
+                                          const std::atomic<bool>* stop = nullptr,
+                                          std::vector<SweepLogRow>* log = nullptr);
 
 // The monotone table through sweep points (ascending command): pool-adjacent-violators isotonic
 // regression of velocity on command, velocities below zero_speed_m_s set to 0, the dead-band edge
