@@ -13,6 +13,12 @@ set -u
 status=0
 fail() { echo "FAIL: $*"; status=1; }
 now() { cut -d' ' -f1 /proc/uptime; }
+case_start=$(now)
+took() {  # the time since the previous case began
+  t=$(now)
+  echo "--- took $(awk -v a="$case_start" -v b="$t" 'BEGIN { printf "%.1f", b - a }') s"
+  case_start=$t
+}
 wait_file() {  # wait_file FILE SECONDS
   tries=0
   until [ -e "$1" ]; do
@@ -40,6 +46,7 @@ echo "=== the DBC, written by craneassist from its embedded K70M mapping"
 ./craneassist can dbc -o /tmp/k70m.dbc || { echo "FAIL: craneassist can dbc"; exit 1; }
 grep -c '^BO_ ' /tmp/k70m.dbc | sed 's/^/messages in the DBC: /'
 
+took
 echo "=== (a) replay against the independent peer"
 start_peer /tmp/peer_a.out
 t0=$(now)
@@ -53,6 +60,7 @@ echo "replay ran $(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.1f", b - a }') s
 [ "$prc" = 0 ] || fail "(a) the peer's checks failed (exit $prc)"
 grep -q "every section's last command: block" /tmp/peer_a.out || fail "(a) not every section blocked at the end"
 
+took
 echo "=== (b) craneassist killed while the crane moves: fail-safe on silence"
 start_peer /tmp/peer_b.out --expect-silence
 ./craneassist replay can_short.csv --backend can --can vcan0 --no-log --settle 0 \
@@ -72,9 +80,11 @@ cat /tmp/peer_b.out
 [ "$prc" = 0 ] || fail "(b) the peer's checks failed (exit $prc)"
 grep -q "fail-safe on silence: " /tmp/peer_b.out || fail "(b) no fail-safe on silence reported"
 
+took
 echo "=== (c) the backend's log of (a) decoded through the DBC"
 python3 decode_can_log.py /tmp/k70m.dbc /tmp/backend.log --moving --ends-blocked || fail "(c) decode"
 
+took
 echo "=== (d) control: wrong frames must fail the peer's checks"
 start_peer /tmp/peer_d.out --exit-after-silence 0.5
 # AVC byte 2 0xFD: resolution mode 1, reserved bits 1; byte 3 0x31: extend, fail-safe block.
@@ -92,4 +102,5 @@ for what in "ValveState extend with flow 0 %" "ValveState 4 (?), not block/exten
             "frames foreign to the DBC: 123"; do
   grep -qF "$what" /tmp/peer_d.out || fail "(d) the peer did not report: $what"
 done
+took
 exit $status

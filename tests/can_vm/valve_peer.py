@@ -194,7 +194,7 @@ class Peer:
         self.violations = {}
         self.hb = dict(count=0, stats=Stats(), last=None, last_state=None, last_adv=None,
                        last_adv_stamp=None, skips=0, repeats=0, faults=0, alive=False,
-                       states=set(), fault_reasons=set(), lost=[])
+                       states=set(), fault_reasons=set())
         self.flow_while_not_enabled = 0
         self.sent = 0
         self.send_times = []
@@ -232,7 +232,7 @@ class Peer:
                     machine_signals[s.name] = (f, s)
         for sec in self.sections.values():
             if sec.joint not in JOINTS:
-                sys.exit(f"valve_peer: {sec.name}: joint '{sec.joint}' not in the peer's joint table")
+                sys.exit(f"valve_peer: {sec.name}: joint '{sec.joint}' not in the joint table")
         for joint, j in JOINTS.items():
             if f"{joint}_position" not in machine_signals:
                 sys.exit(f"valve_peer: the DBC has no {joint}_position signal")
@@ -321,7 +321,7 @@ class Peer:
         else:
             spool = self.check_signal(sec, values)
         sec.last_data = data
-        if spool != 0.0 and self.heartbeat is not None and self.hb["last_state"] != HEARTBEAT_ENABLED:
+        if spool != 0.0 and not self.loop_running():
             self.flow_while_not_enabled += 1
         sec.spool = spool
         if sec.fail_safe is not None:
@@ -335,11 +335,14 @@ class Peer:
         mode = raw["ResolutionMode"]
         name = sec.name
         if raw["PortFlowCommand"] > 250:
-            self.violation(f"{name}: PortFlowCommand raw {raw['PortFlowCommand']} above 250 (100 %)")
+            self.violation(f"{name}: PortFlowCommand raw {raw['PortFlowCommand']} above 250 "
+                           "(100 %)")
         if state not in (0, 1, 2):
-            self.violation(f"{name}: ValveState {state} ({ISO_STATES.get(state, '?')}), not block/extend/retract")
+            self.violation(f"{name}: ValveState {state} ({ISO_STATES.get(state, '?')}), "
+                           "not block/extend/retract")
         if (state == 0) != (raw["PortFlowCommand"] == 0):
-            self.violation(f"{name}: ValveState {ISO_STATES.get(state, state)} with flow {flow:g} %")
+            self.violation(f"{name}: ValveState {ISO_STATES.get(state, state)} "
+                           f"with flow {flow:g} %")
         sec.fail_safe_modes.add(raw["FailSafeMode"])
         if raw["FailSafeMode"] != FAIL_SAFE_CODES[self.args.fail_safe]:
             self.violation(f"{name}: FailSafeMode {raw['FailSafeMode']}, expected "
@@ -348,18 +351,21 @@ class Peer:
         ext_raw = raw["PortFlowCommandExtended"]
         if mode == 1:
             if ext_raw > 64000:
-                self.violation(f"{name}: PortFlowCommandExtended raw {ext_raw} above 64000 (100 %)")
+                self.violation(f"{name}: PortFlowCommandExtended raw {ext_raw} above 64000 "
+                               "(100 %)")
             else:
-                diff = abs(float(values["PortFlowCommandExtended"].phys_value) - flow)
+                ext = float(values["PortFlowCommandExtended"].phys_value)
+                diff = abs(ext - flow)
                 sec.max_ext_diff = max(sec.max_ext_diff, diff)
                 if diff > 0.4 + 1e-9:
-                    self.violation(f"{name}: extended flow {float(values['PortFlowCommandExtended'].phys_value):g} % "
-                                   f"vs 8-bit {flow:g} %: more than one 8-bit step apart")
+                    self.violation(f"{name}: extended flow {ext:g} % vs 8-bit {flow:g} %: more "
+                                   "than one 8-bit step apart")
                 if state == 0 and ext_raw != 0:
                     self.violation(f"{name}: block with extended flow raw {ext_raw}")
         elif mode == 0:
             if ext_raw != 0xFFFF:
-                self.violation(f"{name}: resolution mode 0 but PortFlowCommandExtended raw {ext_raw:#x}, not 0xFFFF")
+                self.violation(f"{name}: resolution mode 0 but PortFlowCommandExtended raw "
+                               f"{ext_raw:#x}, not 0xFFFF")
         else:
             self.violation(f"{name}: ResolutionMode {mode}, expected 0 or 1")
         word = int.from_bytes(data, "little")
@@ -424,19 +430,20 @@ class Peer:
                 self.hb["lost_reported"] = True
                 was_enabled = self.hb["last_state"] == HEARTBEAT_ENABLED
                 after = wall - self.hb["last_adv_stamp"]
-                self.hb["lost"].append((wall, after, was_enabled))
                 say(f"heartbeat lost: AliveCounter not advanced for {after * 1e3:.1f} ms "
                     f"(timeout {self.hb_timeout * 1e3:g} ms; last state "
-                    f"{'enabled' if was_enabled else self.hb['last_state']}): every section to fail-safe")
+                    f"{'enabled' if was_enabled else self.hb['last_state']}): every section to "
+                    "fail-safe")
                 for sec in self.sections.values():
                     self.enter_fail_safe(sec, wall, "heartbeat lost")
             elif silent <= self.hb_timeout:
                 self.hb["lost_reported"] = False
             if silent > self.hb_timeout:
                 self.hb["alive"] = False
+        timeout = self.args.command_timeout
         for sec in self.sections.values():
-            if sec.last_rx is not None and now - sec.last_rx > self.args.command_timeout:
-                self.enter_fail_safe(sec, wall, f"no command for {self.args.command_timeout * 1e3:g} ms")
+            if sec.last_rx is not None and now - sec.last_rx > timeout:
+                self.enter_fail_safe(sec, wall, f"no command for {timeout * 1e3:g} ms")
 
     def enter_fail_safe(self, sec, wall, why):
         if sec.fail_safe is not None or sec.last_stamp is None:
@@ -445,8 +452,9 @@ class Peer:
         sec.fail_safe = why
         after = wall - sec.last_stamp
         sec.events.append(dict(wall=wall, after=after, why=why, moving=moving, spool=sec.spool))
-        say(f"{sec.joint} ({sec.name}): fail-safe {self.args.fail_safe} (spool 0) {after * 1e3:.1f} ms "
-            f"after its last command: {why}; it was {'MOVING at spool %.3f' % sec.spool if moving else 'blocked'}")
+        was = f"MOVING at spool {sec.spool:.3f}" if moving else "blocked"
+        say(f"{sec.joint} ({sec.name}): fail-safe {self.args.fail_safe} (spool 0) "
+            f"{after * 1e3:.1f} ms after its last command: {why}; it was {was}")
 
     def effective_spool(self, sec):
         """The spool the section moves with: 0 in fail-safe or while the heartbeat is not alive."""
@@ -510,7 +518,8 @@ class Peer:
             f"({', '.join(f'{s.joint}={s.name}' for s in self.sections.values())}), "
             f"heartbeat {self.heartbeat.name if self.heartbeat else 'none'}"
             f"{f' (timeout {self.hb_timeout * 1e3:g} ms)' if self.heartbeat else ''}, "
-            f"{len(self.feedback)} feedback messages every {args.period * 1e3:g} ms on {args.channel}")
+            f"{len(self.feedback)} feedback messages every {args.period * 1e3:g} ms on "
+            f"{args.channel}")
         start = time.monotonic()
         next_tick = start
         last_tick = start
@@ -540,16 +549,19 @@ class Peer:
                     if args.ready_file:
                         with open(args.ready_file, "w") as f:
                             f.write(f"{os.getpid()}\n")
-                    say(f"sending feedback ({time.monotonic() - start:.2f} s after opening the bus)")
+                    say(f"sending feedback ({time.monotonic() - start:.2f} s after opening "
+                        "the bus)")
                 next_tick += args.period
                 if next_tick < now:  # overrun: count it, do not burst to catch up
                     self.overruns += 1
                     next_tick = now + args.period
-                if self.last_command is not None and now - self.last_command > args.exit_after_silence:
+                silent = now - self.last_command if self.last_command is not None else 0.0
+                if silent > args.exit_after_silence:
                     say(f"craneassist silent for {args.exit_after_silence:g} s: done")
                     break
                 if self.first_command is None and now - start > args.start_timeout:
-                    self.failures.append(f"no frame from craneassist within {args.start_timeout:g} s")
+                    self.failures.append(f"no frame from craneassist within "
+                                         f"{args.start_timeout:g} s")
                     break
                 if now - start > args.max_time:
                     say(f"--max-time {args.max_time:g} s reached")
@@ -560,96 +572,120 @@ class Peer:
 
     # --- the summary ------------------------------------------------------------------------
     def report(self):
-        args = self.args
         fail = self.failures
         say("--- summary")
-        for sec in self.sections.values():
-            say(f"{sec.joint} ({sec.name} {hex_id(sec.frame.arbitration_id.id, sec.frame.arbitration_id.extended)}): "
-                f"{sec.count} commands, {sec.stats.text(sec.cycle_s)}")
-            extra = ""
-            if sec.kind == "avc":
-                extra = (f", fail-safe modes {sorted(sec.fail_safe_modes)}, resolution modes "
-                         f"{sorted(sec.resolution_modes)}, extended vs 8-bit flow max diff {sec.max_ext_diff:.3f} %")
-            say(f"  largest flow {sec.max_flow:.1f} %{extra}; last command {sec.last_text}; "
-                f"position {self.joint_state[sec.joint]['q']:.4f}")
-            if sec.count == 0:
-                fail.append(f"{sec.name}: no command")
-            mean = sec.stats.mean()
-            if sec.cycle_s and mean is not None and abs(mean - sec.cycle_s) > args.cycle_tolerance * sec.cycle_s:
-                fail.append(f"{sec.name}: mean period {mean * 1e3:.2f} ms, DBC {sec.cycle_s * 1e3:g} ms")
+        self.report_sections(fail)
         if self.heartbeat is not None:
-            hb = self.hb
-            say(f"heartbeat ({self.heartbeat.name}): {hb['count']} messages, {hb['stats'].text(self.hb_cycle_s)}; "
-                f"counter skips {hb['skips']}, repeats {hb['repeats']}; states seen {sorted(hb['states'])}"
-                f"{'; fault reasons %s' % sorted(hb['fault_reasons']) if hb['faults'] else ''}; "
-                f"commands asking for flow while not enabled: {self.flow_while_not_enabled}")
-            if hb["count"] == 0:
-                fail.append("no heartbeat")
-            mean = hb["stats"].mean()
-            if self.hb_cycle_s and mean is not None and abs(mean - self.hb_cycle_s) > args.cycle_tolerance * self.hb_cycle_s:
-                fail.append(f"heartbeat: mean period {mean * 1e3:.2f} ms, DBC {self.hb_cycle_s * 1e3:g} ms")
-            if hb["skips"] or hb["repeats"]:
-                fail.append("heartbeat counter skipped or repeated")
-            if hb["faults"]:
-                fail.append(f"craneassist reported a fault in its heartbeat (reasons {sorted(hb['fault_reasons'])})")
-            if self.flow_while_not_enabled:
-                fail.append(f"{self.flow_while_not_enabled} commands asked for flow while the heartbeat was not enabled")
-        if self.send_times:
-            gaps = [b - a for a, b in zip(self.send_times, self.send_times[1:])]
-            if gaps:
-                mean = statistics.fmean(gaps)
-                say(f"feedback sent: {self.sent} frames, {len(self.send_times)} rounds, period mean "
-                    f"{mean * 1e3:.2f} ms, std dev {statistics.pstdev(gaps) * 1e3:.2f} ms, max {max(gaps) * 1e3:.1f} ms "
-                    f"(nominal {args.period * 1e3:g} ms), overruns {self.overruns}; {self.encodings} encodings; "
-                    f"work per tick mean {statistics.fmean(self.busy) * 1e3:.2f} ms, max {max(self.busy) * 1e3:.1f} ms")
-                if mean > 2 * args.period:
-                    fail.append(f"feedback period mean {mean * 1e3:.2f} ms: the peer did not keep up")
+            self.report_heartbeat(fail)
+        self.report_feedback(fail)
         if self.unknown:
             fail.append("frames foreign to the DBC: " + ", ".join(
                 f"{hex_id(i, e)} x{n}" for (i, e), n in sorted(self.unknown.items())))
         if self.foreign:
             fail.append("another node sent the machine's messages: " + ", ".join(
                 f"{k} x{n}" for k, n in sorted(self.foreign.items())))
-        if self.violations:
-            for what, n in sorted(self.violations.items()):
-                fail.append(f"{what} ({n} frames)")
-        # Silence.
-        moving_events = [(sec, e) for sec in self.sections.values() for e in sec.events if e["moving"]]
-        for sec in self.sections.values():
-            for e in sec.events:
-                say(f"fail-safe: {sec.joint} {e['after'] * 1e3:.1f} ms after its last command ({e['why']}), "
-                    f"{'moving' if e['moving'] else 'already blocked'}")
-        limit = min(args.command_timeout, self.hb_timeout or args.command_timeout) + args.tolerance
-        if args.expect_silence:
-            if not moving_events:
-                fail.append("--expect-silence: no section was moving when the commands stopped")
-            for sec, e in moving_events:
-                if e["after"] > limit:
-                    fail.append(f"{sec.joint}: fail-safe {e['after'] * 1e3:.1f} ms after its last command "
-                                f"(allowed {limit * 1e3:.0f} ms)")
-            if moving_events:
-                worst = max(e["after"] for _, e in moving_events)
-                say(f"fail-safe on silence: {len(moving_events)} moving sections to spool 0, the last "
-                    f"{worst * 1e3:.1f} ms after its last command (timeouts: commands "
-                    f"{args.command_timeout * 1e3:g} ms, heartbeat {(self.hb_timeout or 0) * 1e3:g} ms)")
-            for sec in self.sections.values():
-                if self.effective_spool(sec) != 0.0:
-                    fail.append(f"{sec.joint}: not in fail-safe at the end")
-        else:
-            for sec, e in moving_events:
-                fail.append(f"{sec.joint}: commands stopped while it moved ({e['why']})")
-            for sec in self.sections.values():
-                if sec.count and not sec.last_blocked:
-                    fail.append(f"{sec.joint}: last command {sec.last_text}, not block")
-            if any(sec.count for sec in self.sections.values()) and all(
-                    sec.last_blocked for sec in self.sections.values() if sec.count):
-                say("every section's last command: block")
+        for what, n in sorted(self.violations.items()):
+            fail.append(f"{what} (x{n})")
+        self.report_silence(fail)
         if not self.motion_seen:
             fail.append("no section ever moved")
         for f in fail:
             say(f"FAIL: {f}")
         say("PASS: every check" if not fail else f"FAIL: {len(fail)} checks failed")
         return 1 if fail else 0
+
+    def period_ok(self, what, stats, nominal_s, fail):
+        mean = stats.mean()
+        tol = self.args.cycle_tolerance
+        if nominal_s and mean is not None and abs(mean - nominal_s) > tol * nominal_s:
+            fail.append(f"{what}: mean period {mean * 1e3:.2f} ms, DBC {nominal_s * 1e3:g} ms "
+                        f"(tolerance {tol * 100:g} %)")
+
+    def report_sections(self, fail):
+        for sec in self.sections.values():
+            ident = hex_id(sec.frame.arbitration_id.id, sec.frame.arbitration_id.extended)
+            say(f"{sec.joint} ({sec.name} {ident}): {sec.count} commands, "
+                f"{sec.stats.text(sec.cycle_s)}")
+            extra = ""
+            if sec.kind == "avc":
+                extra = (f", fail-safe modes {sorted(sec.fail_safe_modes)}, resolution modes "
+                         f"{sorted(sec.resolution_modes)}, extended vs 8-bit flow max diff "
+                         f"{sec.max_ext_diff:.3f} %")
+            say(f"  largest flow {sec.max_flow:.1f} %{extra}; last command {sec.last_text}; "
+                f"position {self.joint_state[sec.joint]['q']:.4f}")
+            if sec.count == 0:
+                fail.append(f"{sec.name}: no command")
+            self.period_ok(sec.name, sec.stats, sec.cycle_s, fail)
+
+    def report_heartbeat(self, fail):
+        hb = self.hb
+        reasons = sorted(hb["fault_reasons"])
+        say(f"heartbeat ({self.heartbeat.name}): {hb['count']} messages, "
+            f"{hb['stats'].text(self.hb_cycle_s)}; counter skips {hb['skips']}, repeats "
+            f"{hb['repeats']}; states seen {sorted(hb['states'])}"
+            f"{f'; fault reasons {reasons}' if hb['faults'] else ''}; commands asking for flow "
+            f"while not enabled: {self.flow_while_not_enabled}")
+        if hb["count"] == 0:
+            fail.append("no heartbeat")
+        self.period_ok("heartbeat", hb["stats"], self.hb_cycle_s, fail)
+        if hb["skips"] or hb["repeats"]:
+            fail.append("heartbeat counter skipped or repeated")
+        if hb["faults"]:
+            fail.append(f"craneassist reported a fault in its heartbeat (reasons {reasons})")
+        if self.flow_while_not_enabled:
+            fail.append(f"{self.flow_while_not_enabled} commands asked for flow while the "
+                        "heartbeat was not enabled")
+
+    def report_feedback(self, fail):
+        gaps = [b - a for a, b in zip(self.send_times, self.send_times[1:])]
+        if not gaps:
+            return
+        period = self.args.period
+        mean = statistics.fmean(gaps)
+        say(f"feedback sent: {self.sent} frames, {len(self.send_times)} rounds, period mean "
+            f"{mean * 1e3:.2f} ms, std dev {statistics.pstdev(gaps) * 1e3:.2f} ms, max "
+            f"{max(gaps) * 1e3:.1f} ms (nominal {period * 1e3:g} ms), overruns {self.overruns}; "
+            f"{self.encodings} encodings; work per tick mean "
+            f"{statistics.fmean(self.busy) * 1e3:.2f} ms, max {max(self.busy) * 1e3:.1f} ms")
+        if mean > 2 * period:
+            fail.append(f"feedback period mean {mean * 1e3:.2f} ms: the peer did not keep up")
+
+    def report_silence(self, fail):
+        args = self.args
+        moving = []
+        for sec in self.sections.values():
+            for e in sec.events:
+                say(f"fail-safe: {sec.joint} {e['after'] * 1e3:.1f} ms after its last command "
+                    f"({e['why']}), {'moving' if e['moving'] else 'already blocked'}")
+                if e["moving"]:
+                    moving.append((sec, e))
+        if not args.expect_silence:
+            for sec, e in moving:
+                fail.append(f"{sec.joint}: commands stopped while it moved ({e['why']})")
+            for sec in self.sections.values():
+                if sec.count and not sec.last_blocked:
+                    fail.append(f"{sec.joint}: last command {sec.last_text}, not block")
+            commanded = [sec for sec in self.sections.values() if sec.count]
+            if commanded and all(sec.last_blocked for sec in commanded):
+                say("every section's last command: block")
+            return
+        timeout = min(args.command_timeout, self.hb_timeout or args.command_timeout)
+        limit = timeout + args.tolerance
+        if not moving:
+            fail.append("--expect-silence: no section was moving when the commands stopped")
+        for sec, e in moving:
+            if e["after"] > limit:
+                fail.append(f"{sec.joint}: fail-safe {e['after'] * 1e3:.1f} ms after its last "
+                            f"command (allowed {limit * 1e3:.0f} ms)")
+        if moving:
+            worst = max(e["after"] for _, e in moving)
+            say(f"fail-safe on silence: {len(moving)} moving sections to spool 0, the last "
+                f"{worst * 1e3:.1f} ms after its last command (timeouts: commands "
+                f"{args.command_timeout * 1e3:g} ms, heartbeat "
+                f"{(self.hb_timeout or 0) * 1e3:g} ms)")
+        for sec in self.sections.values():
+            if self.effective_spool(sec) != 0.0:
+                fail.append(f"{sec.joint}: not in fail-safe at the end")
 
 
 def main():
