@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Prepares the SocketCAN test VM (docs/can-vm.md): installs qemu, busybox, can-utils and cpio from
-# Debian's packages when missing, downloads Debian's current stock kernel package (the one
-# linux-image-amd64 depends on; never a fixed version) and extracts the kernel image and the four
-# CAN modules (can, can-raw, can-dev, vcan) into the cache. A complete cache is reused as it is.
+# Prepares the SocketCAN test VM (docs/can-vm.md): installs qemu, busybox, can-utils, cpio,
+# python3-can and python3-canmatrix from Debian's packages when missing, downloads Debian's
+# current stock kernel package (the one linux-image-amd64 depends on; never a fixed version) and
+# extracts the kernel image and the four CAN modules (can, can-raw, can-dev, vcan) into the
+# cache. A complete cache is reused as it is.
 #
 #   tools/can-vm/prepare.sh [--refresh]
 #
@@ -20,7 +21,7 @@ refresh=0
 for arg in "$@"; do
   case "$arg" in
     --refresh) refresh=1 ;;
-    -h | --help) sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h | --help) sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) die "unknown argument '$arg' (see --help)" ;;
   esac
 done
@@ -43,8 +44,10 @@ apt_update() {
 }
 
 # 1. Host tools: qemu (TCG emulation, no KVM needed), a static busybox for the guest, can-utils
-#    (candump, cansend, cangen) as the independent peer on the bus, cpio for the initramfs.
-packages=(qemu-system-x86 busybox-static can-utils cpio)
+#    (candump, cansend, cangen) as the independent peer on the bus, cpio for the initramfs;
+#    python-can and canmatrix for the Python peer that run.sh --python copies into the guest with
+#    Debian's python3 (tests/can_vm/valve_peer.py).
+packages=(qemu-system-x86 busybox-static can-utils cpio python3-can python3-canmatrix)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -2,7 +2,8 @@
 # Runs a guest script inside Debian's stock kernel under qemu, with vcan0 and vcan1 up: the
 # project's real SocketCAN tests (docs/can-vm.md). Run tools/can-vm/prepare.sh once first.
 #
-#   tools/can-vm/run.sh [--timeout S] [--memory MB] [--keep DIR] [--] GUEST_SCRIPT [FILE...]
+#   tools/can-vm/run.sh [--timeout S] [--memory MB] [--keep DIR] [--python] [--]
+#                       GUEST_SCRIPT [FILE...]
 #
 # The FILEs (test binaries, data) are copied to /tests in the guest, each executable with the
 # shared libraries ldd finds for it; GUEST_SCRIPT runs there as `sh GUEST_SCRIPT` (busybox sh)
@@ -14,8 +15,11 @@
 # missing (CTest reports the test skipped), or 2 then if CRANEASSIST_CAN_VM_REQUIRED=1 (CI).
 #
 #   --timeout S   give up after S seconds of wall time (default 240)
-#   --memory MB   guest memory (default 256)
+#   --memory MB   guest memory (default 256; 512 with --python, whose files take about 40 MB of
+#                 the initramfs, unpacked in guest memory next to it)
 #   --keep DIR    keep the initramfs tree and the console log in DIR (for debugging)
+#   --python      put Debian's /usr/bin/python3 in the guest with python-can and canmatrix
+#                 (python3-can, python3-canmatrix); implied when a FILE ends in .py
 set -euo pipefail
 
 say() { echo "can-vm: $*" >&2; }
@@ -24,14 +28,16 @@ usage_error() { say "error: $*"; exit 2; }
 root="$(cd "$(dirname "$0")/../.." && pwd)"
 cache="${CRANEASSIST_CAN_VM_CACHE:-$root/build/can-vm-cache}"
 timeout_s=240
-memory=256
+memory=""
 keep=""
+python=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --timeout) timeout_s="${2:?--timeout needs seconds}"; shift 2 ;;
     --memory) memory="${2:?--memory needs MB}"; shift 2 ;;
     --keep) keep="${2:?--keep needs a folder}"; shift 2 ;;
-    -h | --help) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --python) python=1; shift ;;
+    -h | --help) sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     --) shift; break ;;
     -*) usage_error "unknown option '$1' (see --help)" ;;
     *) break ;;
@@ -41,11 +47,15 @@ done
 guest_script="$1"
 shift
 [ -f "$guest_script" ] || usage_error "guest script '$guest_script' not found"
-for f in "$@"; do [ -f "$f" ] || usage_error "file '$f' not found"; done
+for f in "$@"; do
+  [ -f "$f" ] || usage_error "file '$f' not found"
+  case "$f" in *.py) python=1 ;; esac
+done
+if [ -z "$memory" ]; then memory=$((python ? 512 : 256)); fi
 
 # Prerequisites: without them the test cannot run here; it is skipped with the fix (exit 77), or
 # fails where it is required (CRANEASSIST_CAN_VM_REQUIRED=1: CI, tools/test.sh).
-prepare_hint="run tools/can-vm/prepare.sh (installs qemu, busybox-static, can-utils, cpio and caches Debian's stock kernel)"
+prepare_hint="run tools/can-vm/prepare.sh (installs qemu, busybox-static, can-utils, cpio, python3-can, python3-canmatrix and caches Debian's stock kernel)"
 cannot_run() {
   if [ "${CRANEASSIST_CAN_VM_REQUIRED:-0}" = 1 ]; then usage_error "$*"; fi
   say "skipped: $*"
@@ -62,6 +72,16 @@ is_static() {
 }
 busybox=/bin/busybox
 is_static "$busybox" || missing+=("a static busybox (package busybox-static)")
+# Python in the guest: Debian's own interpreter and packages (never a pyenv or venv one earlier in
+# the PATH), python-can and canmatrix importable.
+host_python=/usr/bin/python3
+if [ "$python" = 1 ]; then
+  if [ ! -x "$host_python" ]; then
+    missing+=("$host_python (package python3)")
+  elif ! "$host_python" -c 'import can.interfaces.socketcan, canmatrix.formats' >/dev/null 2>&1; then
+    missing+=("python-can or canmatrix for $host_python (packages python3-can, python3-canmatrix)")
+  fi
+fi
 [ ${#missing[@]} -eq 0 ] || cannot_run "missing ${missing[*]}: $prepare_hint"
 release="$(cat "$cache/current" 2>/dev/null || true)"
 kdir="$cache/$release"
@@ -102,6 +122,43 @@ copy_libraries() {  # copy_libraries BINARY: its shared libraries (and the loade
 for b in "$rootfs"/usr/bin/* "$rootfs"/tests/*; do
   if [ -x "$b" ]; then copy_libraries "$b"; fi  # ldd lists nothing for scripts, static binaries
 done
+# Python (--python): the interpreter, its standard library without what a test never imports
+# (the test suite, IDLE, tkinter, the static libpython of config-*, installers, optimised .pyc),
+# the C extension modules with their libraries, and from Debian's dist-packages only python-can,
+# canmatrix and what their imports need (found by importing can, can.interfaces.socketcan,
+# can.io and canmatrix.formats with nothing else on the path). The .pyc files come along with
+# their sources' times (tar keeps them), so the guest does not compile at every start.
+if [ "$python" = 1 ]; then
+  py_bin="$(readlink -f "$host_python")"             # /usr/bin/python3.11
+  py_ver="$("$host_python" -c 'import sys; print("%d.%d" % sys.version_info[:2])')"
+  py_lib="/usr/lib/python$py_ver"
+  py_packages=(can canmatrix attr future past six.py typing_extensions.py pkg_resources)
+  mkdir -p "$rootfs/usr/lib/python3/dist-packages"
+  cp "$py_bin" "$rootfs$py_bin"
+  ln -sf "$(basename "$py_bin")" "$rootfs/usr/bin/python3"
+  copy_libraries "$py_bin"
+  tar -C /usr/lib -cf - --exclude-vcs --exclude='*.opt-[12].pyc' \
+    --exclude="python$py_ver/"{test,idlelib,tkinter,turtledemo,ensurepip,lib2to3,pydoc_data,distutils,venv,curses,dbm} \
+    --exclude="python$py_ver/"{config-*,dist-packages,site-packages,sitecustomize.py,turtle.py} \
+    --exclude="python$py_ver/"{unittest,wsgiref,xmlrpc} \
+    --exclude="python$py_ver/lib-dynload/"{_test*,_ctypes_test*,_xxtest*,xxlimited*,_tkinter*,_curses*,_dbm*,nis*,ossaudiodev*,readline*} \
+    --exclude="python$py_ver/lib-dynload/"{_ssl*,_hashlib*,_crypt*,_codecs_*,_multibytecodec*,audioop*,_lsprof*,_xxsub*} \
+    "python$py_ver" | tar -C "$rootfs/usr/lib" -xf -
+  for so in "$rootfs$py_lib"/lib-dynload/*.so; do copy_libraries "${so#"$rootfs"}"; done
+  dist=/usr/lib/python3/dist-packages
+  present=()
+  for p in "${py_packages[@]}"; do [ -e "$dist/$p" ] && present+=("$p"); done
+  tar -C "$dist" -cf - --exclude='*.opt-[12].pyc' --exclude='tests' "${present[@]}" |
+    tar -C "$rootfs$dist" -xf -
+  # What the guest has must be enough: import it here with nothing else on the path, so that a
+  # package a newer python-can or canmatrix needs fails now, by name, not in the guest.
+  if ! why="$("$host_python" -I -S -c "import sys, warnings
+warnings.simplefilter('ignore')
+sys.path[:] = ['$rootfs$py_lib', '$rootfs$py_lib/lib-dynload', '$rootfs$dist']
+import can, can.interfaces.socketcan, can.io, canmatrix.formats" 2>&1)"; then
+    usage_error "python-can or canmatrix do not import from what run.sh copies for the guest (py_packages in $0): ${why##*$'\n'}"
+  fi
+fi
 # /lib64/ld-linux-x86-64.so.2 is a symlink into /lib on Debian (cp -L copied the file itself).
 
 cat >"$rootfs/init" <<INIT
@@ -180,5 +237,8 @@ elif [ $((rc % 2)) -eq 1 ] && [ "$rc" -gt 1 ]; then
   exit 1
 else
   say "FAIL: the guest never reported a result (qemu exit $rc: kernel panic or crash?) (qemu ran $elapsed s)"
+  if grep -q "Initramfs unpacking failed" "$log" 2>/dev/null; then
+    say "the initramfs ($(du -h "$work/initramfs.cpio" | cut -f1)) did not fit in the guest's $memory MB: raise --memory"
+  fi
   exit 3
 fi

@@ -39,7 +39,7 @@ struct SignalSpec {
   double offset = 0.0;
   std::optional<double> minimum;
   std::optional<double> maximum;
-  std::string unit;  // as written in the source file; scale/offset are already SI
+  std::string unit;      // as written in the source file; scale/offset are already SI
   double unit_si = 1.0;  // the SI value of one `unit` (1 deg = 0.01745 rad), to write it back
 };
 
