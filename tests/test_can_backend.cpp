@@ -8,7 +8,9 @@
 #include <string>
 #include <thread>
 
+#include "craneassist/can/address_claim.hpp"
 #include "craneassist/can/can_backend.hpp"
+#include "craneassist/can/dm1.hpp"
 #include "craneassist/can/heartbeat.hpp"
 #include "craneassist/can/valve_frames.hpp"
 #include "craneassist/config/crane_config.hpp"
@@ -28,8 +30,20 @@ std::string hex(const CanFrame& f) {
   return std::string(buf, n).substr(std::string("(0.000000) x ").size());
 }
 
-CanMapping k70m_mapping() {
+// The K70M mapping as shipped: with its address claim, valve replies and DM1 supervision.
+CanMapping k70m_full_mapping() {
   return load_can_mapping(std::string(CRANEASSIST_SOURCE_DIR) + "/config/can/k70m_can.yaml");
+}
+
+// Without the address claim and the supervision: the cases that test the rest of the backend
+// (frames, feedback, watchdog, heartbeat) need no 250 ms claim and no valve playing along. The
+// claim and the supervision have their own cases below.
+CanMapping k70m_mapping() {
+  CanMapping m = k70m_full_mapping();
+  m.address_claim.reset();
+  m.dm1.reset();
+  for (auto& j : m.joints) j.reply.reset();
+  return m;
 }
 
 // Plays the machine's sensors: the position (and pressure) frames of every joint.
@@ -560,6 +574,233 @@ TEST(CanBackend, CandumpLogHoldsSentAndReceivedFrames) {
     ++lines;
   }
   EXPECT_EQ(lines, 9);  // 4 positions received, 4 commands and the heartbeat sent
+}
+
+// ---- J1939 address claim (docs/can.md, "Address claim") ----
+
+constexpr std::uint64_t kK70mName = 0x3000820000000C1Aull;  // config/can/k70m_can.yaml
+
+// The K70M mapping with its address claim, without the valve supervision.
+CanMapping claiming_mapping() {
+  CanMapping m = k70m_full_mapping();
+  m.dm1.reset();
+  for (auto& j : m.joints) j.reply.reset();
+  return m;
+}
+
+bool from_address(const CanFrame& f, std::uint8_t address) {
+  return f.extended && (f.id & 0xFFu) == address;
+}
+
+bool is_claim(const CanFrame& f, std::uint8_t source, std::uint64_t name) {
+  std::uint64_t n = 0;
+  std::uint8_t sa = 0;
+  return j1939::decode_address_claimed(f, n, sa) && sa == source && n == name;
+}
+
+// A claim or request from another node, waiting in the backend's receive queue.
+void deliver(FakeCanTransport& to, const CanFrame& f) {
+  Received r;
+  r.kind = ReceiveKind::kFrame;
+  r.frame = f;
+  r.timestamp_us = realtime_now_us();
+  to.deliver(r);
+}
+
+// The frames the backend sent (the bus log holds the sensors' frames too).
+std::vector<Received> sent_by_backend(FakeCanBus& bus, const CanMapping& map) {
+  std::vector<Received> out;
+  for (const auto& rx : bus.log()) {
+    bool feedback = false;
+    for (const auto& j : map.joints) {
+      feedback = feedback || (rx.frame.id == j.position.id && rx.frame.extended);
+    }
+    if (!feedback) out.push_back(rx);
+  }
+  return out;
+}
+
+TEST(CanBackendAddressClaim, ClaimsBeforeAnyCommandThenWaitsTheClaimTime) {
+  Rig r;
+  r.map = claiming_mapping();
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  valves::MachineState state;
+  r.feedback();
+  backend.read(state);
+  backend.write(spool_command(0.5));   // not claimed yet: nothing at all goes out
+  std::this_thread::sleep_for(100ms);  // nor from the watchdog
+  EXPECT_TRUE(sent_by_backend(r.bus, r.map).empty());
+  EXPECT_EQ(backend.address_claim_state(), j1939::ClaimState::kIdle);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string why;
+  ASSERT_TRUE(backend.activate(2.0, &why)) << why;
+  const auto took = std::chrono::steady_clock::now() - t0;
+  EXPECT_GE(took, 250ms);  // J1939-81: 250 ms for a contending claim
+  EXPECT_LT(took, 400ms);
+  EXPECT_EQ(backend.address_claim_state(), j1939::ClaimState::kClaimed);
+  backend.write(spool_command(0.5));
+  const auto sent = sent_by_backend(r.bus, r.map);
+  ASSERT_GE(sent.size(), 6u);  // the claim, 4 commands, the heartbeat
+  EXPECT_TRUE(is_claim(sent[0].frame, 0x80, kK70mName));
+  EXPECT_EQ(sent[0].frame.id, 0x18EEFF80u);
+  for (std::size_t i = 1; i < sent.size(); ++i) {
+    EXPECT_FALSE(is_claim(sent[i].frame, 0x80, kK70mName)) << "claimed once";
+    EXPECT_GE(sent[i].timestamp_us - sent[0].timestamp_us, 250000) << "sent within the claim time";
+  }
+  r.feedback();
+  EXPECT_EQ(backend.read(state), valves::BackendStatus::kOk);
+  EXPECT_EQ(backend.counters().claim_frames_sent, 1u);
+}
+
+TEST(CanBackendAddressClaim, LosesToAHigherPriorityNameAndSendsNothingFromTheAddress) {
+  Rig r;
+  r.map = claiming_mapping();
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  r.feedback();
+  CanFrame rival;
+  j1939::encode_address_claimed(0x0000000000000001ull, 0x80, rival);  // numerically lower
+  deliver(r.backend_end, rival);                                      // the rival answers our claim
+  std::string why;
+  EXPECT_FALSE(backend.activate(2.0, &why));
+  EXPECT_EQ(why,
+            "cannot claim address 0x80: node with NAME 0x0000000000000001 has priority "
+            "(craneassist's NAME 0x3000820000000C1A)");
+  EXPECT_TRUE(backend.faulted());
+  EXPECT_EQ(backend.fault_reason(), FaultReason::kAddressLost);
+  EXPECT_EQ(backend.address_claim_state(), j1939::ClaimState::kLost);
+  valves::MachineState state;
+  // The control loop would go on calling write(); the watchdog and disable() run too.
+  for (int k = 0; k < 5; ++k) {
+    r.feedback();
+    EXPECT_EQ(backend.read(state), valves::BackendStatus::kFault);
+    EXPECT_FALSE(state.valid);
+    backend.write(spool_command(0.5));
+    std::this_thread::sleep_for(10ms);
+  }
+  std::this_thread::sleep_for(150ms);  // the watchdog: write() no longer called
+  backend.disable();
+  const auto sent = sent_by_backend(r.bus, r.map);
+  ASSERT_GE(sent.size(), 2u);
+  EXPECT_TRUE(is_claim(sent[0].frame, 0x80, kK70mName));
+  EXPECT_TRUE(is_claim(sent[1].frame, j1939::kNullAddress, kK70mName));  // Cannot Claim
+  int extension_blocks = 0;
+  for (std::size_t i = 2; i < sent.size(); ++i) {
+    EXPECT_FALSE(from_address(sent[i].frame, 0x80)) << hex(sent[i].frame);
+    // The extension's driver takes an 11-bit frame, not from the address: it is held blocked.
+    if (is_valve_frame(r.map.joints[3].valve, sent[i].frame)) {
+      EXPECT_TRUE(is_block(r.map.joints[3], sent[i].frame));
+      ++extension_blocks;
+    }
+  }
+  EXPECT_GT(extension_blocks, 0);
+
+  // A global request for address claimed is answered with Cannot Claim within 153 ms.
+  r.bus.clear_log();
+  CanFrame request;
+  j1939::encode_request(j1939::kPgnAddressClaimed, 0x21, j1939::kGlobalAddress, request);
+  r.sensors.send(request);
+  const auto t0 = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - t0 < 200ms) {
+    backend.read(state);
+    std::this_thread::sleep_for(2ms);
+  }
+  int cannot_claim = 0;
+  for (const auto& rx : sent_by_backend(r.bus, r.map)) {
+    cannot_claim += is_claim(rx.frame, j1939::kNullAddress, kK70mName);
+    EXPECT_FALSE(from_address(rx.frame, 0x80));
+  }
+  EXPECT_EQ(cannot_claim, 1);
+}
+
+TEST(CanBackendAddressClaim, WinsAgainstALowerPriorityNameAndReassertsItsClaim) {
+  Rig r;
+  r.map = claiming_mapping();
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  r.feedback();
+  CanFrame rival;
+  j1939::encode_address_claimed(0x5000000000000001ull, 0x80, rival);  // numerically higher
+  deliver(r.backend_end, rival);
+  std::string why;
+  ASSERT_TRUE(backend.activate(2.0, &why)) << why;
+  EXPECT_FALSE(backend.faulted());
+  const auto sent = sent_by_backend(r.bus, r.map);
+  ASSERT_GE(sent.size(), 2u);
+  EXPECT_TRUE(is_claim(sent[0].frame, 0x80, kK70mName));
+  EXPECT_TRUE(is_claim(sent[1].frame, 0x80, kK70mName));  // re-asserted against the rival
+  EXPECT_EQ(backend.counters().claim_frames_sent, 2u);
+  backend.write(spool_command(0.3));
+  bool commanded = false;
+  for (const auto& rx : sent_by_backend(r.bus, r.map)) {
+    commanded = commanded || (rx.frame.id == 0x0CFE3080u && !is_block(r.map.joints[0], rx.frame));
+  }
+  EXPECT_TRUE(commanded);
+}
+
+TEST(CanBackendAddressClaim, AnswersRequestsAndDefendsItsAddressDuringOperation) {
+  Rig r;
+  r.map = claiming_mapping();
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  r.feedback();
+  std::string why;
+  ASSERT_TRUE(backend.activate(2.0, &why)) << why;
+  valves::MachineState state;
+  auto claims_after = [&](const CanFrame& incoming) {
+    r.bus.clear_log();
+    r.sensors.send(incoming);
+    r.feedback();
+    backend.read(state);
+    int n = 0;
+    for (const auto& rx : sent_by_backend(r.bus, r.map)) n += is_claim(rx.frame, 0x80, kK70mName);
+    return n;
+  };
+  CanFrame f;
+  j1939::encode_request(j1939::kPgnAddressClaimed, 0x21, j1939::kGlobalAddress, f);
+  EXPECT_EQ(claims_after(f), 1);
+  j1939::encode_request(j1939::kPgnAddressClaimed, 0x21, 0x80, f);
+  EXPECT_EQ(claims_after(f), 1);
+  j1939::encode_request(j1939::kPgnAddressClaimed, 0x21, 0x81, f);  // another node's
+  EXPECT_EQ(claims_after(f), 0);
+  j1939::encode_address_claimed(0x7000000000000000ull, 0x80, f);  // lower priority: defended
+  EXPECT_EQ(claims_after(f), 1);
+  j1939::encode_address_claimed(0x0000000000000001ull, 0x81, f);  // another address
+  EXPECT_EQ(claims_after(f), 0);
+  EXPECT_FALSE(backend.faulted());
+  EXPECT_EQ(backend.counters().unknown_frames, 0u);  // network management is known
+
+  // A node with priority takes the address while the valves move: fault, Cannot Claim, and
+  // from then on nothing from 0x80 (commands, heartbeat, the watchdog's blocks).
+  backend.write(spool_command(0.4));
+  j1939::encode_address_claimed(0x0000000000000001ull, 0x80, f);
+  r.sensors.send(f);
+  r.bus.clear_log();  // from here on only what the backend sends
+  EXPECT_EQ(backend.read(state), valves::BackendStatus::kFault);
+  EXPECT_EQ(backend.fault_reason(), FaultReason::kAddressLost);
+  EXPECT_EQ(backend.fault_text(),
+            "address 0x80 lost: node with NAME 0x0000000000000001 claimed it with priority "
+            "(craneassist's NAME 0x3000820000000C1A); nothing more is sent from it");
+  for (int k = 0; k < 5; ++k) {
+    backend.write(spool_command(0.4));
+    std::this_thread::sleep_for(10ms);
+  }
+  std::this_thread::sleep_for(150ms);
+  const auto sent = sent_by_backend(r.bus, r.map);
+  ASSERT_FALSE(sent.empty());
+  EXPECT_TRUE(is_claim(sent[0].frame, j1939::kNullAddress, kK70mName));
+  for (const auto& rx : sent) EXPECT_FALSE(from_address(rx.frame, 0x80)) << hex(rx.frame);
+
+  // The deliberate re-enable claims again (and loses again against the same rival).
+  r.bus.clear_log();
+  backend.enable();
+  EXPECT_FALSE(backend.faulted());
+  EXPECT_EQ(backend.address_claim_state(), j1939::ClaimState::kClaiming);
+  backend.write(spool_command(0.4));  // still claiming: nothing but the claim
+  const auto reclaim = sent_by_backend(r.bus, r.map);
+  ASSERT_EQ(reclaim.size(), 1u);
+  EXPECT_TRUE(is_claim(reclaim[0].frame, 0x80, kK70mName));
+  r.sensors.send(f);
+  EXPECT_EQ(backend.read(state), valves::BackendStatus::kFault);
+  EXPECT_EQ(backend.fault_reason(), FaultReason::kAddressLost);
 }
 
 }  // namespace

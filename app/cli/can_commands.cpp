@@ -45,7 +45,7 @@ void CanMachine::report() const {
   std::printf(
       "  CAN %s: sent %llu, received %llu, unknown %llu, bad %llu, unsupported %llu, bus errors "
       "%llu, send queue full %llu, send errors %llu, watchdog block frames %llu, heartbeats %llu, "
-      "log dropped %llu\n",
+      "log dropped %llu, address claim frames %llu, valve replies %llu, DM1 %llu\n",
       "counters", static_cast<unsigned long long>(c.frames_sent),
       static_cast<unsigned long long>(c.frames_received),
       static_cast<unsigned long long>(c.unknown_frames),
@@ -56,7 +56,10 @@ void CanMachine::report() const {
       static_cast<unsigned long long>(c.send_errors),
       static_cast<unsigned long long>(c.watchdog_block_frames),
       static_cast<unsigned long long>(c.heartbeats_sent),
-      static_cast<unsigned long long>(c.log_dropped));
+      static_cast<unsigned long long>(c.log_dropped),
+      static_cast<unsigned long long>(c.claim_frames_sent),
+      static_cast<unsigned long long>(c.valve_replies),
+      static_cast<unsigned long long>(c.dm1_messages));
   if (backend_->faulted()) {
     std::printf("  CAN FAULT (%s) at %.3f s: %s\n", can::to_string(backend_->fault_reason()),
                 backend_->fault_time_s(), backend_->fault_text().c_str());

@@ -52,6 +52,7 @@ std::vector<CandumpRecord> read_capture(const char* path, std::vector<std::strin
 constexpr std::uint32_t kCommandIds[] = {0x0CFE3080, 0x0CFE3180, 0x0CFE3280, 0x210};
 constexpr std::uint32_t kSlewPosition = 0x18FF1021;
 constexpr std::uint32_t kHeartbeat = 0x18FF0080;
+constexpr std::uint32_t kAddressClaimed80 = 0x18EEFF80;  // J1939-81, PGN 0xEE00 from 0x80
 
 int section_of(const CanFrame& f) {
   for (int i = 0; i < 4; ++i) {
@@ -166,6 +167,8 @@ int traffic(const char* path) {
   bool ok = !recs.empty();
   std::vector<std::int64_t> times[4], position, heartbeat;
   int bad_payload = 0, unknown = 0, moving = 0, heartbeat_skips = 0, heartbeat_enabled = 0;
+  int claims = 0;
+  std::int64_t first_claim = -1, first_from_80 = -1;  // J1939-81: claim, then 250 ms, then send
   int last_counter = -1;
   std::int64_t last_enabled_heartbeat = -1;
   bool last_block[4] = {};
@@ -176,10 +179,18 @@ int traffic(const char* path) {
     const int s = section_of(r.frame);
     if (r.direction != CandumpDirection::kNone) {
       ++marked;
-      const bool sent = s >= 0 || (r.frame.extended && r.frame.id == kHeartbeat);
+      const bool sent = s >= 0 || (r.frame.extended &&
+                                   (r.frame.id == kHeartbeat || r.frame.id == kAddressClaimed80));
       wrong_direction += (r.direction == CandumpDirection::kTx) != sent;
     }
     if (s >= 0) last_block[s] = is_block(r.frame);
+    if (r.frame.extended && r.frame.id == kAddressClaimed80 && first_claim < 0) {
+      first_claim = r.timestamp;
+    }
+    if (r.frame.extended && (r.frame.id & 0xFFu) == 0x80 && r.frame.id != kAddressClaimed80 &&
+        first_from_80 < 0) {
+      first_from_80 = r.timestamp;
+    }
     if (r.frame.extended && r.frame.id == kHeartbeat) {
       heartbeat.push_back(r.timestamp);
       if (r.frame.dlc != 8 || r.frame.data[1] > 2) ++bad_payload;
@@ -203,6 +214,8 @@ int traffic(const char* path) {
       }
     } else if (r.frame.extended && r.frame.id == kSlewPosition) {
       position.push_back(r.timestamp);
+    } else if (r.frame.extended && r.frame.id == kAddressClaimed80) {
+      ++claims;
     } else if (!((r.frame.extended && (r.frame.id & 0xFFFFFFF0u) == 0x18FF1020u) ||
                  (!r.frame.extended &&
                   ((r.frame.id >= 0x301 && r.frame.id <= 0x304) || r.frame.id == 0x310)))) {
@@ -211,8 +224,8 @@ int traffic(const char* path) {
   }
   std::printf(
       "capture %s: %zu frames, %d command payloads wrong, %d unexpected identifiers, %d "
-      "AVC commands not block; %d marked T or R, %d of them the wrong way\n",
-      path, recs.size(), bad_payload, unknown, moving, marked, wrong_direction);
+      "AVC commands not block; %d marked T or R, %d of them the wrong way; %d address claims\n",
+      path, recs.size(), bad_payload, unknown, moving, marked, wrong_direction, claims);
   if (marked != 0 && marked != static_cast<int>(recs.size())) ok = false;  // all or none
   if (wrong_direction != 0) ok = false;
   const char* names[] = {"slew AVC 0CFE3080", "lift AVC 0CFE3180", "tilt AVC 0CFE3280",
@@ -228,6 +241,10 @@ int traffic(const char* path) {
   period_stats("heartbeat 18FF0080", heartbeat, 20.0, 0.1, ok);
   std::printf("heartbeat: %zu messages, %d in state enabled, %d counter skips\n", heartbeat.size(),
               heartbeat_enabled, heartbeat_skips);
+  const double claim_lead_ms = static_cast<double>(first_from_80 - first_claim) * 1e-3;
+  std::printf("address claim 18EEFF80: %d, the first other frame from 0x80 %.1f ms after it\n",
+              claims, claim_lead_ms);
+  if (claims < 1 || first_claim < 0 || claim_lead_ms < 250.0) ok = false;
   const bool ended_blocked = last_block[0] && last_block[1] && last_block[2] && last_block[3];
   std::printf("at the end of the capture every section is commanded to block: %s\n",
               ended_blocked ? "yes" : "NO");
