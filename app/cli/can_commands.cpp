@@ -98,7 +98,8 @@ CLI::App* add_emulate_command(CLI::App& cli, EmulateArgs& args) {
   auto* cmd = cli.add_subcommand(
       "emulate",
       "Run the simulated crane behind the CAN protocol: decode valve command frames, step the "
-      "simulator in real time, send joint position and pressure frames");
+      "simulator in real time, send joint position and pressure frames (and, when the mapping "
+      "asks, the valves' replies and DM1)");
   cmd->add_option("--can", args.iface, "CAN interface, e.g. vcan0 or can0")->required();
   add_config_option(*cmd, args.config_file);
   cmd->add_option("--mapping", args.mapping_file,
@@ -109,16 +110,29 @@ CLI::App* add_emulate_command(CLI::App& cli, EmulateArgs& args) {
       ->capture_default_str();
   cmd->add_option("--duration", args.duration_s, "Seconds to run (default: until killed)")
       ->check(FiniteRange(0.0, 1e6));
+  // Test hooks of the can_vm test (seconds since the emulator started).
+  cmd->add_option("--test-valve-fault-at", args.faults.valve_fault_at_s)
+      ->check(FiniteRange(0.0, 1e6))
+      ->group("");
+  cmd->add_option("--test-valve-fault-joint", args.faults.valve_fault_joint)->group("");
+  cmd->add_option("--test-reply-stop-at", args.faults.reply_stop_at_s)
+      ->check(FiniteRange(0.0, 1e6))
+      ->group("");
+  cmd->add_option("--test-dm1-fault-at", args.faults.dm1_fault_at_s)
+      ->check(FiniteRange(0.0, 1e6))
+      ->group("");
   return cmd;
 }
 
 int run_emulate_command(const EmulateArgs& args) {
   config::CraneConfig cfg;
   can::CanMapping mapping;
+  std::optional<EmulatedNodes> nodes;
   try {
     cfg = load_crane(args.config_file);
     mapping = load_mapping_or_default(args.mapping_file);
     can::check_mapping_fits(mapping, cfg.model);  // before the bus is opened
+    nodes.emplace(mapping, args.faults);
   } catch (const std::exception& e) {
     spdlog::error("config: {}", e.what());
     return kExitUsage;
@@ -163,7 +177,8 @@ int run_emulate_command(const EmulateArgs& args) {
     std::optional<can::HeartbeatMonitor> heartbeat;
     if (mapping.heartbeat) heartbeat.emplace(*mapping.heartbeat);
     bool heartbeat_ok = false;
-    unsigned long long commands = 0, bad = 0, other = 0, sent = 0, send_failed = 0, behind = 0;
+    unsigned long long commands = 0, bad = 0, other = 0, sent = 0, send_failed = 0, behind = 0,
+                       network = 0;
     const double step = cfg.simulation.step_s;
     const auto step_ns = static_cast<std::int64_t>(std::llround(step * 1e9));
     const auto feedback_ns = static_cast<std::int64_t>(std::llround(args.feedback_period_s * 1e9));
@@ -186,6 +201,11 @@ int run_emulate_command(const EmulateArgs& args) {
           continue;
         }
         if (heartbeat && heartbeat->on_frame(rx.frame, static_cast<double>(now) * 1e-9)) continue;
+        // J1939 network management: requests answered for the emulated nodes, claims reported.
+        if (nodes->on_frame(rx.frame, static_cast<double>(now) * 1e-9, bus)) {
+          ++network;
+          continue;
+        }
         bool mine = false;
         for (int j = 0; j < n; ++j) {
           const auto& valve = mapping.joints[static_cast<std::size_t>(j)].valve;
@@ -213,11 +233,14 @@ int run_emulate_command(const EmulateArgs& args) {
         heartbeat_ok = alive;
       }
       for (int j = 0; j < n; ++j) {
-        if (!alive || now - last_command_ns[static_cast<std::size_t>(j)] > command_timeout_ns) {
+        if (!alive || now - last_command_ns[static_cast<std::size_t>(j)] > command_timeout_ns ||
+            nodes->failed(j, static_cast<double>(now) * 1e-9)) {
           command.spool[j] = 0.0;
         }
       }
       sim.write(command);
+      // The valves' replies (what they applied) and the nodes' DM1, when the mapping asks.
+      nodes->tick(static_cast<double>(now) * 1e-9, command.spool, bus);
       int steps = 0;
       while (sim_ns + step_ns <= now && steps < 100) {
         sim.advance(step);
@@ -262,6 +285,13 @@ int run_emulate_command(const EmulateArgs& args) {
         "frames; %llu feedback frames sent, %llu failed; fell behind %llu times\n",
         static_cast<double>(mono_ns() - start) * 1e-9, commands, bad, other, sent, send_failed,
         behind);
+    if (nodes->active() || network > 0) {
+      std::printf(
+          "craneassist emulate: J1939 nodes: %llu replies, DM1 and claims sent, %llu failed; %llu "
+          "network management frames received\n",
+          static_cast<unsigned long long>(nodes->frames_sent()),
+          static_cast<unsigned long long>(nodes->send_failures()), network);
+    }
     if (heartbeat) {
       std::printf(
           "craneassist emulate: heartbeat: %llu messages, %llu sequence errors, %llu malformed, "

@@ -10,6 +10,7 @@
 #include "craneassist/can/mapping_config.hpp"
 #include "craneassist/can/socketcan.hpp"
 #include "craneassist/dynamics/model.hpp"
+#include "emulated_nodes.hpp"
 
 namespace craneassist::cli {
 
@@ -39,6 +40,7 @@ struct EmulateArgs {
   double feedback_period_s = 0.01;
   double duration_s = 0.0;  // 0: until killed
   double command_timeout_s = 0.2;
+  EmulatedFaults faults;  // hidden --test-... options
 };
 
 CLI::App* add_emulate_command(CLI::App& cli, EmulateArgs& args);
