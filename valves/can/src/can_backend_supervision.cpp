@@ -186,7 +186,7 @@ bool CanBackend::on_supervised_frame(const CanFrame& f, std::int64_t now) {
         m.counters.dm1_messages.fetch_add(1, std::memory_order_relaxed);
         node.multi_packet_bytes = size;
         node.stop = size > 8;
-      } else if (p == 0xEB00) {
+      } else if (p == j1939::kPgnTpDt) {
         handled = true;  // TP.DT packets of the node's transfers: not reassembled
       }
     }

@@ -28,6 +28,7 @@ namespace craneassist::can::j1939 {
 
 inline constexpr std::uint32_t kPgnDm1 = 0xFECA;   // 65226
 inline constexpr std::uint32_t kPgnTpCm = 0xEC00;  // 60416, transport protocol connection mgmt
+inline constexpr std::uint32_t kPgnTpDt = 0xEB00;  // 60160, transport protocol data transfer
 inline constexpr std::uint32_t kNoSpn = 0;
 inline constexpr std::uint32_t kSpnNotAvailable = 0x7FFFF;  // all 19 bits set
 
