@@ -638,7 +638,7 @@ TEST(CanBackendAddressClaim, ClaimsBeforeAnyCommandThenWaitsTheClaimTime) {
   ASSERT_TRUE(backend.activate(2.0, &why)) << why;
   const auto took = std::chrono::steady_clock::now() - t0;
   EXPECT_GE(took, 250ms);  // J1939-81: 250 ms for a contending claim
-  EXPECT_LT(took, 400ms);
+  EXPECT_LT(took, 500ms);  // 250 ms and the reads around it, on a loaded host
   EXPECT_EQ(backend.address_claim_state(), j1939::ClaimState::kClaimed);
   backend.write(spool_command(0.5));
   const auto sent = sent_by_backend(r.bus, r.map);
@@ -967,7 +967,7 @@ TEST(CanBackendSupervision, AValveInItsFailSafeWhileCommandedStopsAfterTheTimeou
       << r.backend.fault_text();
   EXPECT_NE(r.backend.fault_text().find(" ms while commanded extend"), std::string::npos);
   EXPECT_GE(took, 300ms);
-  EXPECT_LT(took, 400ms);
+  EXPECT_LT(took, 450ms);  // the timeout, a reply period and a loaded host
   r.expect_every_section_blocked_now();
   // Float is never commanded: a valve reporting float is in its fail-safe even while blocked.
   SupervisedRig f;
@@ -992,7 +992,7 @@ TEST(CanBackendSupervision, ARepliesThatStopOrNeverComeStopAfterTheTimeout) {
     EXPECT_NE(r.backend.fault_text().find("joint slew: no valve reply for 3"), std::string::npos)
         << r.backend.fault_text();
     EXPECT_GE(took, 290ms);  // 300 ms after the last reply, which came up to a cycle earlier
-    EXPECT_LT(took, 400ms);
+    EXPECT_LT(took, 450ms);
     std::printf("valve replies stop: fault latched %lld ms after they stopped\n",
                 static_cast<long long>(took.count()));
     r.expect_every_section_blocked_now();
