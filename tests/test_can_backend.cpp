@@ -968,6 +968,8 @@ TEST(CanBackendSupervision, AValveInItsFailSafeWhileCommandedStopsAfterTheTimeou
   EXPECT_NE(r.backend.fault_text().find(" ms while commanded extend"), std::string::npos);
   EXPECT_GE(took, 300ms);
   EXPECT_LT(took, 450ms);  // the timeout, a reply period and a loaded host
+  std::printf("valve in block while commanded extend: fault latched after %lld ms\n",
+              static_cast<long long>(took.count()));
   r.expect_every_section_blocked_now();
   // Float is never commanded: a valve reporting float is in its fail-safe even while blocked.
   SupervisedRig f;
