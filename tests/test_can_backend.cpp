@@ -8,7 +8,10 @@
 #include <string>
 #include <thread>
 
+#include "allocation_counter.hpp"
+#include "craneassist/can/address_claim.hpp"
 #include "craneassist/can/can_backend.hpp"
+#include "craneassist/can/dm1.hpp"
 #include "craneassist/can/heartbeat.hpp"
 #include "craneassist/can/valve_frames.hpp"
 #include "craneassist/config/crane_config.hpp"
@@ -28,8 +31,20 @@ std::string hex(const CanFrame& f) {
   return std::string(buf, n).substr(std::string("(0.000000) x ").size());
 }
 
-CanMapping k70m_mapping() {
+// The K70M mapping as shipped: with its address claim, valve replies and DM1 supervision.
+CanMapping k70m_full_mapping() {
   return load_can_mapping(std::string(CRANEASSIST_SOURCE_DIR) + "/config/can/k70m_can.yaml");
+}
+
+// Without the address claim and the supervision: the cases that test the rest of the backend
+// (frames, feedback, watchdog, heartbeat) need no 250 ms claim and no valve playing along. The
+// claim and the supervision have their own cases below.
+CanMapping k70m_mapping() {
+  CanMapping m = k70m_full_mapping();
+  m.address_claim.reset();
+  m.dm1.reset();
+  for (auto& j : m.joints) j.reply.reset();
+  return m;
 }
 
 // Plays the machine's sensors: the position (and pressure) frames of every joint.
@@ -560,6 +575,627 @@ TEST(CanBackend, CandumpLogHoldsSentAndReceivedFrames) {
     ++lines;
   }
   EXPECT_EQ(lines, 9);  // 4 positions received, 4 commands and the heartbeat sent
+}
+
+// ---- J1939 address claim (docs/can.md, "Address claim") ----
+
+constexpr std::uint64_t kK70mName = 0x3000820000000C1Aull;  // config/can/k70m_can.yaml
+
+// The K70M mapping with its address claim, without the valve supervision.
+CanMapping claiming_mapping() {
+  CanMapping m = k70m_full_mapping();
+  m.dm1.reset();
+  for (auto& j : m.joints) j.reply.reset();
+  return m;
+}
+
+bool from_address(const CanFrame& f, std::uint8_t address) {
+  return f.extended && (f.id & 0xFFu) == address;
+}
+
+bool is_claim(const CanFrame& f, std::uint8_t source, std::uint64_t name) {
+  std::uint64_t n = 0;
+  std::uint8_t sa = 0;
+  return j1939::decode_address_claimed(f, n, sa) && sa == source && n == name;
+}
+
+// A claim or request from another node, waiting in the backend's receive queue.
+void deliver(FakeCanTransport& to, const CanFrame& f) {
+  Received r;
+  r.kind = ReceiveKind::kFrame;
+  r.frame = f;
+  r.timestamp_us = realtime_now_us();
+  to.deliver(r);
+}
+
+// The frames the backend sent (the bus log holds the sensors' frames too).
+std::vector<Received> sent_by_backend(FakeCanBus& bus, const CanMapping& map) {
+  std::vector<Received> out;
+  for (const auto& rx : bus.log()) {
+    bool feedback = false;
+    for (const auto& j : map.joints) {
+      feedback = feedback || (rx.frame.id == j.position.id && rx.frame.extended);
+    }
+    if (!feedback) out.push_back(rx);
+  }
+  return out;
+}
+
+TEST(CanBackendAddressClaim, ClaimsBeforeAnyCommandThenWaitsTheClaimTime) {
+  Rig r;
+  r.map = claiming_mapping();
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  valves::MachineState state;
+  r.feedback();
+  backend.read(state);
+  backend.write(spool_command(0.5));   // not claimed yet: nothing at all goes out
+  std::this_thread::sleep_for(100ms);  // nor from the watchdog
+  EXPECT_TRUE(sent_by_backend(r.bus, r.map).empty());
+  EXPECT_EQ(backend.address_claim_state(), j1939::ClaimState::kIdle);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string why;
+  ASSERT_TRUE(backend.activate(2.0, &why)) << why;
+  const auto took = std::chrono::steady_clock::now() - t0;
+  EXPECT_GE(took, 250ms);  // J1939-81: 250 ms for a contending claim
+  EXPECT_LT(took, 500ms);  // 250 ms and the reads around it, on a loaded host
+  EXPECT_EQ(backend.address_claim_state(), j1939::ClaimState::kClaimed);
+  backend.write(spool_command(0.5));
+  const auto sent = sent_by_backend(r.bus, r.map);
+  ASSERT_GE(sent.size(), 6u);  // the claim, 4 commands, the heartbeat
+  EXPECT_TRUE(is_claim(sent[0].frame, 0x80, kK70mName));
+  EXPECT_EQ(sent[0].frame.id, 0x18EEFF80u);
+  for (std::size_t i = 1; i < sent.size(); ++i) {
+    EXPECT_FALSE(is_claim(sent[i].frame, 0x80, kK70mName)) << "claimed once";
+    EXPECT_GE(sent[i].timestamp_us - sent[0].timestamp_us, 250000) << "sent within the claim time";
+  }
+  r.feedback();
+  EXPECT_EQ(backend.read(state), valves::BackendStatus::kOk);
+  EXPECT_EQ(backend.counters().claim_frames_sent, 1u);
+}
+
+TEST(CanBackendAddressClaim, LosesToAHigherPriorityNameAndSendsNothingFromTheAddress) {
+  Rig r;
+  r.map = claiming_mapping();
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  r.feedback();
+  CanFrame rival;
+  j1939::encode_address_claimed(0x0000000000000001ull, 0x80, rival);  // numerically lower
+  deliver(r.backend_end, rival);                                      // the rival answers our claim
+  std::string why;
+  EXPECT_FALSE(backend.activate(2.0, &why));
+  EXPECT_EQ(why,
+            "cannot claim address 0x80: node with NAME 0x0000000000000001 has priority "
+            "(craneassist's NAME 0x3000820000000C1A)");
+  EXPECT_TRUE(backend.faulted());
+  EXPECT_EQ(backend.fault_reason(), FaultReason::kAddressLost);
+  EXPECT_EQ(backend.address_claim_state(), j1939::ClaimState::kLost);
+  valves::MachineState state;
+  // The control loop would go on calling write(); the watchdog and disable() run too.
+  for (int k = 0; k < 5; ++k) {
+    r.feedback();
+    EXPECT_EQ(backend.read(state), valves::BackendStatus::kFault);
+    EXPECT_FALSE(state.valid);
+    backend.write(spool_command(0.5));
+    std::this_thread::sleep_for(10ms);
+  }
+  std::this_thread::sleep_for(150ms);  // the watchdog: write() no longer called
+  backend.disable();
+  const auto sent = sent_by_backend(r.bus, r.map);
+  ASSERT_GE(sent.size(), 2u);
+  EXPECT_TRUE(is_claim(sent[0].frame, 0x80, kK70mName));
+  EXPECT_TRUE(is_claim(sent[1].frame, j1939::kNullAddress, kK70mName));  // Cannot Claim
+  int extension_blocks = 0;
+  for (std::size_t i = 2; i < sent.size(); ++i) {
+    EXPECT_FALSE(from_address(sent[i].frame, 0x80)) << hex(sent[i].frame);
+    // The extension's driver takes an 11-bit frame, not from the address: it is held blocked.
+    if (is_valve_frame(r.map.joints[3].valve, sent[i].frame)) {
+      EXPECT_TRUE(is_block(r.map.joints[3], sent[i].frame));
+      ++extension_blocks;
+    }
+  }
+  EXPECT_GT(extension_blocks, 0);
+
+  // A global request for address claimed is answered with Cannot Claim within 153 ms.
+  r.bus.clear_log();
+  CanFrame request;
+  j1939::encode_request(j1939::kPgnAddressClaimed, 0x21, j1939::kGlobalAddress, request);
+  r.sensors.send(request);
+  const auto t0 = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - t0 < 200ms) {
+    backend.read(state);
+    std::this_thread::sleep_for(2ms);
+  }
+  int cannot_claim = 0;
+  for (const auto& rx : sent_by_backend(r.bus, r.map)) {
+    cannot_claim += is_claim(rx.frame, j1939::kNullAddress, kK70mName);
+    EXPECT_FALSE(from_address(rx.frame, 0x80));
+  }
+  EXPECT_EQ(cannot_claim, 1);
+}
+
+TEST(CanBackendAddressClaim, WinsAgainstALowerPriorityNameAndReassertsItsClaim) {
+  Rig r;
+  r.map = claiming_mapping();
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  r.feedback();
+  CanFrame rival;
+  j1939::encode_address_claimed(0x5000000000000001ull, 0x80, rival);  // numerically higher
+  deliver(r.backend_end, rival);
+  std::string why;
+  ASSERT_TRUE(backend.activate(2.0, &why)) << why;
+  EXPECT_FALSE(backend.faulted());
+  const auto sent = sent_by_backend(r.bus, r.map);
+  ASSERT_GE(sent.size(), 2u);
+  EXPECT_TRUE(is_claim(sent[0].frame, 0x80, kK70mName));
+  EXPECT_TRUE(is_claim(sent[1].frame, 0x80, kK70mName));  // re-asserted against the rival
+  EXPECT_EQ(backend.counters().claim_frames_sent, 2u);
+  backend.write(spool_command(0.3));
+  bool commanded = false;
+  for (const auto& rx : sent_by_backend(r.bus, r.map)) {
+    commanded = commanded || (rx.frame.id == 0x0CFE3080u && !is_block(r.map.joints[0], rx.frame));
+  }
+  EXPECT_TRUE(commanded);
+}
+
+TEST(CanBackendAddressClaim, AnswersRequestsAndDefendsItsAddressDuringOperation) {
+  Rig r;
+  r.map = claiming_mapping();
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  r.feedback();
+  std::string why;
+  ASSERT_TRUE(backend.activate(2.0, &why)) << why;
+  valves::MachineState state;
+  auto claims_after = [&](const CanFrame& incoming) {
+    r.bus.clear_log();
+    r.sensors.send(incoming);
+    r.feedback();
+    backend.read(state);
+    int n = 0;
+    for (const auto& rx : sent_by_backend(r.bus, r.map)) n += is_claim(rx.frame, 0x80, kK70mName);
+    return n;
+  };
+  CanFrame f;
+  j1939::encode_request(j1939::kPgnAddressClaimed, 0x21, j1939::kGlobalAddress, f);
+  EXPECT_EQ(claims_after(f), 1);
+  j1939::encode_request(j1939::kPgnAddressClaimed, 0x21, 0x80, f);
+  EXPECT_EQ(claims_after(f), 1);
+  j1939::encode_request(j1939::kPgnAddressClaimed, 0x21, 0x81, f);  // another node's
+  EXPECT_EQ(claims_after(f), 0);
+  j1939::encode_address_claimed(0x7000000000000000ull, 0x80, f);  // lower priority: defended
+  EXPECT_EQ(claims_after(f), 1);
+  j1939::encode_address_claimed(0x0000000000000001ull, 0x81, f);  // another address
+  EXPECT_EQ(claims_after(f), 0);
+  EXPECT_FALSE(backend.faulted());
+  EXPECT_EQ(backend.counters().unknown_frames, 0u);  // network management is known
+
+  // A node with priority takes the address while the valves move: fault, Cannot Claim, and
+  // from then on nothing from 0x80 (commands, heartbeat, the watchdog's blocks).
+  backend.write(spool_command(0.4));
+  j1939::encode_address_claimed(0x0000000000000001ull, 0x80, f);
+  r.sensors.send(f);
+  r.bus.clear_log();  // from here on only what the backend sends
+  EXPECT_EQ(backend.read(state), valves::BackendStatus::kFault);
+  EXPECT_EQ(backend.fault_reason(), FaultReason::kAddressLost);
+  EXPECT_EQ(backend.fault_text(),
+            "address 0x80 lost: node with NAME 0x0000000000000001 claimed it with priority "
+            "(craneassist's NAME 0x3000820000000C1A); nothing more is sent from it");
+  for (int k = 0; k < 5; ++k) {
+    backend.write(spool_command(0.4));
+    std::this_thread::sleep_for(10ms);
+  }
+  std::this_thread::sleep_for(150ms);
+  const auto sent = sent_by_backend(r.bus, r.map);
+  ASSERT_FALSE(sent.empty());
+  EXPECT_TRUE(is_claim(sent[0].frame, j1939::kNullAddress, kK70mName));
+  for (const auto& rx : sent) EXPECT_FALSE(from_address(rx.frame, 0x80)) << hex(rx.frame);
+
+  // The deliberate re-enable claims again (and loses again against the same rival).
+  r.bus.clear_log();
+  backend.enable();
+  EXPECT_FALSE(backend.faulted());
+  EXPECT_EQ(backend.address_claim_state(), j1939::ClaimState::kClaiming);
+  backend.write(spool_command(0.4));  // still claiming: nothing but the claim
+  const auto reclaim = sent_by_backend(r.bus, r.map);
+  ASSERT_EQ(reclaim.size(), 1u);
+  EXPECT_TRUE(is_claim(reclaim[0].frame, 0x80, kK70mName));
+  r.sensors.send(f);
+  EXPECT_EQ(backend.read(state), valves::BackendStatus::kFault);
+  EXPECT_EQ(backend.fault_reason(), FaultReason::kAddressLost);
+}
+
+// ---- Valve supervision: the valves' replies and DM1 (docs/can.md, "Valve supervision") ----
+
+// The K70M mapping with its valve replies (valves 0..2 from 0x20, the extension driver's status
+// 0x211) and DM1 from 0x20, without the address claim.
+CanMapping supervised_mapping() {
+  CanMapping m = k70m_full_mapping();
+  m.address_claim.reset();
+  return m;
+}
+
+// What the valve group reports in one round.
+struct ValveReport {
+  iso11783::ValveState state = iso11783::ValveState::kBlock;  // of every AVC valve
+  iso11783::LimitStatus limit = iso11783::LimitStatus::kNotLimited;
+  std::uint8_t lift_only_limit = 0xFF;  // when set: the lift valve's limit status instead
+  std::uint8_t driver_status = 0;       // the extension driver's status byte (0 ok)
+  bool replies = true;                  // false: the valve group has fallen silent
+};
+
+struct SupervisedRig : Rig {
+  CanBackend backend;
+  valves::MachineState state;
+  SupervisedRig() : Rig(), backend((map = supervised_mapping(), map), cfg.model, backend_end) {
+    feedback();
+    backend.read(state);
+    backend.enable();
+  }
+  void replies(const ValveReport& report) {
+    if (!report.replies) return;
+    for (std::uint8_t v = 0; v < 3; ++v) {
+      iso11783::AuxValveEstimatedFlow ef;
+      ef.valve = v;
+      ef.state = report.state;
+      ef.fail_safe = iso11783::FailSafeMode::kBlock;
+      ef.limit = v == 1 && report.lift_only_limit != 0xFF
+                     ? static_cast<iso11783::LimitStatus>(report.lift_only_limit)
+                     : report.limit;
+      ef.extend_flow = ef.retract_flow = 0.0;
+      CanFrame f;
+      ASSERT_EQ(iso11783::encode(ef, 0x20, 3, f), iso11783::CodecStatus::kOk);
+      sensors.send(f);
+    }
+    CanFrame st;
+    st.id = 0x211;
+    st.dlc = 1;
+    st.data[0] = report.driver_status;
+    sensors.send(st);
+  }
+  void dm1(const j1939::Dm1& d, std::uint8_t source = 0x20) {
+    CanFrame f;
+    j1939::encode_dm1(d, source, f);
+    sensors.send(f);
+  }
+  // Control cycles at 100 Hz with fresh feedback and the given report, until the backend
+  // faults or max_cycles pass. Returns the time from the first cycle to the fault.
+  std::chrono::milliseconds run(const valves::ValveCommand& cmd, const ValveReport& report,
+                                int max_cycles) {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int k = 0; k < max_cycles && !backend.faulted(); ++k) {
+      feedback();
+      replies(report);
+      backend.read(state);
+      backend.write(cmd);
+      std::this_thread::sleep_until(t0 + (k + 1) * 10ms);
+    }
+    return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() -
+                                                                 t0);
+  }
+  // The write() in the cycle of the fault blocked every section at once (the run's last
+  // cycle): the latest command of each section on the bus is block, and stays so.
+  void expect_every_section_blocked_now() {
+    auto expect_last_block = [&] {
+      bool seen[4] = {}, blocked[4] = {};
+      for (const auto& rx : bus.log()) {
+        for (std::size_t j = 0; j < 4; ++j) {
+          if (!is_valve_frame(map.joints[j].valve, rx.frame)) continue;
+          seen[j] = true;
+          blocked[j] = is_block(map.joints[j], rx.frame);
+        }
+      }
+      for (std::size_t j = 0; j < 4; ++j) EXPECT_TRUE(seen[j] && blocked[j]) << j;
+    };
+    expect_last_block();
+    EXPECT_EQ(backend.read(state), valves::BackendStatus::kFault);
+    EXPECT_FALSE(state.valid);
+    std::this_thread::sleep_for(25ms);
+    backend.write(spool_command(0.5));
+    expect_last_block();
+  }
+};
+
+ValveReport following(double spool) {
+  ValveReport r;
+  r.state = spool > 0   ? iso11783::ValveState::kExtend
+            : spool < 0 ? iso11783::ValveState::kRetract
+                        : iso11783::ValveState::kBlock;
+  return r;
+}
+
+TEST(CanBackendSupervision, ValvesThatFollowAndAQuietDm1AreNormal) {
+  SupervisedRig r;
+  j1939::Dm1 quiet;  // lamps off, SPN 0: no active DTC
+  r.dm1(quiet);
+  r.run(spool_command(0.4), following(0.4), 50);  // 0.5 s, longer than the 300 ms timeouts
+  EXPECT_FALSE(r.backend.faulted()) << r.backend.fault_text();
+  // Commanded block, the valves report block: normal too (the valve echoes the command).
+  r.run(spool_command(0.0), following(0.0), 40);
+  // A small command inside a valve's dead band: a reported block is not held against it.
+  r.run(spool_command(0.02), following(0.0), 40);
+  EXPECT_FALSE(r.backend.faulted()) << r.backend.fault_text();
+  const auto c = r.backend.counters();
+  EXPECT_GT(c.valve_replies, 400u);
+  EXPECT_EQ(c.dm1_messages, 1u);
+  EXPECT_EQ(c.unknown_frames, 0u);
+}
+
+TEST(CanBackendSupervision, AValveReportingANonRecoverableFaultOrErrorStops) {
+  {
+    SupervisedRig r;
+    r.run(spool_command(0.4), following(0.4), 10);
+    ValveReport fault = following(0.4);
+    fault.lift_only_limit = 6;  // non-recoverable fault
+    r.run(spool_command(0.4), fault, 3);
+    ASSERT_TRUE(r.backend.faulted());
+    EXPECT_EQ(r.backend.fault_reason(), FaultReason::kValveFault);
+    EXPECT_EQ(r.backend.fault_text(),
+              "joint lift: valve 1 (0x20) reports a non-recoverable fault (limit status 6, state "
+              "extend)");
+    r.expect_every_section_blocked_now();
+  }
+  {
+    SupervisedRig r;
+    ValveReport error;
+    error.state = iso11783::ValveState::kError;
+    r.run(spool_command(0.0), error, 3);
+    ASSERT_TRUE(r.backend.faulted());
+    EXPECT_EQ(r.backend.fault_text(), "joint slew: valve 0 (0x20) reports error state");
+  }
+  {
+    SupervisedRig r;  // the signal valve's driver: status 3 is not one of its ok values
+    ValveReport status = following(0.0);
+    status.driver_status = 3;
+    r.run(spool_command(0.0), status, 3);
+    ASSERT_TRUE(r.backend.faulted());
+    EXPECT_EQ(r.backend.fault_reason(), FaultReason::kValveFault);
+    EXPECT_EQ(r.backend.fault_text(),
+              "joint extension: valve driver reports status 3 in frame 211 (not an ok value)");
+  }
+}
+
+TEST(CanBackendSupervision, AValveInItsFailSafeWhileCommandedStopsAfterTheTimeout) {
+  SupervisedRig r;
+  r.run(spool_command(0.4), following(0.4), 10);
+  // The valves fall back to block (their fail-safe) while craneassist commands 40 % extend.
+  const auto took = r.run(spool_command(0.4), following(0.0), 60);
+  ASSERT_TRUE(r.backend.faulted());
+  EXPECT_EQ(r.backend.fault_reason(), FaultReason::kValveFault);
+  EXPECT_NE(r.backend.fault_text().find("joint slew: valve 0 (0x20) reports fail-safe: state block "
+                                        "for "),
+            std::string::npos)
+      << r.backend.fault_text();
+  EXPECT_NE(r.backend.fault_text().find(" ms while commanded extend"), std::string::npos);
+  EXPECT_GE(took, 300ms);
+  EXPECT_LT(took, 450ms);  // the timeout, a reply period and a loaded host
+  std::printf("valve in block while commanded extend: fault latched after %lld ms\n",
+              static_cast<long long>(took.count()));
+  r.expect_every_section_blocked_now();
+  // Float is never commanded: a valve reporting float is in its fail-safe even while blocked.
+  SupervisedRig f;
+  ValveReport floating;
+  floating.state = iso11783::ValveState::kFloat;
+  f.run(spool_command(0.0), floating, 60);
+  ASSERT_TRUE(f.backend.faulted());
+  EXPECT_NE(f.backend.fault_text().find("reports fail-safe: state float"), std::string::npos)
+      << f.backend.fault_text();
+}
+
+TEST(CanBackendSupervision, ARepliesThatStopOrNeverComeStopAfterTheTimeout) {
+  {
+    SupervisedRig r;
+    r.run(spool_command(0.3), following(0.3), 20);
+    ASSERT_FALSE(r.backend.faulted());
+    ValveReport silent = following(0.3);
+    silent.replies = false;
+    const auto took = r.run(spool_command(0.3), silent, 60);
+    ASSERT_TRUE(r.backend.faulted());
+    EXPECT_EQ(r.backend.fault_reason(), FaultReason::kValveReplyLost);
+    EXPECT_NE(r.backend.fault_text().find("joint slew: no valve reply for 3"), std::string::npos)
+        << r.backend.fault_text();
+    EXPECT_GE(took, 290ms);  // 300 ms after the last reply, which came up to a cycle earlier
+    EXPECT_LT(took, 450ms);
+    std::printf("valve replies stop: fault latched %lld ms after they stopped\n",
+                static_cast<long long>(took.count()));
+    r.expect_every_section_blocked_now();
+  }
+  {
+    SupervisedRig r;  // no reply at all since enable()
+    ValveReport silent;
+    silent.replies = false;
+    r.run(spool_command(0.0), silent, 60);
+    ASSERT_TRUE(r.backend.faulted());
+    EXPECT_EQ(r.backend.fault_text(), "joint slew: no valve reply within 300 ms of enable");
+  }
+}
+
+TEST(CanBackendSupervision, Dm1WithAnActiveDtcOrTheRedStopLampStops) {
+  {
+    SupervisedRig r;
+    r.run(spool_command(0.3), following(0.3), 5);
+    j1939::Dm1 d;
+    d.red_stop = j1939::Lamp::kOn;
+    d.spn = 1234;
+    d.fmi = 5;
+    d.occurrence_count = 1;
+    r.dm1(d);
+    r.run(spool_command(0.3), following(0.3), 2);
+    ASSERT_TRUE(r.backend.faulted());
+    EXPECT_EQ(r.backend.fault_reason(), FaultReason::kDm1Fault);
+    EXPECT_EQ(r.backend.fault_text(), "DM1 from 0x20: SPN 1234 FMI 5 (red stop lamp)");
+    r.expect_every_section_blocked_now();
+  }
+  {
+    SupervisedRig r;  // an active DTC with only the amber lamp: a stop as well
+    j1939::Dm1 d;
+    d.amber_warning = j1939::Lamp::kOn;
+    d.spn = 520192;
+    d.fmi = 31;
+    r.dm1(d);
+    r.run(spool_command(0.0), following(0.0), 2);
+    EXPECT_EQ(r.backend.fault_text(), "DM1 from 0x20: SPN 520192 FMI 31 (amber warning lamp)");
+  }
+  {
+    SupervisedRig r;  // the red stop lamp without a DTC
+    j1939::Dm1 d;
+    d.red_stop = j1939::Lamp::kOn;
+    r.dm1(d);
+    r.run(spool_command(0.0), following(0.0), 2);
+    EXPECT_EQ(r.backend.fault_text(), "DM1 from 0x20: red stop lamp on, no DTC");
+  }
+  {
+    SupervisedRig r;  // a multi-packet DM1 (3 DTCs) announced by TP.CM BAM
+    CanFrame bam;
+    bam.id = 0x1CECFF20;
+    bam.extended = true;
+    bam.dlc = 8;
+    bam.data = {32, 14, 0, 2, 0xFF, 0xCA, 0xFE, 0x00};
+    r.sensors.send(bam);
+    r.run(spool_command(0.0), following(0.0), 2);
+    EXPECT_EQ(r.backend.fault_text(),
+              "DM1 from 0x20: 3 active DTCs (multi-packet DM1, its DTCs not decoded)");
+  }
+  {
+    SupervisedRig r;  // another node's DM1 is not supervised; a malformed one of 0x20 is a fault
+    j1939::Dm1 d;
+    d.red_stop = j1939::Lamp::kOn;
+    d.spn = 99;
+    r.dm1(d, 0x33);
+    r.run(spool_command(0.0), following(0.0), 3);
+    EXPECT_FALSE(r.backend.faulted()) << r.backend.fault_text();
+    EXPECT_EQ(r.backend.counters().unknown_frames, 1u);
+    CanFrame shortdm1;
+    j1939::encode_dm1(j1939::Dm1{}, 0x20, shortdm1);
+    shortdm1.dlc = 3;
+    r.sensors.send(shortdm1);
+    r.run(spool_command(0.0), following(0.0), 2);
+    EXPECT_EQ(r.backend.fault_reason(), FaultReason::kBadFeedbackFrame);
+    EXPECT_EQ(r.backend.fault_text(),
+              "DM1 from 0x20 with dlc 3: too short for the lamps and a DTC");
+  }
+}
+
+TEST(CanBackendSupervision, ADm1FaultReportedBeforeEnableStopsRightAfterIt) {
+  Rig r;
+  r.map = supervised_mapping();
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  valves::MachineState state;
+  j1939::Dm1 d;
+  d.spn = 4321;
+  d.fmi = 2;
+  CanFrame f;
+  j1939::encode_dm1(d, 0x20, f);
+  r.sensors.send(f);
+  r.feedback();
+  backend.read(state);
+  EXPECT_FALSE(backend.faulted());  // not enabled: not judged yet
+  backend.enable();
+  r.feedback();
+  EXPECT_EQ(backend.read(state), valves::BackendStatus::kFault);
+  EXPECT_EQ(backend.fault_text(), "DM1 from 0x20: SPN 4321 FMI 2 (no lamp on)");
+}
+
+// A transport that allocates nothing (the in-memory bus does): frames to receive are queued in a
+// fixed array beforehand by the test thread, which also calls read(); sent frames are counted.
+class StaticTransport final : public Transport {
+ public:
+  SendStatus send(const CanFrame&) override {
+    sent.fetch_add(1);
+    return SendStatus::kOk;
+  }
+  void receive(Received& out) override {
+    if (head_ == tail_) {
+      out.kind = ReceiveKind::kNone;
+      return;
+    }
+    out = queue_[head_++ % queue_.size()];
+  }
+  bool wait_readable(int) override { return head_ != tail_; }
+  const char* interface_name() const override { return "static0"; }
+  void push(const CanFrame& f) {
+    Received r;
+    r.kind = ReceiveKind::kFrame;
+    r.frame = f;
+    r.timestamp_us = realtime_now_us();
+    queue_[tail_++ % queue_.size()] = r;
+  }
+  std::atomic<int> sent{0};
+
+ private:
+  std::array<Received, 128> queue_{};
+  std::size_t head_ = 0, tail_ = 0;
+};
+
+// The control thread's rule holds for the claim and the supervision: read() and write() allocate
+// nothing while claiming, answering requests and contenders, judging replies and DM1, and
+// latching a fault with its text.
+TEST(CanBackendSupervision, ReadAndWriteDoNotAllocateWithClaimAndSupervision) {
+  const CanMapping map = k70m_full_mapping();
+  const auto cfg = config::default_crane_config();
+  StaticTransport bus;
+  CanBackend backend(map, cfg.model, bus);
+  const double q[4] = {0.1, 0.2, -0.3, 1.0};
+  std::vector<CanFrame> feedback;
+  for (std::size_t i = 0; i < 4; ++i) {
+    CanFrame f;
+    f.id = map.joints[i].position.id;
+    f.extended = map.joints[i].position.extended;
+    f.dlc = required_dlc(map.joints[i].position);
+    ASSERT_EQ(encode(map.joints[i].position, q[i], f), SignalStatus::kOk);
+    feedback.push_back(f);
+  }
+  std::vector<CanFrame> replies;
+  for (std::uint8_t v = 0; v < 3; ++v) {
+    iso11783::AuxValveEstimatedFlow ef;
+    ef.valve = v;
+    ef.state = iso11783::ValveState::kExtend;
+    ef.limit = iso11783::LimitStatus::kNotLimited;
+    CanFrame f;
+    ASSERT_EQ(iso11783::encode(ef, 0x20, 3, f), iso11783::CodecStatus::kOk);
+    replies.push_back(f);
+  }
+  CanFrame status;
+  status.id = 0x211;
+  status.dlc = 1;
+  replies.push_back(status);
+  CanFrame request, rival, quiet_dm1, bad_dm1;
+  j1939::encode_request(j1939::kPgnAddressClaimed, 0x21, j1939::kGlobalAddress, request);
+  j1939::encode_address_claimed(0x7000000000000000ull, 0x80, rival);
+  j1939::encode_dm1(j1939::Dm1{}, 0x20, quiet_dm1);
+  j1939::Dm1 d;
+  d.red_stop = j1939::Lamp::kOn;
+  d.spn = 1234;
+  d.fmi = 5;
+  j1939::encode_dm1(d, 0x20, bad_dm1);
+  const auto cmd = spool_command(0.3);
+  valves::MachineState state;
+  for (const auto& f : feedback) bus.push(f);
+  backend.read(state);  // sizes the state's vectors
+  backend.enable();     // starts the claim
+
+  auto cycle = [&](std::initializer_list<const CanFrame*> extra) {
+    for (const auto& f : feedback) bus.push(f);
+    for (const auto& f : replies) bus.push(f);
+    for (const CanFrame* f : extra) bus.push(*f);
+    const long before = test::heap_allocations();
+    backend.read(state);
+    backend.write(cmd);
+    return test::heap_allocations() - before;
+  };
+  EXPECT_EQ(cycle({&request, &rival, &quiet_dm1}), 0) << "claiming";
+  EXPECT_EQ(backend.address_claim_state(), j1939::ClaimState::kClaiming);
+  for (int k = 0; k < 30 && backend.address_claim_state() != j1939::ClaimState::kClaimed; ++k) {
+    cycle({});
+    std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_EQ(backend.address_claim_state(), j1939::ClaimState::kClaimed);
+  const int sent_before = bus.sent.load();
+  EXPECT_EQ(cycle({&request, &quiet_dm1}), 0) << "claimed, commanding";
+  EXPECT_GT(bus.sent.load(), sent_before);
+  EXPECT_FALSE(backend.faulted()) << backend.fault_text();
+  EXPECT_EQ(cycle({&bad_dm1}), 0) << "latching a fault";
+  EXPECT_TRUE(backend.faulted());
+  EXPECT_EQ(backend.fault_text(), "DM1 from 0x20: SPN 1234 FMI 5 (red stop lamp)");
 }
 
 }  // namespace

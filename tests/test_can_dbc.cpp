@@ -192,6 +192,67 @@ TEST(CanDbc, RoundTripOfEveryShippedMapping) {
   }
 }
 
+TEST(CanDbc, TheClaimTheValveRepliesAndDm1AreInTheDbc) {
+  const CanMapping mapping = load_can_mapping(kConfigDir + "k70m_can.yaml");
+  ASSERT_TRUE(mapping.address_claim.has_value());
+  const Dbc dbc = parse_dbc(write_dbc(mapping, "k70m_can.yaml"), "written.dbc");
+  // craneassist's claim: PGN 60928 from its address, the NAME's fields in their bits.
+  const DbcMessage* claim = dbc.message("AddressClaimed_80");
+  ASSERT_NE(claim, nullptr);
+  EXPECT_EQ(claim->id, 0x18EEFF80u);
+  EXPECT_EQ(claim->sender, "craneassist");
+  ASSERT_EQ(claim->signals.size(), 10u);
+  CanFrame frame;
+  frame.id = claim->id;
+  frame.extended = true;
+  frame.dlc = 8;
+  for (int i = 0; i < 8; ++i) {
+    frame.data[static_cast<std::size_t>(i)] =
+        static_cast<std::uint8_t>(mapping.address_claim->name >> (8 * i));
+  }
+  const auto field = [&](const DbcMessage& m, const char* name) {
+    for (const auto& s : m.signals) {
+      if (s.name == name) {
+        double v = -1.0;
+        EXPECT_EQ(decode(s.spec, frame, v), SignalStatus::kOk) << name;
+        return v;
+      }
+    }
+    ADD_FAILURE() << "no signal " << name;
+    return -1.0;
+  };
+  EXPECT_EQ(field(*claim, "IdentityNumber"), 0xC1A);  // config/can/k70m_can.yaml's NAME
+  EXPECT_EQ(field(*claim, "Function"), 130);
+  EXPECT_EQ(field(*claim, "IndustryGroup"), 3);
+  EXPECT_EQ(field(*claim, "ArbitraryAddressCapable"), 0);
+  // The valve group at 0x20: its claim, the Estimated Flow of every supervised valve, DM1.
+  ASSERT_NE(dbc.message("AddressClaimed_20"), nullptr);
+  for (int valve = 0; valve < 3; ++valve) {
+    const DbcMessage* ef = dbc.message("AuxValveEstimatedFlow" + std::to_string(valve));
+    ASSERT_NE(ef, nullptr) << valve;
+    EXPECT_EQ(ef->id, 0x0CFE1020u + (static_cast<std::uint32_t>(valve) << 8));
+    EXPECT_EQ(ef->sender, "machine");
+    EXPECT_TRUE(ef->j1939);
+  }
+  const DbcMessage* dm1 = dbc.message("DM1_20");
+  ASSERT_NE(dm1, nullptr);
+  EXPECT_EQ(dm1->id, 0x18FECA20u);
+  ASSERT_TRUE(dm1->cycle_s.has_value());
+  EXPECT_DOUBLE_EQ(*dm1->cycle_s, 1.0);
+  // SPN 1234 FMI 5 with the red stop lamp, as craneassist's DM1 codec lays it out.
+  frame.id = dm1->id;
+  frame.data = {0x10, 0xFF, 0xD2, 0x04, 0x05, 0x01, 0xFF, 0xFF};
+  EXPECT_EQ(field(*dm1, "RedStopLamp"), 1);
+  EXPECT_EQ(field(*dm1, "SpnLow") + 65536 * field(*dm1, "SpnHigh"), 1234);
+  EXPECT_EQ(field(*dm1, "Fmi"), 5);
+  EXPECT_EQ(field(*dm1, "OccurrenceCount"), 1);
+  // The extension driver's status byte, with its OK value named.
+  const DbcMessage* status = dbc.message("extension_valve_status");
+  ASSERT_NE(status, nullptr);
+  EXPECT_EQ(status->id, 0x211u);
+  EXPECT_EQ(status->sender, "machine");
+}
+
 TEST(CanDbc, ReadsAVendorStyleDbc) {
   const Dbc dbc = parse_dbc(kVendorDbc, "vendor.dbc");
   ASSERT_EQ(dbc.messages.size(), 3u);

@@ -332,3 +332,132 @@ TEST(CanMapping, MissingFile) {
     EXPECT_EQ(std::string(e.what()), "/nonexistent/map.yaml: file not found");
   }
 }
+
+// address_claim, valve.reply and diagnostics: values, and every mistake named by line and field.
+TEST(CanMapping, AddressClaimRepliesAndDm1) {
+  const std::string claim =
+      "address_claim:\n"
+      "  address: 0x80\n"
+      "  name: {identity_number: 0xC1A, manufacturer_code: 0x7FE, function: 130,\n"
+      "         industry_group: 3, function_instance: 2}\n"
+      "diagnostics:\n"
+      "  dm1: {source_addresses: [0x20, 0x21]}\n";
+  const std::string signal_valve =
+      "    valve:\n"
+      "      signal: {id: 0x210, start_bit: 0, length: 16, byte_order: intel, signed: true,\n"
+      "               scale: 1, unit: mA, min: -800, max: 800, cycle: 20 ms}\n"
+      "      reply:\n"
+      "        status: {id: 0x211, start_bit: 0, length: 8, byte_order: intel, ok: [0, 1]}\n"
+      "        timeout: 250 ms\n";
+  const std::string text =
+      "format: craneassist-can-map/1\n" + claim +
+      "joints:\n"
+      "  - name: slew\n"
+      "    valve:\n"
+      "      iso11783_avc: {valve: 1, source_address: 0x80, cycle: 20 ms}\n"
+      "      reply: {source_address: 0x20, timeout: 300 ms}\n" +
+      kPosition + "  - name: lift\n" + signal_valve +
+      "    position: {id: 0x18FF1022, extended: true, start_bit: 0,\n"
+      "               length: 16, byte_order: intel, scale: 0.01, unit: deg}\n";
+  const CanMapping m = parse_can_mapping(text, "map.yaml");
+  ASSERT_TRUE(m.address_claim.has_value());
+  EXPECT_EQ(m.address_claim->address, 0x80);
+  EXPECT_DOUBLE_EQ(m.address_claim->timeout_s, 0.25);  // J1939-81's default
+  const std::uint64_t name = m.address_claim->name;
+  EXPECT_EQ(name & 0x1FFFFF, 0xC1Au);
+  EXPECT_EQ((name >> 21) & 0x7FF, 0x7FEu);
+  EXPECT_EQ((name >> 35) & 0x1F, 2u);
+  EXPECT_EQ((name >> 40) & 0xFF, 130u);
+  EXPECT_EQ((name >> 60) & 0x7, 3u);
+  EXPECT_EQ(name >> 63, 0u);
+  ASSERT_TRUE(m.dm1.has_value());
+  EXPECT_EQ(m.dm1->source_addresses, (std::vector<std::uint8_t>{0x20, 0x21}));
+  ASSERT_TRUE(m.joints[0].reply.has_value());
+  EXPECT_EQ(m.joints[0].reply->source_address, 0x20);
+  EXPECT_DOUBLE_EQ(m.joints[0].reply->timeout_s, 0.3);
+  ASSERT_TRUE(m.joints[1].reply.has_value());
+  EXPECT_EQ(m.joints[1].reply->status.id, 0x211u);
+  EXPECT_EQ(m.joints[1].reply->status.length, 8);
+  EXPECT_EQ(m.joints[1].reply->ok_values, (std::vector<std::uint64_t>{0, 1}));
+  EXPECT_DOUBLE_EQ(m.joints[1].reply->timeout_s, 0.25);
+  // The NAME as one 64-bit number; a single ok value.
+  std::string hex_name = text;
+  hex_name.replace(hex_name.find("{identity_number"),
+                   hex_name.find("function_instance: 2}") + 21 - hex_name.find("{identity_number"),
+                   "0x30820FFC00000C1A");
+  EXPECT_EQ(parse_can_mapping(hex_name, "map.yaml").address_claim->name, 0x30820FFC00000C1Aull);
+
+  struct Case {
+    std::string from, to;
+    std::string field, reason_part;
+  };
+  const Case cases[] = {
+      {"address: 0x80", "address: 0xFE", "address_claim.address", "at most 253"},
+      {"address: 0x80", "address: 0x81", "joints[0].valve.iso11783_avc.source_address",
+       "is 0x80, the address_claim address is 0x81"},
+      {"industry_group: 3,", "industry_group: 8,", "address_claim.name.industry_group",
+       "at most 7"},
+      {"manufacturer_code: 0x7FE,", "", "address_claim.name.manufacturer_code", "missing"},
+      {"function_instance: 2}", "function_instance: 2, arbitrary_address_capable: true}",
+       "address_claim.name.arbitrary_address_capable", "must be false"},
+      {"function_instance: 2}", "ecu: 1}", "address_claim.name.ecu", "unknown field"},
+      {"  dm1: {source_addresses: [0x20, 0x21]}", "  dm1: {source_addresses: [0x20, 0x20]}",
+       "diagnostics.dm1.source_addresses[1]", "listed twice"},
+      {"  dm1: {source_addresses: [0x20, 0x21]}", "  dm1: {source_addresses: [0x20, 0x80]}",
+       "diagnostics.dm1.source_addresses[1]", "craneassist's own"},
+      {"  dm1: {source_addresses: [0x20, 0x21]}", "  dm1: {source_addresses: []}",
+       "diagnostics.dm1.source_addresses", "list of addresses"},
+      {"  dm1: {source_addresses: [0x20, 0x21]}", "  dm2: {}", "diagnostics.dm2", "unknown field"},
+      {"reply: {source_address: 0x20, timeout: 300 ms}",
+       "reply: {source_address: 0x80, timeout: 300 ms}", "joints[0].valve.reply.source_address",
+       "the command's source address"},
+      {"reply: {source_address: 0x20, timeout: 300 ms}", "reply: {source_address: 0x20}",
+       "joints[0].valve.reply.timeout", "missing"},
+      {"reply: {source_address: 0x20, timeout: 300 ms}",
+       "reply: {source_address: 0x20, timeout: 10 s}", "joints[0].valve.reply.timeout",
+       "between 20 ms and 5 s"},
+      {"reply: {source_address: 0x20, timeout: 300 ms}",
+       "reply: {status: {id: 0x211}, timeout: 300 ms}", "joints[0].valve.reply.status",
+       "unknown field"},
+      {"ok: [0, 1]", "ok: [0, 256]", "joints[1].valve.reply.status.ok[1]", "at most 255"},
+      {"ok: [0, 1]", "ok: []", "joints[1].valve.reply.status.ok", "at least one"},
+      {"ok: [0, 1]", "ok: 0, scale: 2", "joints[1].valve.reply.status.scale", "unknown field"},
+      // The status frame is received: it cannot also be the (sent) command's identifier.
+      {"status: {id: 0x211,", "status: {id: 0x210, extended: false,",
+       "joints[1].valve.reply.status", "other direction"},
+      {"timeout: 250 ms\n", "timeout: 250 ms\n      valve: 3\n", "joints[1].valve.valve",
+       "unknown field"},
+  };
+  for (const auto& c : cases) {
+    std::string edited = text;
+    const auto at = edited.find(c.from);
+    ASSERT_NE(at, std::string::npos) << c.from;
+    edited.replace(at, c.from.size(), c.to);
+    const ConfigError e = error_of(edited);
+    EXPECT_EQ(e.field(), c.field) << e.what();
+    EXPECT_NE(e.reason().find(c.reason_part), std::string::npos) << e.what();
+    EXPECT_GT(e.line(), 0) << e.what();
+  }
+  // A J1939 heartbeat must come from the claimed address; an 11-bit one may be anything.
+  auto e = error_of(
+      "format: craneassist-can-map/1\nheartbeat: {id: 0x18FF0081, cycle: 20 ms, "
+      "timeout: 100 ms}\n" +
+      claim + "joints:\n  - name: slew\n" + kValve + kPosition);
+  EXPECT_EQ(e.field(), "heartbeat.id");
+  EXPECT_EQ(e.line(), 2);
+  EXPECT_NE(e.reason().find("has source address 0x81 (its low byte), the address_claim address "
+                            "is 0x80"),
+            std::string::npos)
+      << e.what();
+  EXPECT_NO_THROW(
+      parse_can_mapping("format: craneassist-can-map/1\nheartbeat: {id: 0x181, "
+                        "extended: false, cycle: 20 ms, timeout: 100 ms}\n" +
+                            claim + "joints:\n  - name: slew\n" + kValve + kPosition,
+                        "map.yaml"));
+  // The line of a wrong source address is the joint's valve line.
+  e = error_of("format: craneassist-can-map/1\n" + claim + "joints:\n  - name: slew\n" +
+               "    valve:\n      iso11783_avc: {valve: 0, source_address: 0x81, cycle: 20 ms}\n" +
+               kPosition);
+  EXPECT_EQ(e.line(), 11);
+  EXPECT_EQ(e.field(), "joints[0].valve.iso11783_avc.source_address");
+}

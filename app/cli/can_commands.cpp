@@ -45,7 +45,7 @@ void CanMachine::report() const {
   std::printf(
       "  CAN %s: sent %llu, received %llu, unknown %llu, bad %llu, unsupported %llu, bus errors "
       "%llu, send queue full %llu, send errors %llu, watchdog block frames %llu, heartbeats %llu, "
-      "log dropped %llu\n",
+      "log dropped %llu, address claim frames %llu, valve replies %llu, DM1 %llu\n",
       "counters", static_cast<unsigned long long>(c.frames_sent),
       static_cast<unsigned long long>(c.frames_received),
       static_cast<unsigned long long>(c.unknown_frames),
@@ -56,7 +56,10 @@ void CanMachine::report() const {
       static_cast<unsigned long long>(c.send_errors),
       static_cast<unsigned long long>(c.watchdog_block_frames),
       static_cast<unsigned long long>(c.heartbeats_sent),
-      static_cast<unsigned long long>(c.log_dropped));
+      static_cast<unsigned long long>(c.log_dropped),
+      static_cast<unsigned long long>(c.claim_frames_sent),
+      static_cast<unsigned long long>(c.valve_replies),
+      static_cast<unsigned long long>(c.dm1_messages));
   if (backend_->faulted()) {
     std::printf("  CAN FAULT (%s) at %.3f s: %s\n", can::to_string(backend_->fault_reason()),
                 backend_->fault_time_s(), backend_->fault_text().c_str());
@@ -95,7 +98,8 @@ CLI::App* add_emulate_command(CLI::App& cli, EmulateArgs& args) {
   auto* cmd = cli.add_subcommand(
       "emulate",
       "Run the simulated crane behind the CAN protocol: decode valve command frames, step the "
-      "simulator in real time, send joint position and pressure frames");
+      "simulator in real time, send joint position and pressure frames (and, when the mapping "
+      "asks, the valves' replies and DM1)");
   cmd->add_option("--can", args.iface, "CAN interface, e.g. vcan0 or can0")->required();
   add_config_option(*cmd, args.config_file);
   add_payload_option(*cmd, args.payload_kg);
@@ -112,17 +116,30 @@ CLI::App* add_emulate_command(CLI::App& cli, EmulateArgs& args) {
       ->capture_default_str();
   cmd->add_option("--duration", args.duration_s, "Seconds to run (default: until killed)")
       ->check(FiniteRange(0.0, 1e6));
+  // Test hooks of the can_vm test (seconds since the emulator started).
+  cmd->add_option("--test-valve-fault-at", args.faults.valve_fault_at_s)
+      ->check(FiniteRange(0.0, 1e6))
+      ->group("");
+  cmd->add_option("--test-valve-fault-joint", args.faults.valve_fault_joint)->group("");
+  cmd->add_option("--test-reply-stop-at", args.faults.reply_stop_at_s)
+      ->check(FiniteRange(0.0, 1e6))
+      ->group("");
+  cmd->add_option("--test-dm1-fault-at", args.faults.dm1_fault_at_s)
+      ->check(FiniteRange(0.0, 1e6))
+      ->group("");
   return cmd;
 }
 
 int run_emulate_command(const EmulateArgs& args) {
   config::CraneConfig cfg;
   can::CanMapping mapping;
+  std::optional<EmulatedNodes> nodes;
   try {
     cfg = load_crane(args.config_file);
     apply_crane_options(cfg, {.payload_kg = args.payload_kg});
     mapping = load_mapping_or_default(args.mapping_file);
     can::check_mapping_fits(mapping, cfg.model);  // before the bus is opened
+    nodes.emplace(mapping, args.faults);
   } catch (const std::exception& e) {
     spdlog::error("config: {}", e.what());
     return kExitUsage;
@@ -167,7 +184,8 @@ int run_emulate_command(const EmulateArgs& args) {
     std::optional<can::HeartbeatMonitor> heartbeat;
     if (mapping.heartbeat) heartbeat.emplace(*mapping.heartbeat);
     bool heartbeat_ok = false;
-    unsigned long long commands = 0, bad = 0, other = 0, sent = 0, send_failed = 0, behind = 0;
+    unsigned long long commands = 0, bad = 0, other = 0, sent = 0, send_failed = 0, behind = 0,
+                       network = 0;
     const double step = cfg.simulation.step_s;
     const auto step_ns = static_cast<std::int64_t>(std::llround(step * 1e9));
     const auto feedback_ns = static_cast<std::int64_t>(std::llround(args.feedback_period_s * 1e9));
@@ -197,6 +215,11 @@ int run_emulate_command(const EmulateArgs& args) {
           continue;
         }
         if (heartbeat && heartbeat->on_frame(rx.frame, static_cast<double>(now) * 1e-9)) continue;
+        // J1939 network management: requests answered for the emulated nodes, claims reported.
+        if (nodes->on_frame(rx.frame, static_cast<double>(now) * 1e-9, bus)) {
+          ++network;
+          continue;
+        }
         bool mine = false;
         for (int j = 0; j < n; ++j) {
           const auto& valve = mapping.joints[static_cast<std::size_t>(j)].valve;
@@ -224,11 +247,14 @@ int run_emulate_command(const EmulateArgs& args) {
         heartbeat_ok = alive;
       }
       for (int j = 0; j < n; ++j) {
-        if (!alive || now - last_command_ns[static_cast<std::size_t>(j)] > command_timeout_ns) {
+        if (!alive || now - last_command_ns[static_cast<std::size_t>(j)] > command_timeout_ns ||
+            nodes->failed(j, static_cast<double>(now) * 1e-9)) {
           command.spool[j] = 0.0;
         }
       }
       sim.write(command);
+      // The valves' replies (what they applied) and the nodes' DM1, when the mapping asks.
+      nodes->tick(static_cast<double>(now) * 1e-9, command.spool, bus);
       int steps = 0;
       while (sim_ns + step_ns <= now && steps < 100) {
         sim.advance(step);
@@ -289,6 +315,13 @@ int run_emulate_command(const EmulateArgs& args) {
         static_cast<double>(mono_ns() - start) * 1e-9, commands, bad, other, sent, send_failed,
         behind, static_cast<double>(max_lag_ns) * 1e-6, args.lag_warning_s * 1e3,
         static_cast<double>(lagging_ns) * 1e-9);
+    if (nodes->active() || network > 0) {
+      std::printf(
+          "craneassist emulate: J1939 nodes: %llu replies, DM1 and claims sent, %llu failed; %llu "
+          "network management frames received\n",
+          static_cast<unsigned long long>(nodes->frames_sent()),
+          static_cast<unsigned long long>(nodes->send_failures()), network);
+    }
     if (heartbeat) {
       std::printf(
           "craneassist emulate: heartbeat: %llu messages, %llu sequence errors, %llu malformed, "

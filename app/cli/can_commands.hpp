@@ -11,6 +11,7 @@
 #include "craneassist/can/mapping_config.hpp"
 #include "craneassist/can/socketcan.hpp"
 #include "craneassist/dynamics/model.hpp"
+#include "emulated_nodes.hpp"
 
 namespace craneassist::cli {
 
@@ -42,6 +43,7 @@ struct EmulateArgs {
   double lag_warning_s = 0.02;  // say so when the simulation is this far behind the wall clock
   double duration_s = 0.0;      // 0: until killed
   double command_timeout_s = 0.2;
+  EmulatedFaults faults;  // hidden --test-... options
 };
 
 CLI::App* add_emulate_command(CLI::App& cli, EmulateArgs& args);

@@ -76,8 +76,13 @@ int Machine::open(const config::CraneConfig& cfg, const BackendArgs& args,
                cfg.backend.can.feedback_timeout_s);  // --can-feedback-timeout applied to cfg
   machine_ = &can_->backend();
   if (std::string why; !machine_->activate(2.0, &why)) {
-    spdlog::error("{} on {} (is the machine or `craneassist emulate --can {}` running?)", why,
-                  iface, iface);
+    if (machine_->faulted()) {  // e.g. the J1939 address belongs to another node
+      spdlog::error("the machine was not activated on {}: {}", iface, why);
+      can_->report();
+    } else {
+      spdlog::error("{} on {} (is the machine or `craneassist emulate --can {}` running?)", why,
+                    iface, iface);
+    }
     return kExitRuntime;
   }
   return kExitOk;

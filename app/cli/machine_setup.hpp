@@ -47,9 +47,10 @@ void apply_backend_options(config::CraneConfig& cfg, const BackendArgs& args);
 class Machine {
  public:
   valves::MachineInterface& get() { return *machine_; }
-  // Builds and activates the machine (a bus machine waits up to 2 s for every joint's
-  // feedback) from the inputs load_machine_inputs read. Returns kExitOk, or logs why not and
-  // returns the exit code.
+  // Builds and activates the machine (a bus machine claims its J1939 address, when its mapping
+  // says so, and waits up to 2 s for every joint's feedback) from the inputs
+  // load_machine_inputs read. Returns kExitOk, or logs why not (with the bus report after a
+  // fault, e.g. the address lost) and returns the exit code.
   int open(const config::CraneConfig& cfg, const BackendArgs& args, const MachineInputs& inputs);
   // The normal end of a run: the machine deactivated (every valve to its safe state, its
   // threads ended) and the bus report printed. Returns kExitRuntime after a latched fault.

@@ -3,7 +3,8 @@
 # backend and from independent candump captures; then the fault cases; then the live loop
 # (`craneassist sim --backend can`) against the live loop on the sim backend; then controller
 # error frames on the bus and every way a run ends on the CAN backend (its end, --duration,
-# SIGINT): the valves come down gradually, never from flow to block in one frame.
+# SIGINT): the valves come down gradually, never from flow to block in one frame; then the
+# J1939 address claim against a rival node and the valves' replies and DM1 (emulator hooks).
 # The live runs leave DDS telemetry off (--no-telemetry): the one emulated CPU is busy enough.
 set -u
 status=0
@@ -219,6 +220,73 @@ cat /tmp/f12.out
 [ "$rc" = 0 ] || fail "SIGINT: expected exit 0, got $rc"
 grep -q "ran [0-2]\.[0-9]* s of machine time" /tmp/f12.out || fail "SIGINT: the run did not end early"
 ./can_backend_check stop /tmp/cap12.log 250 || fail "SIGINT: valves not brought down gradually"
+echo "=== 14. J1939 address claim: a node with a higher-priority NAME holds 0x80"
+# j1939_rival (raw socket, not the project's codecs) answers craneassist's claim with its own.
+start_emulator
+start_capture /tmp/cap14.log
+./j1939_rival vcan0 80 0000000000000001 30 >/tmp/rival14.log 2>&1 &
+rv=$!
+sleep 0.2
+./craneassist replay can_short.csv --backend can --can vcan0 --no-log --settle 0 >/tmp/f14.out 2>&1; rc=$?
+stop_capture
+kill "$emu" "$rv"; wait "$emu"; wait "$rv"
+cat /tmp/rival14.log /tmp/f14.out
+[ "$rc" = 3 ] || fail "claim lost: expected exit 3, got $rc"
+grep -q "CAN FAULT (address lost) at .*: cannot claim address 0x80: node with NAME 0x0000000000000001 has priority" /tmp/f14.out ||
+  fail "claim lost: no cannot-claim fault reported"
+./can_backend_check claim /tmp/cap14.log lost 0000000000000001 || fail "claim lost: capture"
+
+echo "=== 15. a lower-priority contender gives way; the run proceeds until the lift valve fails"
+./craneassist emulate --can vcan0 --test-valve-fault-at 2.5 --test-valve-fault-joint lift \
+  >/tmp/emu15.log 2>&1 &
+emu=$!
+sleep 0.5
+start_capture /tmp/cap15.log
+./j1939_rival vcan0 80 5000000000000001 30 >/tmp/rival15.log 2>&1 &
+rv=$!
+sleep 0.2
+./craneassist replay can_short.csv --backend can --can vcan0 --no-log --settle 0 \
+  --can-feedback-timeout 0.3 >/tmp/f15.out 2>&1; rc=$?
+stop_capture
+kill "$emu" "$rv"; wait "$emu"; wait "$rv"
+cat /tmp/rival15.log /tmp/emu15.log; grep CAN /tmp/f15.out
+[ "$rc" = 3 ] || fail "valve fault: expected exit 3, got $rc"
+grep -q "CAN FAULT (valve fault) at .*: joint lift: valve 1 (0x20) reports a non-recoverable fault (limit status 6" /tmp/f15.out ||
+  fail "valve fault: not reported"
+./can_backend_check claim /tmp/cap15.log won 5000000000000001 || fail "claim won: capture"
+./can_backend_check safe /tmp/cap15.log valve-fault 100 || fail "valve fault: safe state"
+
+echo "=== 16. the valve replies stop (test hook at 2.5 s)"
+./craneassist emulate --can vcan0 --test-reply-stop-at 2.5 >/tmp/emu16.log 2>&1 &
+emu=$!
+sleep 0.5
+start_capture /tmp/cap16.log
+./craneassist replay can_short.csv --backend can --can vcan0 --no-log --settle 0 \
+  --can-feedback-timeout 0.3 >/tmp/f16.out 2>&1; rc=$?
+stop_capture
+kill "$emu"; wait "$emu"
+grep CAN /tmp/f16.out
+[ "$rc" = 3 ] || fail "reply silence: expected exit 3, got $rc"
+grep -q "CAN FAULT (valve reply lost) at .*: joint .*: no valve reply for [0-9]* ms" /tmp/f16.out ||
+  fail "reply silence: not reported"
+# The fault is due 300 ms after the last reply: every section blocked within 100 ms of that.
+./can_backend_check safe /tmp/cap16.log last-reply 400 || fail "reply silence: safe state"
+
+echo "=== 17. DM1 from the valve group with an active DTC (test hook at 2.5 s)"
+./craneassist emulate --can vcan0 --test-dm1-fault-at 2.5 >/tmp/emu17.log 2>&1 &
+emu=$!
+sleep 0.5
+start_capture /tmp/cap17.log
+./craneassist replay can_short.csv --backend can --can vcan0 --no-log --settle 0 \
+  --can-feedback-timeout 0.3 >/tmp/f17.out 2>&1; rc=$?
+stop_capture
+kill "$emu"; wait "$emu"
+grep CAN /tmp/f17.out
+[ "$rc" = 3 ] || fail "DM1: expected exit 3, got $rc"
+grep -q "CAN FAULT (DM1 fault) at .*: DM1 from 0x20: SPN 1234 FMI 5 (red stop lamp)" /tmp/f17.out ||
+  fail "DM1: not reported"
+./can_backend_check safe /tmp/cap17.log dm1-fault 100 || fail "DM1: safe state"
+
 echo "=== 13. feedback lost while the wall clock steps back (timed on CLOCK_MONOTONIC)"
 # The clock goes back years the moment the emulator dies: freshness timed on the wall clock
 # would see the last position frame in the future and the fault would wait for the run's end.

@@ -6,10 +6,13 @@
 //        EVENT: last-feedback (the last position frame), bad-frame (the first position frame
 //        with a wrong dlc), last-motion (the last non-block command before the safe state),
 //        error-frame (the first controller error frame; needs a capture whose error mask
-//        passes them, e.g. candump -L vcan0,0:0,#FFFFFFFF)
+//        passes them, e.g. candump -L vcan0,0:0,#FFFFFFFF), valve-fault (the first valve reply
+//        reporting a fault), last-reply (the last Estimated Flow before the safe state),
+//        dm1-fault (the first DM1 with the red stop lamp or an active DTC)
 //   stop CAPTURE MIN_FALL_MS            the run's end brought the flow down gradually: the pump
 //                                       flow the emulator measures falls from 90 % to 10 % in at
 //                                       least MIN_FALL_MS (an abrupt block: about 100 ms)
+//   claim CAPTURE lost|won RIVAL_NAME   the J1939 address claim against j1939_rival (hex NAME)
 //   wait-motion IFACE TIMEOUT_S         waits until a command that is not block is on the bus:
 //                                       the run is moving
 //   tables SIM.yaml CAN.yaml TOL        valve tables of `craneassist calibrate` on the two
@@ -58,6 +61,37 @@ std::vector<CandumpRecord> read_capture(const char* path, std::vector<std::strin
 constexpr std::uint32_t kCommandIds[] = {0x0CFE3080, 0x0CFE3180, 0x0CFE3280, 0x210};
 constexpr std::uint32_t kSlewPosition = 0x18FF1021;
 constexpr std::uint32_t kHeartbeat = 0x18FF0080;
+constexpr std::uint32_t kAddressClaimed80 = 0x18EEFF80;  // J1939-81, PGN 0xEE00 from 0x80
+
+// The valve group's frames (k70m_can.yaml; the emulator sends them): Auxiliary Valve
+// Estimated Flow of valves 0..2 from 0x20, the extension driver's status 0x211, DM1 and the
+// address claim of 0x20.
+bool is_machine_j1939(const CanFrame& f) {
+  if (!f.extended) return f.id == 0x211;
+  return f.id == 0x0CFE1020 || f.id == 0x0CFE1120 || f.id == 0x0CFE1220 || f.id == 0x18FECA20 ||
+         f.id == 0x18EEFF20;
+}
+
+// An Estimated Flow (PGN 0xFE10 + valve, any source) reporting limit status 6 or error state,
+// or the extension driver's status other than 0.
+bool is_valve_fault_reply(const CanFrame& f) {
+  if (!f.extended) return f.id == 0x211 && f.dlc >= 1 && f.data[0] != 0;
+  const std::uint32_t pgn = (f.id >> 8) & 0x3FFFF;
+  if (pgn < 0xFE10 || pgn > 0xFE1F || f.dlc != 8) return false;
+  return (f.data[3] >> 5) == 6 || (f.data[2] & 0x0F) == 14;
+}
+
+bool is_estimated_flow(const CanFrame& f) {
+  const std::uint32_t pgn = (f.id >> 8) & 0x3FFFF;
+  return f.extended && pgn >= 0xFE10 && pgn <= 0xFE1F;
+}
+
+// A DM1 (PGN 0xFECA) with the red stop lamp on or an active DTC (SPN other than 0).
+bool is_dm1_fault(const CanFrame& f) {
+  if (!f.extended || ((f.id >> 8) & 0x3FFFF) != 0xFECA || f.dlc < 6) return false;
+  const std::uint32_t spn = f.data[2] | (f.data[3] << 8) | ((f.data[4] >> 5) << 16);
+  return ((f.data[0] >> 4) & 3) == 1 || (spn != 0 && spn != 0x7FFFF);
+}
 
 int section_of(const CanFrame& f) {
   for (int i = 0; i < 4; ++i) {
@@ -237,6 +271,8 @@ int traffic(const char* path) {
   bool ok = !recs.empty();
   std::vector<std::int64_t> times[4], position, heartbeat;
   int bad_payload = 0, unknown = 0, moving = 0, heartbeat_skips = 0, heartbeat_enabled = 0;
+  int claims = 0, machine_j1939 = 0;
+  std::int64_t first_claim = -1, first_from_80 = -1;  // J1939-81: claim, then 250 ms, then send
   int last_counter = -1;
   std::int64_t last_enabled_heartbeat = -1;
   bool last_block[4] = {};
@@ -247,10 +283,18 @@ int traffic(const char* path) {
     const int s = section_of(r.frame);
     if (r.direction != CandumpDirection::kNone) {
       ++marked;
-      const bool sent = s >= 0 || (r.frame.extended && r.frame.id == kHeartbeat);
+      const bool sent = s >= 0 || (r.frame.extended &&
+                                   (r.frame.id == kHeartbeat || r.frame.id == kAddressClaimed80));
       wrong_direction += (r.direction == CandumpDirection::kTx) != sent;
     }
     if (s >= 0) last_block[s] = is_block(r.frame);
+    if (r.frame.extended && r.frame.id == kAddressClaimed80 && first_claim < 0) {
+      first_claim = r.timestamp;
+    }
+    if (r.frame.extended && (r.frame.id & 0xFFu) == 0x80 && r.frame.id != kAddressClaimed80 &&
+        first_from_80 < 0) {
+      first_from_80 = r.timestamp;
+    }
     if (r.frame.extended && r.frame.id == kHeartbeat) {
       heartbeat.push_back(r.timestamp);
       if (r.frame.dlc != 8 || r.frame.data[1] > 2) ++bad_payload;
@@ -274,6 +318,10 @@ int traffic(const char* path) {
       }
     } else if (r.frame.extended && r.frame.id == kSlewPosition) {
       position.push_back(r.timestamp);
+    } else if (r.frame.extended && r.frame.id == kAddressClaimed80) {
+      ++claims;
+    } else if (is_machine_j1939(r.frame)) {
+      ++machine_j1939;
     } else if (!((r.frame.extended && (r.frame.id & 0xFFFFFFF0u) == 0x18FF1020u) ||
                  (!r.frame.extended &&
                   ((r.frame.id >= 0x301 && r.frame.id <= 0x304) || r.frame.id == 0x310)))) {
@@ -282,8 +330,8 @@ int traffic(const char* path) {
   }
   std::printf(
       "capture %s: %zu frames, %d command payloads wrong, %d unexpected identifiers, %d "
-      "AVC commands not block; %d marked T or R, %d of them the wrong way\n",
-      path, recs.size(), bad_payload, unknown, moving, marked, wrong_direction);
+      "AVC commands not block; %d marked T or R, %d of them the wrong way; %d address claims\n",
+      path, recs.size(), bad_payload, unknown, moving, marked, wrong_direction, claims);
   if (marked != 0 && marked != static_cast<int>(recs.size())) ok = false;  // all or none
   if (wrong_direction != 0) ok = false;
   const char* names[] = {"slew AVC 0CFE3080", "lift AVC 0CFE3180", "tilt AVC 0CFE3280",
@@ -299,6 +347,12 @@ int traffic(const char* path) {
   period_stats("heartbeat 18FF0080", heartbeat, 20.0, 0.1, ok);
   std::printf("heartbeat: %zu messages, %d in state enabled, %d counter skips\n", heartbeat.size(),
               heartbeat_enabled, heartbeat_skips);
+  const double claim_lead_ms = static_cast<double>(first_from_80 - first_claim) * 1e-3;
+  std::printf(
+      "address claim 18EEFF80: %d, the first other frame from 0x80 %.1f ms after it; %d valve "
+      "replies, DM1 and claims of the valve group\n",
+      claims, claim_lead_ms, machine_j1939);
+  if (claims < 1 || first_claim < 0 || claim_lead_ms < 250.0) ok = false;
   const bool ended_blocked = last_block[0] && last_block[1] && last_block[2] && last_block[3];
   std::printf("at the end of the capture every section is commanded to block: %s\n",
               ended_blocked ? "yes" : "NO");
@@ -365,6 +419,13 @@ int safe(const char* path, const std::string& event, double limit_ms) {
     if (event == "last-motion" && i < safe_index && section_of(f) >= 0 && !is_block(f)) {
       event_at = recs[i].timestamp;
     }
+    if (event == "valve-fault" && event_at < 0 && is_valve_fault_reply(f)) {
+      event_at = recs[i].timestamp;
+    }
+    if (event == "last-reply" && i < safe_index && is_estimated_flow(f)) {
+      event_at = recs[i].timestamp;
+    }
+    if (event == "dm1-fault" && event_at < 0 && is_dm1_fault(f)) event_at = recs[i].timestamp;
   }
   if (event == "error-frame") event_at = first_error_frame(storage);
   if (event_at < 0) {
@@ -483,6 +544,58 @@ int tables(const char* sim_path, const char* can_path, double tolerance) {
   return ok ? 0 : 1;
 }
 
+// The J1939 address claim against a rival node (tests/can_vm/j1939_rival.cpp) from a capture:
+// `lost` (the rival has priority): craneassist claimed 0x80, the rival claimed it, craneassist
+// sent Cannot Claim Address and nothing else from 0x80; `won`: craneassist claimed, the rival
+// contended, craneassist claimed again, the rival gave way (Cannot Claim), and craneassist's first
+// other frame from 0x80 came at least 250 ms after its last claim.
+int claim(const char* path, const std::string& outcome, std::uint64_t rival_name) {
+  std::vector<std::string> storage;
+  const auto recs = read_capture(path, storage);
+  auto name_of = [](const CanFrame& f) {
+    std::uint64_t n = 0;
+    for (int i = 0; i < 8; ++i) n |= static_cast<std::uint64_t>(f.data[i]) << (8 * i);
+    return n;
+  };
+  std::int64_t ours_first = -1, ours_last = -1, rival_claim = -1, ours_after_rival = -1;
+  std::int64_t our_cannot = -1, rival_cannot = -1, first_other = -1;
+  int other_from_80 = 0;
+  for (const auto& r : recs) {
+    const CanFrame& f = r.frame;
+    if (!f.extended) continue;
+    const bool is_claim_frame = ((f.id >> 8) & 0x3FF00) == 0xEE00 && f.dlc == 8;
+    if (is_claim_frame && (f.id & 0xFF) == 0x80) {
+      if (name_of(f) == rival_name) {
+        if (rival_claim < 0) rival_claim = r.timestamp;
+      } else {
+        if (ours_first < 0) ours_first = r.timestamp;
+        if (rival_claim >= 0 && ours_after_rival < 0) ours_after_rival = r.timestamp;
+        if (first_other < 0) ours_last = r.timestamp;
+      }
+    } else if (is_claim_frame && (f.id & 0xFF) == 0xFE) {
+      (name_of(f) == rival_name ? rival_cannot : our_cannot) = r.timestamp;
+    } else if ((f.id & 0xFF) == 0x80) {
+      ++other_from_80;
+      if (first_other < 0) first_other = r.timestamp;
+    }
+  }
+  auto at = [&](std::int64_t t) {
+    return t < 0 ? -1.0 : static_cast<double>(t - ours_first) * 1e-3;
+  };
+  std::printf(
+      "claim (%s): craneassist's claim at 0, the rival's at %.1f ms, craneassist again at %.1f ms, "
+      "its Cannot Claim at %.1f ms, the rival's Cannot Claim at %.1f ms; %d other frames from "
+      "0x80, the first %.1f ms after craneassist's last claim\n",
+      outcome.c_str(), at(rival_claim), at(ours_after_rival), at(our_cannot), at(rival_cannot),
+      other_from_80, first_other < 0 ? -1.0 : static_cast<double>(first_other - ours_last) * 1e-3);
+  if (ours_first < 0 || rival_claim < ours_first) return 1;
+  if (outcome == "lost") return our_cannot > rival_claim && other_from_80 == 0 ? 0 : 1;
+  return ours_after_rival > rival_claim && rival_cannot > ours_after_rival && our_cannot < 0 &&
+                 first_other - ours_last >= 250000
+             ? 0
+             : 1;
+}
+
 }  // namespace
 
 // Fault injection must wait for the run to move: a fixed sleep does not, when a loaded host
@@ -529,11 +642,14 @@ int main(int argc, char** argv) {
   if (mode == "direction" && argc == 4) return direction(argv[2], std::strtod(argv[3], nullptr));
   if (mode == "safe" && argc == 5) return safe(argv[2], argv[3], std::strtod(argv[4], nullptr));
   if (mode == "stop" && argc == 4) return stop(argv[2], std::strtod(argv[3], nullptr));
+  if (mode == "claim" && argc == 5) {
+    return claim(argv[2], argv[3], std::strtoull(argv[4], nullptr, 16));
+  }
   if (mode == "wait-motion" && argc == 4)
     return wait_motion(argv[2], std::strtod(argv[3], nullptr));
   if (mode == "tables" && argc == 5) return tables(argv[2], argv[3], std::strtod(argv[4], nullptr));
-  std::fprintf(
-      stderr,
-      "usage: can_backend_check compare|traffic|direction|safe|stop|wait-motion|tables ...\n");
+  std::fprintf(stderr,
+               "usage: can_backend_check "
+               "compare|traffic|direction|safe|stop|claim|wait-motion|tables ...\n");
   return 2;
 }

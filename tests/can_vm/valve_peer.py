@@ -103,7 +103,13 @@ UNIT_SCALE = {
     "rad": 1.0, "deg": math.pi / 180.0, "m": 1.0, "mm": 1e-3, "cm": 1e-2,
     "Pa": 1e-5, "kPa": 1e-2, "MPa": 10.0, "bar": 1.0,  # pressures to bar
     "L/min": 1.0, "m^3/s": 60000.0,  # flows to L/min
+    "%": 1.0, "": 1.0, "1": 1.0,  # valve replies, DM1, NAME fields: as the DBC states them
 }
+# The peer's own J1939 NAME for the valve group's address claim (any value; it only has to be a
+# NAME): identity number 0x2A, function 129, industry group 2.
+PEER_NAME = dict(IdentityNumber=0x2A, ManufacturerCode=0, EcuInstance=0, FunctionInstance=0,
+                 Function=129, Reserved=0, VehicleSystem=0, VehicleSystemInstance=0, IndustryGroup=2,
+                 ArbitraryAddressCapable=0)
 ISO_STATES = {0: "block", 1: "extend", 2: "retract", 3: "float", 15: "dont_care"}
 FAIL_SAFE_CODES = {"block": 0, "float": 1}
 HEARTBEAT_ENABLED = 1
@@ -187,7 +193,12 @@ class Peer:
         self.failures = []
         self.sections = {}  # (id, extended) -> Section
         self.heartbeat = None
-        self.feedback = []  # (frame, [(signal, getter)])
+        self.claim_frame = None
+        self.claims = []  # (monotonic time, NAME) of craneassist's address claims
+        self.first_section_command = None
+        self.feedback = []  # (frame, [(signal, getter)], period in s: 0 every tick, None once)
+        self.next_send = {}
+        self.reserved = {}
         self.joint_state = {}
         self.unknown = {}
         self.foreign = {}
@@ -223,18 +234,20 @@ class Peer:
                     self.sections[key] = Section(f, m.group(1), "avc")
                 elif "AliveCounter" in names:
                     self.heartbeat = f
+                elif "IdentityNumber" in names:
+                    self.claim_frame = f  # craneassist's J1939 address claim
                 elif f.name.endswith("_valve_command") and len(f.signals) == 1:
                     self.sections[key] = Section(f, f.name[: -len("_valve_command")], "signal")
                 else:
                     sys.exit(f"valve_peer: {f.name}: a craneassist message this peer does not know")
             else:
                 for s in f.signals:
-                    machine_signals[s.name] = (f, s)
+                    machine_signals[(f.name, s.name)] = (f, s)
         for sec in self.sections.values():
             if sec.joint not in JOINTS:
                 sys.exit(f"valve_peer: {sec.name}: joint '{sec.joint}' not in the joint table")
         for joint, j in JOINTS.items():
-            if f"{joint}_position" not in machine_signals:
+            if (f"{joint}_position", f"{joint}_position") not in machine_signals:
                 sys.exit(f"valve_peer: the DBC has no {joint}_position signal")
             self.joint_state[joint] = dict(q=j["start"], open=0.0)
         # Every machine message with the value each of its signals reports.
@@ -246,8 +259,15 @@ class Peer:
             for s in sigs:
                 if s.unit not in UNIT_SCALE:
                     sys.exit(f"valve_peer: {f.name}.{s.name}: unit '{s.unit}' not known")
-                getters.append((s, self._getter(s.name)))
-            self.feedback.append((f, getters))
+                getters.append((s, self._getter(f, s)))
+            # Positions, pressures, the pump and the valves' replies every tick; DM1 at its
+            # cycle (1 s); the valve group's address claim once, at the start.
+            period = 0.0
+            if f.name.startswith("AddressClaimed"):
+                period = None
+            elif f.name.startswith("DM1_"):
+                period = (f.cycle_time or 1000) / 1000.0
+            self.feedback.append((f, getters, period))
         self.feedback.sort(key=lambda item: item[0].name)
         # The heartbeat's timeout: the DBC comment states it ("... not advanced for 100 ms").
         self.hb_timeout = self.args.heartbeat_timeout
@@ -256,7 +276,37 @@ class Peer:
             self.hb_timeout = float(m.group(1)) / 1000.0 if m else 0.1
         self.hb_cycle_s = (self.heartbeat.cycle_time or 0) / 1000.0 if self.heartbeat else 0.0
 
-    def _getter(self, name):
+    def _section_of(self, frame):
+        m = re.search(r"joint (\w+)", frame.comment or "")
+        for sec in self.sections.values():
+            if m and sec.joint == m.group(1):
+                return sec
+        sys.exit(f"valve_peer: {frame.name}: no valve section named in its DBC comment")
+
+    def _getter(self, frame, signal):
+        name = signal.name
+        if frame.name.startswith("AuxValveEstimatedFlow"):
+            # The valve's own report of what it does: its effective spool (0 in fail-safe).
+            sec = self._section_of(frame)
+            spool = lambda: self.effective_spool(sec)  # noqa: E731
+            return {
+                "ExtendPortEstimatedFlow": lambda: max(spool(), 0.0) * 100.0,
+                "RetractPortEstimatedFlow": lambda: max(-spool(), 0.0) * 100.0,
+                "ValveState": lambda: 1 if spool() > 0 else (2 if spool() < 0 else 0),
+                "FailSafeMode": lambda: FAIL_SAFE_CODES[self.args.fail_safe],
+                "LimitStatus": lambda: 0,
+            }.get(name) or sys.exit(f"valve_peer: {frame.name}.{name}: not known")
+        if frame.name.startswith("DM1_"):  # no active fault: lamps off, no DTC, no flash
+            return lambda: 255 if name == "LampFlash" else 0
+        if frame.name.startswith("AddressClaimed"):
+            if name not in PEER_NAME:
+                sys.exit(f"valve_peer: {frame.name}.{name}: not a NAME field")
+            return lambda: PEER_NAME[name]
+        if name.endswith("_valve_status"):  # the driver's status: its value named "ok"
+            ok = [v for v, text in (signal.values or {}).items() if text == "ok"]
+            if not ok:
+                sys.exit(f"valve_peer: {frame.name}.{name}: no value named ok")
+            return lambda: int(ok[0])
         m = re.fullmatch(r"(\w+)_(position|pressure_a|pressure_b)", name)
         if m and m.group(1) in JOINTS:
             joint, what = m.group(1), m.group(2)
@@ -309,7 +359,17 @@ class Peer:
         if frame is self.heartbeat:
             self.on_heartbeat(values, msg.timestamp, now)
             return
+        if frame is self.claim_frame:
+            word = int.from_bytes(data, "little")
+            if self.claims and self.claims[-1][1] != word:
+                self.violation(f"{frame.name}: the NAME changed ({word:#018x})")
+            if any(sec.count for sec in self.sections.values()):
+                self.violation(f"{frame.name}: a claim after valve commands")
+            self.claims.append((now, word))
+            return
         sec = self.sections[key]
+        if self.first_section_command is None:
+            self.first_section_command = now
         sec.count += 1
         sec.stats.add(msg.timestamp, self.loop_running())
         sec.last_rx = now
@@ -493,6 +553,9 @@ class Peer:
         if msg is None:
             # canmatrix 0.9.5's Frame.encode takes raw values.
             data = bytes(frame.encode({s.name: r for (s, _), r in zip(getters, raws)}))
+            if frame.is_j1939:  # J1939: bits no signal covers are reserved, sent as 1
+                data = (int.from_bytes(data, "little") | self.reserved_bits(frame)).to_bytes(
+                    len(data), "little")
             msg = can.Message(arbitration_id=frame.arbitration_id.id,
                               is_extended_id=frame.arbitration_id.extended, data=data)
             if len(self.encode_cache) > 4096:
@@ -501,8 +564,21 @@ class Peer:
             self.encodings += 1
         return msg
 
+    def reserved_bits(self, frame):
+        mask = self.reserved.get(frame.name)
+        if mask is None:
+            ones = {s.name: (-1 if s.is_signed else (1 << s.size) - 1) for s in frame.signals}
+            covered = int.from_bytes(bytes(frame.encode(ones)), "little")
+            mask = ~covered & ((1 << (8 * frame.size)) - 1)
+            self.reserved[frame.name] = mask
+        return mask
+
     def send_feedback(self, bus, now):
-        for frame, getters in self.feedback:
+        for frame, getters, period in self.feedback:
+            due = self.next_send.get(frame.name, now)
+            if due is None or now < due:
+                continue
+            self.next_send[frame.name] = None if period is None else now + period
             try:
                 bus.send(self.message(frame, getters))
                 self.sent += 1
@@ -578,6 +654,8 @@ class Peer:
         if self.heartbeat is not None:
             self.report_heartbeat(fail)
         self.report_feedback(fail)
+        if self.claim_frame is not None:
+            self.report_claim(fail)
         if self.unknown:
             fail.append("frames foreign to the DBC: " + ", ".join(
                 f"{hex_id(i, e)} x{n}" for (i, e), n in sorted(self.unknown.items())))
@@ -593,6 +671,19 @@ class Peer:
             say(f"FAIL: {f}")
         say("PASS: every check" if not fail else f"FAIL: {len(fail)} checks failed")
         return 1 if fail else 0
+
+    def report_claim(self, fail):
+        """J1939-81: craneassist claims its address, then waits 250 ms before it sends from it."""
+        if not self.claims:
+            fail.append(f"{self.claim_frame.name}: craneassist never claimed its address")
+            return
+        last = self.claims[-1][0]
+        gap = (self.first_section_command - last) * 1e3 if self.first_section_command else None
+        say(f"address claim: {len(self.claims)} claims, NAME {self.claims[-1][1]:#018x}; the first "
+            f"valve command {gap:.0f} ms after the last claim" if gap is not None else
+            f"address claim: {len(self.claims)} claims, no valve command")
+        if gap is not None and gap < 250.0 - 5.0:  # 5 ms: the peer's own tick
+            fail.append(f"a valve command {gap:.0f} ms after the address claim (J1939-81: 250 ms)")
 
     def period_ok(self, what, stats, nominal_s, fail):
         mean = stats.mean()

@@ -4,9 +4,13 @@
 //    decomposed identifier's PGN gives that PGN back;
 //  - the ISO 11783-7 auxiliary valve codec (can/iso11783_valve.hpp): the command, measured flow
 //    and estimated flow decoders; a decoded command encodes to a frame that decodes the same;
+//  - J1939 network management and diagnostics (can/address_claim.hpp, can/dm1.hpp): Address
+//    Claimed, Request, DM1 and its TP.CM announcement decode to what encodes the same frame; an
+//    AddressClaimer fed every frame only ever sends claims of its address or Cannot Claim;
 //  - the shipped signal mappings (config/can/*.yaml): every joint's position and pressure
 //    signals, the valve command decoder of the machine emulator, the heartbeat and its monitor;
-//  - the CAN backend itself (can::CanBackend) on an in-memory bus: what the control loop reads.
+//  - the CAN backend itself (can::CanBackend) on an in-memory bus: what the control loop reads,
+//    with the shipped mappings' address claim, valve replies and DM1 supervision.
 // The input is a sequence of 14-byte records: identifier (4 bytes, little endian; bit 31: a
 // 29-bit identifier), dlc, 8 data bytes, and a byte of flags for the backend (bit 0: call
 // read(), bit 1: enable()).
@@ -17,7 +21,9 @@
 #include <cstring>
 #include <memory>
 
+#include "craneassist/can/address_claim.hpp"
 #include "craneassist/can/can_backend.hpp"
+#include "craneassist/can/dm1.hpp"
 #include "craneassist/can/heartbeat.hpp"
 #include "craneassist/can/iso11783_valve.hpp"
 #include "craneassist/can/j1939.hpp"
@@ -112,6 +118,54 @@ void check_iso11783(const can::CanFrame& frame) {
   }
 }
 
+void check_network(const can::CanFrame& frame, double t_s) {
+  std::uint64_t name = 0;
+  std::uint8_t source = 0;
+  if (j1939::decode_address_claimed(frame, name, source)) {
+    can::CanFrame again;
+    j1939::encode_address_claimed(name, source, again);
+    std::uint64_t back = 0;
+    std::uint8_t back_source = 0;
+    FUZZ_CHECK(j1939::decode_address_claimed(again, back, back_source) && back == name &&
+                   back_source == source,
+               "an Address Claimed survives encode and decode");
+    FUZZ_CHECK(j1939::pack_name(j1939::unpack_name(name)) == (name & ~(std::uint64_t{1} << 48)),
+               "the NAME's fields hold every bit but the reserved one");
+  }
+  std::uint32_t requested = 0;
+  std::uint8_t destination = 0;
+  if (j1939::decode_request(frame, requested, destination)) {
+    FUZZ_CHECK(requested <= 0xFFFFFF && frame.dlc >= 3, "a request names a 3-byte PGN");
+  }
+  j1939::Dm1 dm1;
+  const j1939::Dm1Status status = j1939::decode_dm1(frame, dm1, source);
+  if (status == j1939::Dm1Status::kOk) {
+    FUZZ_CHECK(dm1.spn <= 0x7FFFF && dm1.fmi < 32 && dm1.occurrence_count < 128,
+               "DM1 fields within their bits");
+    can::CanFrame again;
+    j1939::encode_dm1(dm1, source, again);
+    FUZZ_CHECK(std::memcmp(again.data.data(), frame.data.data(), 6) == 0,
+               "a DM1's lamps and DTC survive encode");
+    (void)j1939::dm1_requires_stop(dm1);
+  } else {
+    FUZZ_CHECK(status == j1939::Dm1Status::kNotDm1 || frame.dlc < 6, "only a short DM1 is short");
+  }
+  std::uint16_t size = 0;
+  (void)j1939::decode_dm1_announcement(frame, source, size);
+  // A claimer that sees every frame: whatever it answers is its claim or a Cannot Claim.
+  static j1939::AddressClaimer claimer(0x80, 0x3000820000000C1Aull);
+  const auto now_us = static_cast<std::int64_t>(t_s * 1e6);
+  can::CanFrame out;
+  if (claimer.state() == j1939::ClaimState::kIdle) claimer.start(now_us, out);
+  for (const auto action : {claimer.on_frame(frame, now_us, out), claimer.poll(now_us, out)}) {
+    if (action == j1939::AddressClaimer::Action::kNone) continue;
+    FUZZ_CHECK(j1939::decode_address_claimed(out, name, source) && name == claimer.name() &&
+                   (source == 0x80 || source == j1939::kNullAddress),
+               "the claimer sends only its claim or Cannot Claim");
+  }
+  (void)j1939::to_string(claimer.state());
+}
+
 void check_signal(const can::SignalSpec& spec, const can::CanFrame& frame) {
   double value = 0.0;
   const can::SignalStatus status = can::decode(spec, frame, value);
@@ -193,6 +247,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
     check_j1939(frame);
     check_iso11783(frame);
+    check_network(frame, t_s);
     for (Machine& m : machines) {
       check_mapping(m, frame, t_s);
       can::Received received;

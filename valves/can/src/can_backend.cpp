@@ -8,6 +8,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "can_backend_impl.hpp"
 #include "craneassist/can/heartbeat.hpp"
 #include "craneassist/can/valve_frames.hpp"
 #include "craneassist/config/config_error.hpp"
@@ -32,132 +33,19 @@ const char* to_string(FaultReason reason) {
       return "send errors";
     case FaultReason::kLoopFrozen:
       return "control loop frozen";
+    case FaultReason::kAddressLost:
+      return "address lost";
+    case FaultReason::kValveFault:
+      return "valve fault";
+    case FaultReason::kValveReplyLost:
+      return "valve reply lost";
+    case FaultReason::kDm1Fault:
+      return "DM1 fault";
   }
   return "?";
 }
 
-namespace {
-
-std::int64_t mono_us() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1000000 + ts.tv_nsec / 1000;
-}
-
-struct LogEntry {
-  CanFrame frame;
-  TimestampUs t_us = 0;
-  CandumpDirection direction = CandumpDirection::kNone;  // sent or received
-};
-
-// Single producer, single consumer; a full ring drops the entry (counted by the caller).
-class LogRing {
- public:
-  explicit LogRing(std::size_t capacity) : buf_(capacity + 1) {}
-  bool push(const CanFrame& f, TimestampUs t, CandumpDirection direction) {
-    const std::size_t h = head_.load(std::memory_order_relaxed);
-    const std::size_t next = (h + 1) % buf_.size();
-    if (next == tail_.load(std::memory_order_acquire)) return false;
-    buf_[h].frame = f;
-    buf_[h].t_us = t;
-    buf_[h].direction = direction;
-    head_.store(next, std::memory_order_release);
-    return true;
-  }
-  bool pop(LogEntry& e) {
-    const std::size_t t = tail_.load(std::memory_order_relaxed);
-    if (t == head_.load(std::memory_order_acquire)) return false;
-    e = buf_[t];
-    tail_.store((t + 1) % buf_.size(), std::memory_order_release);
-    return true;
-  }
-
- private:
-  std::vector<LogEntry> buf_;
-  std::atomic<std::size_t> head_{0}, tail_{0};
-};
-
-struct AtomicCounters {
-  std::atomic<std::uint64_t> frames_sent{0}, frames_received{0}, send_queue_full{0}, send_errors{0},
-      unknown_frames{0}, bad_frames{0}, unsupported_frames{0}, bus_error_frames{0},
-      receive_errors{0}, watchdog_block_frames{0}, faults{0}, log_dropped{0}, heartbeats_sent{0};
-};
-
-constexpr int kMaxDrainPerRead = 512;
-
-}  // namespace
-
-struct CanBackend::Impl {
-  Impl(Transport& t, const CanBackendOptions& o)
-      : transport(t), options(o), control_ring(o.log_capacity), watchdog_ring(o.log_capacity) {}
-
-  struct Joint {
-    JointMapping map;
-    double area_ratio = 0.0;  // A_B / A_A
-    std::int64_t cycle_us = 20000;
-    std::int64_t last_sent_us = 0;           // control thread
-    std::int64_t watchdog_last_sent_us = 0;  // watchdog thread
-    CanFrame block_frame;                    // preencoded
-    CanFrame command_frame;
-    bool seen = false;
-    // The newest position frame: its receive stamp (CLOCK_REALTIME, the kernel's; for the
-    // velocity estimate and the log) and when read() took it (CLOCK_MONOTONIC; for freshness,
-    // so a wall-clock step neither hides lost feedback nor fakes it).
-    TimestampUs last_position_us = 0;
-    std::int64_t last_position_mono_us = 0;
-    double q = 0.0, qdot = 0.0, pa = 0.0, pb = 0.0;
-  };
-
-  Transport& transport;
-  CanBackendOptions options;
-  std::vector<Joint> joints;
-  std::int64_t start_us = mono_us();
-  std::atomic<std::int64_t> last_write_us{0};
-  std::atomic<double> fault_time_s{NAN};
-  bool block_sent_after_fault = false;
-  int consecutive_send_errors = 0;
-  AtomicCounters counters;
-  LogRing control_ring, watchdog_ring;
-  std::FILE* log_file = nullptr;
-  char reason_text[256] = {};
-  std::atomic<bool> stop{false};
-  std::thread watchdog, logger;
-  std::mutex stop_mutex;
-  Received rx;
-  // Pump measurements (when the mapping has them): control thread only.
-  PumpMapping pump_map;
-  double pump_pressure_pa = 0.0, pump_flow_m3_s = 0.0, pump_energy_j = 0.0;
-  std::int64_t pump_last_us = 0;        // newest pump frame, taken (CLOCK_MONOTONIC)
-  std::int64_t pump_integrated_us = 0;  // mono time of the last energy step
-  // The heartbeat (when the mapping has one): control thread only.
-  std::optional<HeartbeatSpec> heartbeat;
-  std::int64_t heartbeat_cycle_us = 0;
-  std::int64_t heartbeat_last_us = 0;
-  Heartbeat heartbeat_next;
-  CanFrame heartbeat_frame;
-};
-
-namespace {
-
-// Sends one frame and accounts for it: counted as sent and copied to the log ring, or counted
-// as a full queue or a send error. Non-blocking, allocation-free.
-template <class Counters, class Ring>
-SendStatus send_counted(Transport& transport, Counters& counters, Ring& ring, bool logging,
-                        const CanFrame& frame, TimestampUs now_rt_us) {
-  const SendStatus st = transport.send(frame);
-  if (st == SendStatus::kOk) {
-    counters.frames_sent.fetch_add(1, std::memory_order_relaxed);
-    if (logging && !ring.push(frame, now_rt_us, CandumpDirection::kTx)) {
-      counters.log_dropped.fetch_add(1, std::memory_order_relaxed);
-    }
-  } else {
-    (st == SendStatus::kQueueFull ? counters.send_queue_full : counters.send_errors)
-        .fetch_add(1, std::memory_order_relaxed);
-  }
-  return st;
-}
-
-}  // namespace
+using namespace backend_detail;
 
 CanBackend::CanBackend(const CanMapping& mapping, const dynamics::CraneModel& model,
                        Transport& transport, const CanBackendOptions& options)
@@ -189,6 +77,28 @@ CanBackend::CanBackend(const CanMapping& mapping, const dynamics::CraneModel& mo
     impl_->heartbeat = *mapping.heartbeat;
     impl_->heartbeat_cycle_us =
         static_cast<std::int64_t>(std::llround(mapping.heartbeat->cycle_s * 1e6));
+  }
+  if (mapping.address_claim) {
+    // Frames that carry the claimed address as their J1939 source (every AVC command, by the
+    // mapping's checks; a 29-bit heartbeat or signal output whose low byte is the address).
+    const std::uint8_t address = mapping.address_claim->address;
+    const auto from_address = [address](const CanFrame& f) {
+      return f.extended && (f.id & 0xFFu) == address;
+    };
+    impl_->claimer.emplace(address, mapping.address_claim->name, mapping.address_claim->timeout_s);
+    impl_->has_claim = true;
+    for (auto& j : impl_->joints) j.from_claimed_address = from_address(j.block_frame);
+    impl_->heartbeat_from_claimed_address = mapping.heartbeat && mapping.heartbeat->extended &&
+                                            (mapping.heartbeat->id & 0xFFu) == address;
+  } else {
+    impl_->claim_state.store(j1939::ClaimState::kClaimed);
+  }
+  if (mapping.dm1) {
+    for (std::uint8_t a : mapping.dm1->source_addresses) {
+      Impl::Dm1Node node;
+      node.source_address = a;
+      impl_->dm1_nodes.push_back(node);
+    }
   }
   if (!options.candump_log.empty()) {
     impl_->log_file = std::fopen(options.candump_log.c_str(), "w");
@@ -252,8 +162,16 @@ void CanBackend::enable() {
   impl_->fault_time_s.store(NAN);
   impl_->block_sent_after_fault = false;
   impl_->consecutive_send_errors = 0;
+  // The valves' replies are judged afresh from here (a fault they still report latches again).
+  impl_->supervised_since_us = 0;
+  for (auto& j : impl_->joints) j.not_following_since_us = 0;
   fault_.store(kClear, std::memory_order_release);
   enabled_.store(true, std::memory_order_release);
+  // Not (or no longer) holding the address: claim it; the valves stay blocked until then.
+  if (impl_->claimer && (impl_->claimer->state() == j1939::ClaimState::kIdle ||
+                         impl_->claimer->state() == j1939::ClaimState::kLost)) {
+    start_claim(mono_us());
+  }
 }
 
 std::string CanBackend::fault_text() const {
@@ -281,7 +199,14 @@ CanBackendCounters CanBackend::counters() const {
   out.faults = c.faults.load();
   out.log_dropped = c.log_dropped.load();
   out.heartbeats_sent = c.heartbeats_sent.load();
+  out.claim_frames_sent = c.claim_frames_sent.load();
+  out.valve_replies = c.valve_replies.load();
+  out.dm1_messages = c.dm1_messages.load();
   return out;
+}
+
+j1939::ClaimState CanBackend::address_claim_state() const {
+  return impl_->claim_state.load(std::memory_order_acquire);
 }
 
 valves::BackendStatus CanBackend::read(valves::MachineState& state) {
@@ -326,7 +251,9 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
         !m.control_ring.push(f, m.rx.timestamp_us, CandumpDirection::kRx)) {
       m.counters.log_dropped.fetch_add(1, std::memory_order_relaxed);
     }
-    bool known = false;
+    // Network management, valve replies and DM1 (a reply's status may share a frame with
+    // feedback signals, so the frame goes on to them as well).
+    bool known = on_supervised_frame(f, taken_us);
     for (auto& j : m.joints) {
       auto matches = [&f](const SignalSpec& s) { return s.id == f.id && s.extended == f.extended; };
       double value = 0.0;
@@ -382,6 +309,7 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
   }
 
   const std::int64_t now = mono_us();
+  supervise(now);
   const auto timeout_us = static_cast<std::int64_t>(m.options.feedback_timeout_s * 1e6);
   bool fresh = true;
   state.q.resize(n);
@@ -405,7 +333,8 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
   }
   state.t_s = static_cast<double>(mono_us() - m.start_us) * 1e-6;
   read_pump(state.pump, now, timeout_us);
-  state.valid = fresh && !faulted();
+  // Until the address is claimed the valves are not commanded: no state to control from.
+  state.valid = fresh && !faulted() && m.claimed();
   if (faulted()) return valves::BackendStatus::kFault;
   return state.valid ? valves::BackendStatus::kOk : valves::BackendStatus::kNoData;
 }
@@ -446,6 +375,7 @@ valves::BackendStatus CanBackend::write(const valves::ValveCommand& command) {
   const TimestampUs now_rt = m.log_file != nullptr ? realtime_now_us() : 0;
   for (std::size_t i = 0; i < m.joints.size(); ++i) {
     auto& j = m.joints[i];
+    if (!m.may_send(j.from_claimed_address)) continue;  // J1939: not from an unclaimed address
     if (!force && now - j.last_sent_us < j.cycle_us - kEarlyUs) continue;
     const double spool = safe || static_cast<Eigen::Index>(i) >= command.spool.size()
                              ? 0.0
@@ -457,6 +387,7 @@ valves::BackendStatus CanBackend::write(const valves::ValveCommand& command) {
     const SendStatus st = send_counted(m.transport, m.counters, m.control_ring,
                                        m.log_file != nullptr, *frame, now_rt);
     j.last_sent_us = now;
+    j.note_command(*frame);
     if (st == SendStatus::kOk) {
       m.consecutive_send_errors = 0;
     } else {
@@ -467,7 +398,8 @@ valves::BackendStatus CanBackend::write(const valves::ValveCommand& command) {
     }
   }
   if (force) m.block_sent_after_fault = true;
-  if (m.heartbeat && (force || now - m.heartbeat_last_us >= m.heartbeat_cycle_us - kEarlyUs)) {
+  if (m.heartbeat && m.may_send(m.heartbeat_from_claimed_address) &&
+      (force || now - m.heartbeat_last_us >= m.heartbeat_cycle_us - kEarlyUs)) {
     send_heartbeat(now, now_rt);
   }
   if (faulted()) return valves::BackendStatus::kFault;
@@ -492,10 +424,33 @@ void CanBackend::send_heartbeat(std::int64_t now_us, std::int64_t now_rt_us) {
 }
 
 bool CanBackend::activate(double timeout_s, std::string* why) {
+  Impl& m = *impl_;
+  const std::int64_t end = mono_us() + static_cast<std::int64_t>(timeout_s * 1e6);
+  // The claim (J1939-81: 250 ms for a contending claim) runs while the feedback comes in.
+  if (m.claimer && m.claimer->state() != j1939::ClaimState::kClaimed &&
+      m.claimer->state() != j1939::ClaimState::kClaiming) {
+    start_claim(mono_us());
+  }
   valves::MachineState state;
-  if (!wait_for_feedback(timeout_s, state)) {
-    if (why != nullptr) *why = "no position feedback of every joint within the timeout";
-    return false;
+  for (;;) {
+    read(state);
+    if (m.claimer && m.claimer->state() == j1939::ClaimState::kLost) {
+      if (why != nullptr) *why = fault_text();  // latched: "cannot claim address 0x80: ..."
+      return false;
+    }
+    bool all = true;
+    for (const auto& j : m.joints) all = all && j.seen;
+    if (all && m.claimed()) break;
+    const std::int64_t left = end - mono_us();
+    if (left <= 0) {
+      if (why != nullptr) {
+        *why = !all ? "no position feedback of every joint within the timeout"
+                    : "the J1939 address claim did not complete within the timeout";
+      }
+      return false;
+    }
+    m.transport.wait_readable(static_cast<int>(std::min<std::int64_t>(left / 1000 + 1, 10)));
+    m.last_write_us.store(mono_us(), std::memory_order_release);
   }
   enable();
   return true;
@@ -508,11 +463,13 @@ void CanBackend::disable() noexcept {
   const std::int64_t now = mono_us();
   const TimestampUs now_rt = m.log_file != nullptr ? realtime_now_us() : 0;
   for (auto& j : m.joints) {
+    if (!m.may_send(j.from_claimed_address)) continue;
     send_counted(m.transport, m.counters, m.control_ring, m.log_file != nullptr, j.block_frame,
                  now_rt);
     j.last_sent_us = now;
+    j.note_command(j.block_frame);
   }
-  if (m.heartbeat) send_heartbeat(now, now_rt);
+  if (m.heartbeat && m.may_send(m.heartbeat_from_claimed_address)) send_heartbeat(now, now_rt);
   // No further write() is expected: the watchdog's loop-frozen check is disarmed, but it keeps
   // sending block commands at each cycle until stop().
   m.last_write_us.store(1, std::memory_order_release);
@@ -543,6 +500,7 @@ void CanBackend::watchdog_loop() {
     // The loop is not writing: the watchdog keeps the valves blocked itself, at each cycle.
     const TimestampUs now_rt = realtime_now_us();
     for (auto& j : m.joints) {
+      if (!m.may_send(j.from_claimed_address)) continue;
       if (now - j.watchdog_last_sent_us < j.cycle_us - 2000) continue;
       j.watchdog_last_sent_us = now;
       if (send_counted(m.transport, m.counters, m.watchdog_ring, m.log_file != nullptr,

@@ -8,6 +8,8 @@
 #include <map>
 #include <sstream>
 
+#include "craneassist/can/address_claim.hpp"
+#include "craneassist/can/dm1.hpp"
 #include "craneassist/can/iso11783_valve.hpp"
 #include "craneassist/can/j1939.hpp"
 #include "craneassist/config/config_error.hpp"
@@ -514,6 +516,106 @@ OutMessage avc_message(const JointMapping& jm) {
   return m;
 }
 
+// A J1939 broadcast message of fixed layout: its identifier from priority, PGN and sender.
+OutMessage j1939_message(std::string name, std::uint8_t priority, std::uint32_t pgn_value,
+                         std::uint8_t source, std::string sender, std::string comment) {
+  OutMessage m;
+  std::uint32_t id = 0;
+  j1939::make_id(priority, pgn_value, source, j1939::kGlobalAddress, id);
+  m.name = std::move(name);
+  m.id = id;
+  m.extended = true;
+  m.dlc = 8;
+  m.sender = std::move(sender);
+  m.j1939 = true;
+  m.comment = std::move(comment);
+  return m;
+}
+
+void add_field(OutMessage& m, const char* name, std::uint16_t start, std::uint16_t length,
+               double scale, double offset, double lo, double hi, const char* unit,
+               const char* comment, std::vector<std::pair<int, std::string>> values = {}) {
+  const std::string receiver = m.sender == "craneassist" ? "machine" : "craneassist";
+  m.signals.push_back({name, m.name, name, field(m.id, start, length, scale, offset, lo, hi, unit),
+                       receiver, comment, std::move(values)});
+}
+
+std::string hex_address(std::uint8_t a) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "%02X", static_cast<unsigned>(a));
+  return buf;
+}
+
+// J1939-81 Address Claimed from `source`: craneassist's (its NAME, sent at start-up, on a request
+// and on a contending claim) or a supervised node's. A Cannot Claim comes from the null address
+// 0xFE and is not described.
+OutMessage address_claim_message(std::uint8_t source, const std::string& sender,
+                                 const std::string& comment) {
+  OutMessage m = j1939_message("AddressClaimed_" + hex_address(source), j1939::kNetworkPriority,
+                               j1939::kPgnAddressClaimed, source, sender,
+                               "J1939-81 Address Claimed (PGN 60928) " + comment);
+  add_field(m, "IdentityNumber", 0, 21, 1, 0, 0, 2097151, "", "");
+  add_field(m, "ManufacturerCode", 21, 11, 1, 0, 0, 2047, "", "");
+  add_field(m, "EcuInstance", 32, 3, 1, 0, 0, 7, "", "");
+  add_field(m, "FunctionInstance", 35, 5, 1, 0, 0, 31, "", "");
+  add_field(m, "Function", 40, 8, 1, 0, 0, 255, "", "");
+  add_field(m, "Reserved", 48, 1, 1, 0, 0, 1, "", "sent as 0");
+  add_field(m, "VehicleSystem", 49, 7, 1, 0, 0, 127, "", "");
+  add_field(m, "VehicleSystemInstance", 56, 4, 1, 0, 0, 15, "", "");
+  add_field(m, "IndustryGroup", 60, 3, 1, 0, 0, 7, "", "");
+  add_field(m, "ArbitraryAddressCapable", 63, 1, 1, 0, 0, 1, "", "");
+  return m;
+}
+
+// ISO 11783-7 Auxiliary Valve Estimated Flow of a supervised valve (docs/can.md, "Valve
+// supervision"). The mapping does not state the valve's send rate, so no cycle time is given.
+OutMessage estimated_flow_message(const JointMapping& jm) {
+  const std::uint8_t valve = jm.valve.avc.valve;
+  OutMessage m = j1939_message(
+      "AuxValveEstimatedFlow" + std::to_string(valve), iso11783::kDefaultPriority,
+      iso11783::kPgnAuxValveEstimatedFlow0 + valve, jm.reply->source_address, "machine",
+      "ISO 11783-7 Auxiliary Valve " + std::to_string(valve) + " Estimated Flow (PGN " +
+          std::to_string(iso11783::kPgnAuxValveEstimatedFlow0 + valve) + "), joint " + jm.name +
+          ": supervised, at least every " + number_text(jm.reply->timeout_s * 1e3) + " ms");
+  add_field(m, "ExtendPortEstimatedFlow", 0, 8, 1, -125, -125, 125, "%", "");
+  add_field(m, "RetractPortEstimatedFlow", 8, 8, 1, -125, -125, 125, "%", "");
+  auto states = kValveStates;
+  states.insert(states.end() - 1, {14, "error"});
+  add_field(m, "ValveState", 16, 4, 1, 0, 0, 15, "", "the valve's state", states);
+  add_field(m, "FailSafeMode", 22, 2, 1, 0, 0, 3, "", "", kFailSafeModes);
+  add_field(m, "LimitStatus", 29, 3, 1, 0, 0, 7, "", "6: non-recoverable fault",
+            {{0, "not_limited"},
+             {1, "operator_limited"},
+             {2, "limited_high"},
+             {3, "limited_low"},
+             {6, "non_recoverable_fault"},
+             {7, "not_available"}});
+  return m;
+}
+
+// J1939-73 DM1 of a supervised node, single-frame form. The SPN's 19 bits are split as the frame
+// splits them: the low 16 in bytes 3-4, the high 3 in byte 5 bits 6-8 (SPN = low + high * 65536).
+OutMessage dm1_message(std::uint8_t source) {
+  OutMessage m = j1939_message(
+      "DM1_" + hex_address(source), j1939::kNetworkPriority, j1939::kPgnDm1, source, "machine",
+      "J1939-73 DM1 Active Diagnostic Trouble Codes of node 0x" + hex_address(source) +
+          ": an active DTC or the red stop lamp stops the crane (docs/can.md)");
+  const std::vector<std::pair<int, std::string>> lamp = {
+      {0, "off"}, {1, "on"}, {2, "error"}, {3, "not_available"}};
+  add_field(m, "ProtectLamp", 0, 2, 1, 0, 0, 3, "", "", lamp);
+  add_field(m, "AmberWarningLamp", 2, 2, 1, 0, 0, 3, "", "", lamp);
+  add_field(m, "RedStopLamp", 4, 2, 1, 0, 0, 3, "", "", lamp);
+  add_field(m, "MalfunctionIndicatorLamp", 6, 2, 1, 0, 0, 3, "", "", lamp);
+  add_field(m, "LampFlash", 8, 8, 1, 0, 0, 255, "", "");
+  add_field(m, "SpnLow", 16, 16, 1, 0, 0, 65535, "", "SPN bits 0-15");
+  add_field(m, "Fmi", 32, 5, 1, 0, 0, 31, "", "failure mode identifier");
+  add_field(m, "SpnHigh", 37, 3, 1, 0, 0, 7, "", "SPN bits 16-18");
+  add_field(m, "OccurrenceCount", 40, 7, 1, 0, 0, 127, "", "");
+  add_field(m, "SpnConversionMethod", 47, 1, 1, 0, 0, 1, "", "");
+  m.cycle_s = 1.0;
+  return m;
+}
+
 OutMessage heartbeat_message(const HeartbeatSpec& hb) {
   OutMessage m;
   m.name = "craneassist_heartbeat";
@@ -640,6 +742,16 @@ std::string write_dbc(const CanMapping& mapping, std::string_view title) {
     }
   }
   if (mapping.heartbeat) messages.add_message(heartbeat_message(*mapping.heartbeat));
+  if (mapping.address_claim) {
+    char name[24];
+    std::snprintf(name, sizeof name, "0x%016llX",
+                  static_cast<unsigned long long>(mapping.address_claim->name));
+    messages.add_message(
+        address_claim_message(mapping.address_claim->address, "craneassist",
+                              "of craneassist, NAME " + std::string(name) +
+                                  ", before it sends anything from this address (docs/can.md)"));
+    station = mapping.address_claim->address;
+  }
   // Feedback: what the machine sends. Its cycle is the machine's; the mapping does not say it.
   for (const auto& jm : mapping.joints) {
     const std::string owner = identifier(jm.name);
@@ -671,6 +783,47 @@ std::string write_dbc(const CanMapping& mapping, std::string_view title) {
                     {}},
                    "machine", 0.0);
     }
+  }
+  // The valves' replies: Estimated Flow of ISO 11783 valves, a driver's status signal; DM1.
+  for (const auto& jm : mapping.joints) {
+    if (!jm.reply) continue;
+    if (jm.valve.kind == ValveOutputKind::kIso11783Avc) {
+      messages.add_message(estimated_flow_message(jm));
+    } else {
+      const std::string owner = identifier(jm.name);
+      std::vector<std::pair<int, std::string>> ok;
+      for (const std::uint64_t v : jm.reply->ok_values) ok.emplace_back(static_cast<int>(v), "ok");
+      messages.add({owner + "_valve_status", owner, "valve_status", in_file_units(jm.reply->status),
+                    "craneassist",
+                    "joint " + jm.name +
+                        ": the valve driver's status; a value not marked ok is "
+                        "a fault, supervised, at least every " +
+                        number_text(jm.reply->timeout_s * 1e3) + " ms",
+                    ok},
+                   "machine", 0.0);
+    }
+  }
+  if (mapping.dm1) {
+    for (const std::uint8_t sa : mapping.dm1->source_addresses) {
+      messages.add_message(dm1_message(sa));
+    }
+  }
+  // The supervised J1939 nodes claim their addresses too.
+  std::vector<std::uint8_t> nodes;
+  for (const auto& jm : mapping.joints) {
+    if (jm.reply && jm.valve.kind == ValveOutputKind::kIso11783Avc) {
+      nodes.push_back(jm.reply->source_address);
+    }
+  }
+  if (mapping.dm1) {
+    nodes.insert(nodes.end(), mapping.dm1->source_addresses.begin(),
+                 mapping.dm1->source_addresses.end());
+  }
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  for (const std::uint8_t sa : nodes) {
+    if (mapping.address_claim && sa == mapping.address_claim->address) continue;
+    messages.add_message(address_claim_message(sa, "machine", "of a supervised node"));
   }
   if (mapping.pump.pressure) {
     messages.add({"pump_pressure",

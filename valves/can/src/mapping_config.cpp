@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <initializer_list>
 #include <optional>
 #include <sstream>
 
+#include "craneassist/can/address_claim.hpp"
 #include "craneassist/can/dbc.hpp"
 #include "craneassist/can/valve_frames.hpp"
 #include "craneassist/config/config_error.hpp"
@@ -93,8 +95,12 @@ class Reader : public config::YamlReader {
   // A non-negative integer, decimal or 0x-prefixed hex, at most max_value.
   std::uint64_t integer(const YAML::Node& map, const std::string& key, const std::string& path,
                         std::uint64_t max_value) const {
-    const YAML::Node node = child(map, key, path);
-    const std::string field = join(path, key);
+    return integer(child(map, key, path), join(path, key), max_value);
+  }
+
+  // The same for a node itself (a list entry).
+  std::uint64_t integer(const YAML::Node& node, const std::string& field,
+                        std::uint64_t max_value) const {
     const std::string s = text(node, field);
     std::uint64_t v = 0;
     const bool hex = s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
@@ -228,13 +234,8 @@ SignalSpec read_dbc_signal(const Reader& r, const YAML::Node& node, const std::s
   return s;
 }
 
-SignalSpec read_signal(const Reader& r, const YAML::Node& node, const std::string& path,
-                       SignalUse use, std::initializer_list<const char*> keys,
-                       PositionKind* kind_out) {
-  if (node.IsMap() && node["dbc"].IsDefined())
-    return read_dbc_signal(r, node, path, use, keys, kind_out);
-  r.check_keys(node, path, keys);
-  SignalSpec s;
+// Where a signal sits: id, extended, start_bit, length, byte_order, signed.
+void read_layout(const Reader& r, const YAML::Node& node, const std::string& path, SignalSpec& s) {
   s.extended = r.flag(node, "extended", path, false);
   s.id = static_cast<std::uint32_t>(
       r.integer(node, "id", path, s.extended ? kMaxExtendedId : kMaxStandardId));
@@ -258,6 +259,17 @@ SignalSpec read_signal(const Reader& r, const YAML::Node& node, const std::strin
            "the signal (start bit " + std::to_string(s.start_bit) + ", " +
                std::to_string(s.length) + " bits, " + order + ") runs past the 8th data byte");
   }
+}
+
+SignalSpec read_signal(const Reader& r, const YAML::Node& node, const std::string& path,
+                       SignalUse use, std::initializer_list<const char*> keys,
+                       PositionKind* kind_out) {
+  if (node.IsMap() && node["dbc"].IsDefined()) {
+    return read_dbc_signal(r, node, path, use, keys, kind_out);
+  }
+  r.check_keys(node, path, keys);
+  SignalSpec s;
+  read_layout(r, node, path, s);
 
   const YAML::Node unit_node = r.child(node, "unit", path);
   s.unit = r.text(unit_node, Reader::join(path, "unit"));
@@ -294,7 +306,7 @@ constexpr std::initializer_list<const char*> kSignalKeys = {
     "scale", "offset",   "unit",      "min",    "max"};
 
 ValveOutput read_valve(const Reader& r, const YAML::Node& node, const std::string& path) {
-  r.check_keys(node, path, {"iso11783_avc", "signal"});
+  r.check_keys(node, path, {"iso11783_avc", "signal", "reply"});
   const bool has_avc = node["iso11783_avc"].IsDefined();
   const bool has_signal = node["signal"].IsDefined();
   if (has_avc == has_signal) {
@@ -354,6 +366,124 @@ ValveOutput read_valve(const Reader& r, const YAML::Node& node, const std::strin
   return out;
 }
 
+std::string hex_address(std::uint8_t a) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "0x%02X", static_cast<unsigned>(a));
+  return buf;
+}
+
+// A J1939 source address of another node, 0..253, written like `source_address: 0x20`.
+std::uint8_t node_address(const Reader& r, const YAML::Node& map, const std::string& key,
+                          const std::string& path) {
+  return static_cast<std::uint8_t>(r.integer(map, key, path, 253));
+}
+
+// `valve.reply`: the valve's Estimated Flow (ISO 11783-7 valves) or the driver's status signal
+// (signal valves), and how long it may stay away.
+ValveReply read_reply(const Reader& r, const YAML::Node& node, const std::string& path,
+                      const ValveOutput& valve) {
+  ValveReply reply;
+  if (valve.kind == ValveOutputKind::kIso11783Avc) {
+    r.check_keys(node, path, {"source_address", "timeout"});
+    reply.source_address = node_address(r, node, "source_address", path);
+    if (reply.source_address == valve.avc.source_address) {
+      r.fail(node["source_address"], Reader::join(path, "source_address"),
+             "is the command's source address (craneassist's own): the reply comes from the "
+             "valve's address");
+    }
+  } else {
+    r.check_keys(node, path, {"status", "timeout"});
+    const std::string p = Reader::join(path, "status");
+    const YAML::Node st = r.child(node, "status", path);
+    r.check_keys(st, p, {"id", "extended", "start_bit", "length", "byte_order", "ok"});
+    read_layout(r, st, p, reply.status);
+    reply.status.unit = "1";
+    const std::uint64_t max_raw = reply.status.length >= 64
+                                      ? ~std::uint64_t{0}
+                                      : (std::uint64_t{1} << reply.status.length) - 1;
+    const YAML::Node ok = r.child(st, "ok", p);
+    const std::string okp = Reader::join(p, "ok");
+    if (ok.IsSequence()) {
+      if (ok.size() == 0) r.fail(ok, okp, "expected at least one value");
+      for (std::size_t i = 0; i < ok.size(); ++i) {
+        reply.ok_values.push_back(r.integer(ok[i], okp + "[" + std::to_string(i) + "]", max_raw));
+      }
+    } else {
+      reply.ok_values.push_back(r.integer(st, "ok", p, max_raw));
+    }
+  }
+  reply.timeout_s = r.time(node, "timeout", path, 0.02, 5.0, "between 20 ms and 5 s");
+  return reply;
+}
+
+// `address_claim: {address, name, timeout}`; name is the 64-bit NAME or its fields.
+AddressClaimSpec read_address_claim(const Reader& r, const YAML::Node& node) {
+  const std::string path = "address_claim";
+  r.check_keys(node, path, {"address", "name", "timeout"});
+  AddressClaimSpec spec;
+  spec.address = node_address(r, node, "address", path);
+  const YAML::Node name = r.child(node, "name", path);
+  if (name.IsMap()) {
+    const std::string p = "address_claim.name";
+    r.check_keys(name, p,
+                 {"identity_number", "manufacturer_code", "ecu_instance", "function_instance",
+                  "function", "vehicle_system", "vehicle_system_instance", "industry_group",
+                  "arbitrary_address_capable"});
+    auto field = [&](const char* key, std::uint64_t max_value, bool required) -> std::uint64_t {
+      if (!required && !name[key].IsDefined()) return 0;
+      return r.integer(name, key, p, max_value);
+    };
+    j1939::Name n;
+    n.identity_number = static_cast<std::uint32_t>(field("identity_number", 0x1FFFFF, true));
+    n.manufacturer_code = static_cast<std::uint16_t>(field("manufacturer_code", 0x7FF, true));
+    n.ecu_instance = static_cast<std::uint8_t>(field("ecu_instance", 7, false));
+    n.function_instance = static_cast<std::uint8_t>(field("function_instance", 31, false));
+    n.function = static_cast<std::uint8_t>(field("function", 255, true));
+    n.vehicle_system = static_cast<std::uint8_t>(field("vehicle_system", 127, false));
+    n.vehicle_system_instance =
+        static_cast<std::uint8_t>(field("vehicle_system_instance", 15, false));
+    n.industry_group = static_cast<std::uint8_t>(field("industry_group", 7, true));
+    n.arbitrary_address_capable = r.flag(name, "arbitrary_address_capable", p, false);
+    if (n.arbitrary_address_capable) {
+      r.fail(name["arbitrary_address_capable"], Reader::join(p, "arbitrary_address_capable"),
+             "must be false: craneassist keeps its one configured address (valves accept "
+             "commands from that address only) and does not move to another one");
+    }
+    spec.name = j1939::pack_name(n);
+  } else {
+    spec.name = r.integer(node, "name", path, ~std::uint64_t{0});
+    if (j1939::unpack_name(spec.name).arbitrary_address_capable) {
+      r.fail(name, "address_claim.name",
+             "has the arbitrary address capable bit (63) set: craneassist keeps its one "
+             "configured address (valves accept commands from that address only)");
+    }
+  }
+  if (node["timeout"].IsDefined()) {
+    spec.timeout_s = r.time(node, "timeout", path, 0.25, 2.0, "between 250 ms and 2 s");
+  }
+  return spec;
+}
+
+// `diagnostics: {dm1: {source_addresses: [0x20, ...]}}`.
+Dm1Supervision read_diagnostics(const Reader& r, const YAML::Node& node) {
+  r.check_keys(node, "diagnostics", {"dm1"});
+  const YAML::Node dm1 = r.child(node, "dm1", "diagnostics");
+  r.check_keys(dm1, "diagnostics.dm1", {"source_addresses"});
+  const std::string p = "diagnostics.dm1.source_addresses";
+  const YAML::Node list = r.child(dm1, "source_addresses", "diagnostics.dm1");
+  if (!list.IsSequence() || list.size() == 0) r.fail(list, p, "expected a list of addresses");
+  Dm1Supervision out;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string field = p + "[" + std::to_string(i) + "]";
+    const auto a = static_cast<std::uint8_t>(r.integer(list[i], field, 253));
+    for (std::uint8_t b : out.source_addresses) {
+      if (a == b) r.fail(list[i], field, "address " + hex_address(a) + " is listed twice");
+    }
+    out.source_addresses.push_back(a);
+  }
+  return out;
+}
+
 // Bits a signal occupies, for the overlap check.
 struct Occupancy {
   std::uint32_t id;
@@ -375,8 +505,46 @@ std::uint64_t occupied_bits(const SignalSpec& spec) {
   return bits;
 }
 
+// With an address claim, craneassist sends from the claimed address only: every AVC command and
+// a J1939 heartbeat come from it, and no node it supervises may have it (a valve's reply address
+// differs from its command's source address: read_reply).
+void check_claimed_address(const Reader& r, const YAML::Node& root, const CanMapping& mapping) {
+  const std::uint8_t address = mapping.address_claim->address;
+  const std::string claimed = "the address_claim address is " + hex_address(address);
+  for (std::size_t i = 0; i < mapping.joints.size(); ++i) {
+    const JointMapping& jm = mapping.joints[i];
+    const YAML::Node valve = root["joints"][i]["valve"];
+    const std::string path = "joints[" + std::to_string(i) + "].valve";
+    if (jm.valve.kind == ValveOutputKind::kIso11783Avc && jm.valve.avc.source_address != address) {
+      r.fail(valve["iso11783_avc"]["source_address"], path + ".iso11783_avc.source_address",
+             "is " + hex_address(jm.valve.avc.source_address) + ", " + claimed +
+                 ": craneassist sends commands only from the address it claimed");
+    }
+  }
+  if (mapping.heartbeat && mapping.heartbeat->extended &&
+      (mapping.heartbeat->id & 0xFFu) != address) {
+    r.fail(root["heartbeat"]["id"].IsDefined() ? root["heartbeat"]["id"] : root["heartbeat"],
+           "heartbeat.id",
+           "has source address " + hex_address(static_cast<std::uint8_t>(mapping.heartbeat->id)) +
+               " (its low byte), " + claimed +
+               ": a J1939 (29-bit) heartbeat must come from the claimed address");
+  }
+  if (mapping.dm1) {
+    const auto& list = mapping.dm1->source_addresses;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      if (list[i] == address) {
+        r.fail(root["diagnostics"]["dm1"]["source_addresses"][i],
+               "diagnostics.dm1.source_addresses[" + std::to_string(i) + "]",
+               "is craneassist's own (" + claimed + ")");
+      }
+    }
+  }
+}
+
 CanMapping read_mapping(Reader& r, const YAML::Node& root) {
-  r.check_keys(root, "", {"format", "note", "dbc", "joints", "heartbeat", "pump"});
+  r.check_keys(
+      root, "",
+      {"format", "note", "dbc", "joints", "heartbeat", "pump", "address_claim", "diagnostics"});
   const YAML::Node format = r.child(root, "format", "");
   if (r.text(format, "format") != kMappingFormat) {
     r.fail(format, "format", std::string("expected ") + kMappingFormat);
@@ -430,6 +598,14 @@ CanMapping read_mapping(Reader& r, const YAML::Node& root) {
       occupancy.push_back({jm.valve.signal.signal.id, jm.valve.signal.signal.extended,
                            occupied_bits(jm.valve.signal.signal), path + ".valve.signal",
                            j["valve"]["signal"], true});
+    }
+    if (j["valve"]["reply"].IsDefined()) {
+      jm.reply = read_reply(r, j["valve"]["reply"], path + ".valve.reply", jm.valve);
+      if (jm.valve.kind == ValveOutputKind::kSignal) {
+        const SignalSpec& st = jm.reply->status;
+        occupancy.push_back({st.id, st.extended, occupied_bits(st), path + ".valve.reply.status",
+                             j["valve"]["reply"]["status"], false});
+      }
     }
     jm.position = read_signal(r, r.child(j, "position", path), path + ".position",
                               SignalUse::kPosition, kSignalKeys, &jm.position_kind);
@@ -503,6 +679,11 @@ CanMapping read_mapping(Reader& r, const YAML::Node& root) {
     // The whole frame is the heartbeat's: no signal may use its identifier.
     occupancy.push_back({hb.id, hb.extended, ~std::uint64_t{0}, "heartbeat", h, true});
     mapping.heartbeat = hb;
+  }
+  if (root["diagnostics"].IsDefined()) mapping.dm1 = read_diagnostics(r, root["diagnostics"]);
+  if (root["address_claim"].IsDefined()) {
+    mapping.address_claim = read_address_claim(r, root["address_claim"]);
+    check_claimed_address(r, root, mapping);
   }
   // Signals sharing a frame must not share bits; a frame is either sent or received.
   for (std::size_t a = 0; a < occupancy.size(); ++a) {

@@ -11,10 +11,21 @@
 //   - bus-off or error-passive reported by the controller (error frames),
 //   - send errors on max_send_errors consecutive sends,
 //   - a frozen control loop: write() not called for loop_timeout_s (80 ms; the watchdog thread
-//     notices and sends the block commands itself; armed by the first write() after enable())
+//     notices and sends the block commands itself; armed by the first write() after enable()),
+//   - the J1939 address lost to a node whose NAME has priority (mapping `address_claim`),
+//   - a valve reply (mapping `valve.reply`) reporting a fault, not following the command, or
+//     silent for its timeout; a DM1 with an active DTC or the red stop lamp (`diagnostics`)
 // latches a fault: every section is commanded to block (ISO 11783: state block, flow 0; signal
 // outputs: 0) on every cycle from then on, read() reports kFault and state.valid = false. The
 // fault stays until a deliberate enable(); nothing clears it by itself.
+//
+// Address claim (J1939-81). With `address_claim` in the mapping nothing is sent before the
+// address is claimed: activate() (and enable(), when not claimed) sends Address Claimed, and
+// read() completes the claim when its timeout (250 ms) passes without a contending claim of
+// higher priority; until then write() sends nothing and read() reports no valid state. Once the
+// address is lost nothing more is sent from it (the valves' own command timeout and the
+// machine's heartbeat supervision take over); frames without that source address (11-bit
+// signal outputs) are still commanded to block.
 #pragma once
 
 #include <array>
@@ -27,6 +38,7 @@
 #include <thread>
 #include <vector>
 
+#include "craneassist/can/address_claim.hpp"
 #include "craneassist/can/mapping_config.hpp"
 #include "craneassist/can/transport.hpp"
 #include "craneassist/dynamics/model.hpp"
@@ -53,6 +65,10 @@ enum class FaultReason : std::uint8_t {
   kSendError,
   kLoopFrozen,
   kControllerRestarted,  // the controller restarted: it was bus-off, frames were lost
+  kAddressLost,          // J1939: the claimed address belongs to a node with priority
+  kValveFault,           // a valve's reply reports a fault or does not follow the command
+  kValveReplyLost,       // a valve's reply stopped for longer than its timeout
+  kDm1Fault,             // a supervised node's DM1 has an active DTC or the red stop lamp
 };
 const char* to_string(FaultReason reason);
 
@@ -70,6 +86,9 @@ struct CanBackendCounters {
   std::uint64_t faults = 0;
   std::uint64_t log_dropped = 0;
   std::uint64_t heartbeats_sent = 0;
+  std::uint64_t claim_frames_sent = 0;  // Address Claimed and Cannot Claim Address
+  std::uint64_t valve_replies = 0;      // valve replies received (mapping `valve.reply`)
+  std::uint64_t dm1_messages = 0;       // DM1 from supervised nodes (single frame or announced)
 };
 
 class CanBackend final : public valves::MachineInterface {
@@ -89,8 +108,10 @@ class CanBackend final : public valves::MachineInterface {
   // The slowest valve command cycle of the mapping (ISO 11783-7 AVC, or the current signal's).
   double command_period_s() const override;
   bool real_time() const override { return true; }
-  // activate(): wait_for_feedback(), then enable(). safe_stop(): disable(). deactivate():
-  // disable(), then stop().
+  // activate(): claims the address (when the mapping has address_claim) while it waits for
+  // every joint's feedback, then enable(); false (with why) when the feedback does not come, or
+  // the address is lost (a latched fault) or not claimed within timeout_s. safe_stop():
+  // disable(). deactivate(): disable(), then stop().
   bool activate(double timeout_s, std::string* why) override;
   void safe_stop() noexcept override { disable(); }
   void deactivate() override {
@@ -100,7 +121,9 @@ class CanBackend final : public valves::MachineInterface {
 
   // Start-up (may block): reads until every joint's position has arrived, or the timeout.
   bool wait_for_feedback(double timeout_s, valves::MachineState& state);
-  // The deliberate (re-)enable: clears a latched fault and lets write() command the valves.
+  // The deliberate (re-)enable: clears a latched fault and lets write() command the valves;
+  // with address_claim and the address not (or no longer) claimed, it starts claiming and the
+  // valves stay blocked until the claim completes.
   void enable();
   // The normal end of a run (control thread, non-blocking): sends block to every section at once
   // and a heartbeat in state disabled; further write()s send block until the next enable().
@@ -113,6 +136,8 @@ class CanBackend final : public valves::MachineInterface {
   // Monotonic time (s since construction) when the fault latched, or NaN.
   double fault_time_s() const;
   CanBackendCounters counters() const;
+  // The J1939 address claim (kClaimed also when the mapping has none).
+  j1939::ClaimState address_claim_state() const;
   // Stops the watchdog and flushes the log (also done by the destructor).
   void stop();
 
@@ -122,6 +147,11 @@ class CanBackend final : public valves::MachineInterface {
   void latch(FaultReason reason, const char* fmt, ...);
   void send_heartbeat(std::int64_t now_us, std::int64_t now_rt_us);
   void read_pump(valves::PumpMeasurement& pump, std::int64_t now_mono_us, std::int64_t timeout_us);
+  // Address claim, valve replies and DM1 (can_backend_supervision.cpp), control thread.
+  void start_claim(std::int64_t now_us);
+  bool on_supervised_frame(const CanFrame& frame, std::int64_t now_us);  // true: one of theirs
+  void supervise(std::int64_t now_us);
+  void send_network_frame(const CanFrame& frame);
   void watchdog_loop();
   void log_loop();
 

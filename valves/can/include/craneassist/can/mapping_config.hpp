@@ -58,6 +58,19 @@ struct ValveOutput {
 
 enum class PositionKind { kAngle, kLength };  // from the position signal's unit
 
+// What a joint's valve reports back (`valve.reply`), supervised by the backend (docs/can.md,
+// "Valve supervision"): the reply must keep coming (timeout) and must not report a fault.
+struct ValveReply {
+  // ISO 11783-7 valves: Auxiliary Valve Estimated Flow (PGN 65040 + the command's valve number)
+  // from the valve's own source address.
+  std::uint8_t source_address = 0;
+  // Signal valves: the driver's status field, read raw (no scale), and the raw values that mean
+  // OK; any other value is a fault.
+  SignalSpec status;
+  std::vector<std::uint64_t> ok_values;
+  double timeout_s = 0.3;  // no reply for this long (or none this long after enable) -> fault
+};
+
 struct JointMapping {
   std::string name;
   ValveOutput valve;
@@ -65,6 +78,7 @@ struct JointMapping {
   PositionKind position_kind = PositionKind::kAngle;
   std::optional<SignalSpec> pressure_a;  // Pa, piston side
   std::optional<SignalSpec> pressure_b;  // Pa, rod side
+  std::optional<ValveReply> reply;       // optional supervision of the valve
   // Where the entry is in its file, for check_mapping_fits's errors (1-based; 0: built in code).
   int name_line = 0;
   int valve_line = 0;
@@ -88,12 +102,28 @@ struct PumpMapping {
   std::optional<SignalSpec> flow;      // m^3/s (unit L/min, m^3/s, ...)
 };
 
+// J1939-81 address claim of craneassist's source address before it sends anything from it
+// (docs/can.md, "Address claim"). Every AVC command and a J1939 (29-bit) heartbeat are sent from
+// `address`.
+struct AddressClaimSpec {
+  std::uint8_t address = 0x80;
+  std::uint64_t name = 0;   // the J1939 NAME (address_claim.hpp), not arbitrary-address capable
+  double timeout_s = 0.25;  // J1939-81: wait 250 ms for a contending claim
+};
+
+// J1939-73 DM1 (active diagnostic trouble codes) supervision of the listed nodes.
+struct Dm1Supervision {
+  std::vector<std::uint8_t> source_addresses;
+};
+
 struct CanMapping {
   std::string source;   // the file name, for messages
   int joints_line = 0;  // the line of `joints:` (0: built in code)
   std::vector<JointMapping> joints;
   std::optional<HeartbeatSpec> heartbeat;
   PumpMapping pump;
+  std::optional<AddressClaimSpec> address_claim;
+  std::optional<Dm1Supervision> dm1;  // `diagnostics: {dm1: ...}`
 };
 
 // Throws config::ConfigError (file:line: field 'joints[1].position.length': reason).
