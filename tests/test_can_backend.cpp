@@ -230,6 +230,30 @@ TEST(CanBackend, SendsAtTheMappingCycleNotEveryWrite) {
   EXPECT_FALSE(r.backend.faulted());
 }
 
+// A control loop that runs late now and then (every 3rd cycle 4 ms late) keeps the 20 ms command
+// period: a late send keeps its slot in the schedule instead of pushing the next one a cycle on
+// (which made 26-30 ms gaps: 14 commands instead of 20 in 400 ms).
+TEST(CanBackend, ALateCycleDoesNotStretchTheCommandPeriod) {
+  EnabledRig r;
+  r.bus.clear_log();
+  const auto cmd = spool_command(0.3);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 0; k < 40; ++k) {  // 400 ms at 100 Hz
+    std::this_thread::sleep_until(t0 + k * 10ms + (k % 3 == 0 ? 4ms : 0ms));
+    r.feedback();
+    r.backend.read(r.state);
+    r.backend.write(cmd);
+  }
+  int slew = 0, heartbeats = 0;
+  for (const auto& rx : r.bus.log()) {
+    slew += rx.frame.id == 0x0CFE3080u;
+    heartbeats += is_heartbeat_frame(*r.map.heartbeat, rx.frame);
+  }
+  EXPECT_GE(slew, 19) << "one command per 20 ms over 400 ms";
+  EXPECT_LE(slew, 21);
+  EXPECT_GE(heartbeats, 19);
+}
+
 // The valves see a command every 20 ms: the backend says so, and the controller's valve
 // follower leaves out its one-cycle dead-zone lead (tests/test_valve_command_period.cpp).
 TEST(CanBackend, ReportsItsValveCommandPeriod) {

@@ -364,6 +364,20 @@ double CanBackend::command_period_s() const {
   return static_cast<double>(longest_us) * 1e-6;
 }
 
+namespace {
+
+// The time a periodic send counts as sent at: its slot in the schedule (one cycle after the
+// previous one) when it went out within half a cycle of it, so that a control loop running a few
+// ms late does not push every later send back (with a 20 ms cycle and a 100 Hz loop a send 4 ms
+// late would otherwise leave the next one to the cycle after, 26 ms on); else, after a gap, a
+// forced send or the first one, the schedule starts again from now.
+std::int64_t schedule_slot(std::int64_t last_us, std::int64_t now_us, std::int64_t cycle_us) {
+  const std::int64_t nominal = last_us + cycle_us;
+  return std::abs(now_us - nominal) <= cycle_us / 2 ? nominal : now_us;
+}
+
+}  // namespace
+
 valves::BackendStatus CanBackend::write(const valves::ValveCommand& command) {
   Impl& m = *impl_;
   const std::int64_t now = mono_us();
@@ -386,7 +400,7 @@ valves::BackendStatus CanBackend::write(const valves::ValveCommand& command) {
     }
     const SendStatus st = send_counted(m.transport, m.counters, m.control_ring,
                                        m.log_file != nullptr, *frame, now_rt);
-    j.last_sent_us = now;
+    j.last_sent_us = force ? now : schedule_slot(j.last_sent_us, now, j.cycle_us);
     j.note_command(*frame);
     if (st == SendStatus::kOk) {
       m.consecutive_send_errors = 0;
@@ -400,7 +414,10 @@ valves::BackendStatus CanBackend::write(const valves::ValveCommand& command) {
   if (force) m.block_sent_after_fault = true;
   if (m.heartbeat && m.may_send(m.heartbeat_from_claimed_address) &&
       (force || now - m.heartbeat_last_us >= m.heartbeat_cycle_us - kEarlyUs)) {
+    const std::int64_t slot =
+        force ? now : schedule_slot(m.heartbeat_last_us, now, m.heartbeat_cycle_us);
     send_heartbeat(now, now_rt);
+    m.heartbeat_last_us = slot;
   }
   if (faulted()) return valves::BackendStatus::kFault;
   return valves::BackendStatus::kOk;
