@@ -93,8 +93,16 @@ class Emulator {
   std::thread thread_;
 };
 
+// The K70M mapping without its J1939 network management and supervision (address claim, valve
+// replies, DM1): the machine here is only the crane behind the valve and sensor frames, and the
+// claim and the supervision have their own tests (test_can_backend).
 can::CanMapping k70m_mapping() {
-  return can::load_can_mapping(std::string(CRANEASSIST_SOURCE_DIR) + "/config/can/k70m_can.yaml");
+  can::CanMapping map =
+      can::load_can_mapping(std::string(CRANEASSIST_SOURCE_DIR) + "/config/can/k70m_can.yaml");
+  map.address_claim.reset();
+  map.dm1.reset();
+  for (auto& joint : map.joints) joint.reply.reset();
+  return map;
 }
 
 // A short sweep: the top level only, a shorter settle (the lift reaches its speed in about
