@@ -232,13 +232,13 @@ TEST(CanBackend, SendsAtTheMappingCycleNotEveryWrite) {
 
 // A control loop that runs late now and then (every 3rd cycle 4 ms late) keeps the 20 ms command
 // period: a late send keeps its slot in the schedule instead of pushing the next one a cycle on
-// (which made 26-30 ms gaps: 14 commands instead of 20 in 400 ms).
+// (which made 26-30 ms gaps: about 35 commands instead of 50 in a second).
 TEST(CanBackend, ALateCycleDoesNotStretchTheCommandPeriod) {
   EnabledRig r;
   r.bus.clear_log();
   const auto cmd = spool_command(0.3);
   const auto t0 = std::chrono::steady_clock::now();
-  for (int k = 0; k < 40; ++k) {  // 400 ms at 100 Hz
+  for (int k = 0; k < 100; ++k) {  // 1 s at 100 Hz
     std::this_thread::sleep_until(t0 + k * 10ms + (k % 3 == 0 ? 4ms : 0ms));
     r.feedback();
     r.backend.read(r.state);
@@ -249,9 +249,10 @@ TEST(CanBackend, ALateCycleDoesNotStretchTheCommandPeriod) {
     slew += rx.frame.id == 0x0CFE3080u;
     heartbeats += is_heartbeat_frame(*r.map.heartbeat, rx.frame);
   }
-  EXPECT_GE(slew, 19) << "one command per 20 ms over 400 ms";
-  EXPECT_LE(slew, 21);
-  EXPECT_GE(heartbeats, 19);
+  // 50 on time; a slow (sanitizer) build may lose one at the start or end.
+  EXPECT_GE(slew, 47) << "one command per 20 ms over 1 s";
+  EXPECT_LE(slew, 51);
+  EXPECT_GE(heartbeats, 47);
 }
 
 // The valves see a command every 20 ms: the backend says so, and the controller's valve

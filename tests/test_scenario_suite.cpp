@@ -53,6 +53,10 @@ TEST(ScenarioSuite, MistakesNameFileLineAndField) {
   EXPECT_EQ(e.field(), "runs[0].replay");
   EXPECT_EQ(e.line(), 3);
   EXPECT_NE(e.reason().find("no such file"), std::string::npos);
+  // A name the file system refuses (longer than NAME_MAX) is the entry's error, not a crash.
+  e = error_of(head + "runs:\n  - replay: " + std::string(300, 'a') + ".csv\n");
+  EXPECT_EQ(e.field(), "runs[0].replay");
+  EXPECT_NE(e.reason().find("cannot use"), std::string::npos) << e.reason();
   e = error_of(head + "runs:\n  - replay: demo.csv\n    poses: [folded]\n");
   EXPECT_EQ(e.field(), "runs[0].poses");
   EXPECT_NE(e.reason().find("no pose named 'folded'"), std::string::npos);

@@ -62,6 +62,8 @@ for name, text in (("folded.txt", "lift=0 deg, tilt=-125 deg, extension=0.2 m"),
                    ("twice.txt", "lift=1 deg, lift=2 deg")):
     write("fuzz_joint_pose", name, text)
 write("fuzz_suite_manifest", "suite.yaml", read("examples/replays/suite.yaml"))
+write("fuzz_suite_manifest", "long_name.yaml",  # a name longer than NAME_MAX: once a crash
+      "format: craneassist-suite/1\nruns:\n  - replay: " + "a" * 300 + ".csv\n")
 write("fuzz_suite_manifest", "payload_targets.yaml",
       "format: craneassist-suite/1\nposes:\n  low: lift=5 deg\ntargets:\n  stall_events: 0\n"
       "runs:\n  - replay: heavy_lift.csv\n    poses: [default, low]\n    payload: 650 kg\n"

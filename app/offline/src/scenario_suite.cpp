@@ -116,8 +116,15 @@ Suite parse_suite(std::string_view yaml_text, std::string_view source_name,
       run.line = node.Mark().line + 1;
       run.replay_text = r.text(node, "replay", path);
       run.replay = base_dir / run.replay_text;
-      if (!std::filesystem::is_regular_file(run.replay)) {
-        r.fail(node["replay"], path + ".replay", "no such file: " + run.replay.string());
+      // The error_code form: a name the file system refuses (too long, say) is a bad entry of
+      // the manifest, not an exception from the file system.
+      std::error_code ec;
+      const auto status = std::filesystem::status(run.replay, ec);
+      if (status.type() != std::filesystem::file_type::regular) {
+        const bool missing = status.type() == std::filesystem::file_type::not_found || !ec;
+        r.fail(node["replay"], path + ".replay",
+               missing ? "no such file: " + run.replay.string()
+                       : "cannot use " + run.replay.string() + ": " + ec.message());
       }
       if (node["payload"].IsDefined()) {
         run.payload_kg = r.quantity(node, "payload", path, config::Dimension::kMass, 0.0, 1e5);
