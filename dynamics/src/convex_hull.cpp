@@ -149,7 +149,8 @@ ConvexHull3::ConvexHull3(int max_points)
       second_normal_(at(max_points_)),
       projected_(at(max_points_)),
       flat_(max_points_),
-      alive_faces_(faces_.size()) {}
+      alive_faces_(faces_.size()),
+      pending_(faces_.size()) {}
 
 int ConvexHull3::new_face(int a, int b, int c) noexcept {
   int index;
@@ -179,11 +180,20 @@ void ConvexHull3::set_plane(Face& f) noexcept {
   f.offset = f.normal.dot((a + b + c) / 3.0);
 }
 
+void ConvexHull3::push_pending(int face) noexcept {
+  if (pending_count_ < static_cast<int>(pending_.size())) {
+    pending_[at(pending_count_++)] = face;
+  } else {
+    pending_overflow_ = true;
+  }
+}
+
 void ConvexHull3::assign(int point, const int* faces, int face_count) noexcept {
   for (int k = 0; k < face_count; ++k) {
     Face& f = faces_[at(faces[k])];
     const double d = distance(f, point);
     if (d > tolerance_) {
+      if (f.outside < 0) push_pending(faces[k]);
       next_outside_[at(point)] = f.outside;
       f.outside = point;
       if (f.furthest < 0 || d > f.furthest_distance) {
@@ -203,6 +213,8 @@ int ConvexHull3::build(std::span<const Eigen::Vector3d> points) noexcept {
   volume_ = 0.0;
   skipped_ = 0;
   stamp_ = 0;  // every face of this build starts at stamp 0 (new_face)
+  pending_count_ = 0;
+  pending_overflow_ = false;
   dimension_ = -1;
   if (n == 0) return dimension_;
   double scale = 0.0;
@@ -298,19 +310,22 @@ int ConvexHull3::build(std::span<const Eigen::Vector3d> points) noexcept {
     if (i != a && i != b && i != c && i != d) assign(i, start.data(), 4);
   }
 
-  // Add the furthest outside point of some face until no face has any; a full pass over the
-  // faces without work ends it.
-  int cursor = 0, idle = 0;
-  while (idle <= face_high_) {
-    if (cursor >= face_high_) cursor = 0;
-    const Face& f = faces_[at(cursor)];
-    if (f.alive && f.outside >= 0) {
-      if (!add_point(cursor, f.furthest) && skipped_ > n) break;  // no progress: give up
-      idle = 0;
-    } else {
-      ++idle;
+  // Add the furthest outside point of a face with outside points until none has any. The faces
+  // wait on a stack (assign() pushes a face when it gets its first point); should the stack
+  // ever fill, a scan over all faces refills it.
+  for (;;) {
+    while (pending_count_ > 0) {
+      const int f = pending_[at(--pending_count_)];
+      const Face& face = faces_[at(f)];
+      if (!face.alive || face.outside < 0) continue;
+      if (!add_point(f, face.furthest) && skipped_ > n) break;  // no progress: give up
+      if (faces_[at(f)].alive && faces_[at(f)].outside >= 0) push_pending(f);  // eye skipped
     }
-    ++cursor;
+    if (!pending_overflow_ || skipped_ > n) break;
+    pending_overflow_ = false;
+    for (int f = 0; f < face_high_; ++f) {
+      if (faces_[at(f)].alive && faces_[at(f)].outside >= 0) push_pending(f);
+    }
   }
   finish_solid(centre);
   return dimension_;
@@ -451,11 +466,21 @@ void ConvexHull3::finish_solid(const Eigen::Vector3d& centre) noexcept {
   volume_ = six_volume / 6.0;
   dimension_ = 3;
 
-  // The vertices. A mesh vertex can lie on a flat face or a straight edge of the polytope (it
-  // was outside the hull when it was added, and points added later made its faces coplanar):
-  // its faces then have normals in at most two directions. A corner of the polytope has three
-  // independent ones. Two passes over the faces: each vertex's first normal and the one most
-  // across it, then whether any third normal leaves their plane.
+  corners_known_ = false;  // vertices() finds them when asked
+}
+
+std::span<const int> ConvexHull3::vertices() const noexcept {
+  if (dimension_ == 3 && !corners_known_) find_corners();
+  return {vertices_.data(), static_cast<std::size_t>(vertex_count_)};
+}
+
+void ConvexHull3::find_corners() const noexcept {
+  // A mesh vertex can lie on a flat face or a straight edge of the polytope (it was outside the
+  // hull when it was added, and points added later made its faces coplanar): its faces then
+  // have normals in at most two directions. A corner of the polytope has three independent
+  // ones. Two passes over the faces: each vertex's first normal and the one most across it,
+  // then whether any third normal leaves their plane.
+  vertex_count_ = 0;
   std::fill(is_vertex_.begin(), is_vertex_.end(), 0);  // 0 none, 1 in the mesh, 2 a corner
   for (int k = 0; k < alive_count_; ++k) {
     const Face& face = faces_[at(alive_faces_[at(k)])];
@@ -465,8 +490,8 @@ void ConvexHull3::finish_solid(const Eigen::Vector3d& centre) noexcept {
         first_normal_[at(v)] = face.normal;
         second_normal_[at(v)] = face.normal;
       } else {
-        const double across = first_normal_[at(v)].cross(face.normal).norm();
-        if (across > first_normal_[at(v)].cross(second_normal_[at(v)]).norm()) {
+        const double across = first_normal_[at(v)].cross(face.normal).squaredNorm();
+        if (across > first_normal_[at(v)].cross(second_normal_[at(v)]).squaredNorm()) {
           second_normal_[at(v)] = face.normal;
         }
       }
@@ -483,6 +508,7 @@ void ConvexHull3::finish_solid(const Eigen::Vector3d& centre) noexcept {
       }
     }
   }
+  corners_known_ = true;
 }
 
 void ConvexHull3::build_lower_dimension(int a, int b, int c, int count) noexcept {

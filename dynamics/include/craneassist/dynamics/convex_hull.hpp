@@ -77,9 +77,8 @@ class ConvexHull3 {
   // Indices into the points of the hull's vertices: the polytope's corners, in no particular
   // order (points on its faces and edges are left out); a flat hull's counterclockwise in its
   // plane.
-  std::span<const int> vertices() const noexcept {
-    return {vertices_.data(), static_cast<std::size_t>(vertex_count_)};
-  }
+  // Found on the first call after build() (the volume does not need them).
+  std::span<const int> vertices() const noexcept;
 
   // The triangles of a solid hull, outward normals (counterclockwise seen from outside).
   int face_count() const noexcept;
@@ -124,9 +123,11 @@ class ConvexHull3 {
   int new_face(int a, int b, int c) noexcept;
   void set_plane(Face& f) noexcept;
   void assign(int point, const int* faces, int face_count) noexcept;
+  void push_pending(int face) noexcept;
   bool add_point(int face, int eye) noexcept;
   void build_lower_dimension(int a, int b, int c, int count) noexcept;
   void finish_solid(const Eigen::Vector3d& centre) noexcept;
+  void find_corners() const noexcept;
 
   int max_points_;
   std::vector<Eigen::Vector3d> points_;
@@ -137,10 +138,13 @@ class ConvexHull3 {
   std::vector<int> stack_, visible_, new_faces_, orphans_;
   std::vector<HorizonEdge> horizon_;
   std::vector<int> horizon_from_;  // per point: the horizon edge leaving it (-1: none)
-  std::vector<int> vertices_;
-  std::vector<char> is_vertex_;
-  std::vector<Eigen::Vector3d> first_normal_, second_normal_;  // per vertex (finish_solid)
-  std::vector<Eigen::Vector2d> projected_;                     // a flat hull's points in its plane
+  // The corners: a cache vertices() fills (mutable: found on demand, from the mesh).
+  mutable std::vector<int> vertices_;
+  mutable std::vector<char> is_vertex_;
+  mutable std::vector<Eigen::Vector3d> first_normal_, second_normal_;  // per vertex
+  mutable int vertex_count_ = 0;
+  mutable bool corners_known_ = false;
+  std::vector<Eigen::Vector2d> projected_;  // a flat hull's points in its plane
   ConvexHull2 flat_;
   // A flat hull's plane n.x = d and the orthonormal axes e1, e2 in it (2-D coordinates x.e1,
   // x.e2, so the 3-D origin projects to the 2-D origin).
@@ -149,7 +153,9 @@ class ConvexHull3 {
   Eigen::Vector3d flat_e1_ = Eigen::Vector3d::Zero(), flat_e2_ = Eigen::Vector3d::Zero();
   std::vector<int> alive_faces_;  // after build(): the faces of the hull
   int alive_count_ = 0;
-  int vertex_count_ = 0;
+  std::vector<int> pending_;  // faces that may have outside points
+  int pending_count_ = 0;
+  bool pending_overflow_ = false;
   int dimension_ = -1;
   double volume_ = 0.0;
   double tolerance_ = 0.0;
