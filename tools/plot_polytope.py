@@ -105,13 +105,17 @@ def main():
 
     plt = pyplot()
     views = VIEWS if dim == 3 else [("in the arm's plane", 0, 1)]
-    fig = plt.figure(figsize=(12, 10) if dim == 3 else (7, 6.5), constrained_layout=True)
+    fig = plt.figure(figsize=(12, 10.5) if dim == 3 else (7, 7), constrained_layout=True)
+    # The panels, and a row below them for the legend (inside a panel it would hide data).
+    grid = (fig.add_gridspec(3, 2, height_ratios=[1, 1, 0.08]) if dim == 3
+            else fig.add_gridspec(2, 1, height_ratios=[1, 0.1]))
+    cells = [grid[0, 0], grid[0, 1], grid[1, 0], grid[1, 1]] if dim == 3 else [grid[0, 0]]
     title = meta.get("title", "flow manipulability polytope")
     size_text = (f"volume {size:.3g} m$^3$/s$^3$" if dim == 3 and not flat
                  else f"area {float(meta.get('area_m2_s2', 0)):.3g} m$^2$/s$^2$")
     fig.suptitle(f"{title}\n{meta.get('pose', '')}; {size_text}", fontsize=11)
     for k, (name, i, j) in enumerate(views):
-        ax = fig.add_subplot(2, 2, k + 1) if dim == 3 else fig.add_subplot(1, 1, 1)
+        ax = fig.add_subplot(cells[k])
         ring = polygon(pts[:, [i, j]]) if len(pts) else pts
         ax.fill(ring[:, 0], ring[:, 1], color="tab:orange", alpha=0.35, lw=0)
         ax.plot(ring[:, 0], ring[:, 1], color="tab:orange", lw=1.5)
@@ -121,8 +125,8 @@ def main():
                         arrowprops=dict(arrowstyle="->", color="tab:blue", lw=2))
             ax.plot([best * u[i]], [best * u[j]], "o", color="tab:blue",
                     label=f"best joint motion (LP): {best:.2f} m/s")
-            ax.plot([resolved * u[i]], [resolved * u[j]], "s", color="tab:green",
-                    label=f"{resolution}: {resolved:.2f} m/s")
+            ax.plot([resolved * u[i]], [resolved * u[j]], "s", color="tab:green", mfc="none",
+                    ms=9, mew=2, label=f"along the {resolution} resolution: {resolved:.2f} m/s")
         ax.plot([0], [0], "k+", ms=10)
         ax.set_xlabel(f"{axes[i]} velocity, m/s")
         ax.set_ylabel(f"{axes[j]} velocity, m/s")
@@ -130,9 +134,9 @@ def main():
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(alpha=0.3)
         if k == 0:
-            ax.legend(loc="best", fontsize=8)
+            handles, labels = ax.get_legend_handles_labels()
     if dim == 3:
-        ax = fig.add_subplot(2, 2, 4, projection="3d")
+        ax = fig.add_subplot(cells[3], projection="3d")
         if not flat and len(pts) >= 4:
             hull = ConvexHull(pts)
             # Matplotlib's 3-D axes have z up: show the crane's up (y) as up.
@@ -145,7 +149,11 @@ def main():
         ax.set_ylabel("z (lateral), m/s")
         ax.set_zlabel("y (up), m/s")
         ax.set_title("3-D")
+        ax.tick_params(labelsize=7)
         ax.set_box_aspect(np.ptp(pts[:, [0, 2, 1]], axis=0) + 1e-9)
+    legend = fig.add_subplot(grid[-1, :])
+    legend.axis("off")
+    legend.legend(handles, labels, loc="center", ncol=3, fontsize=9, frameon=False)
     fig.savefig(a.out, dpi=110)
     print(f"plot_polytope: wrote {a.out}")
     return 0

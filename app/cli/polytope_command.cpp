@@ -86,7 +86,8 @@ Eigen::Vector3d task_coordinates(const offline::PolytopeReport& r, const Eigen::
 }
 
 std::string vector_text(const Eigen::Vector3d& shown, int dim) {
-  const Eigen::Vector3d v = shown + Eigen::Vector3d::Zero();  // -0 prints as 0
+  // Rounding dust below the printed digits (-1e-17) prints as 0, not -0.000.
+  const Eigen::Vector3d v = shown.unaryExpr([](double x) { return std::abs(x) < 5e-4 ? 0.0 : x; });
   char text[96];
   if (dim == 3) {
     std::snprintf(text, sizeof text, "(%6.3f, %6.3f, %6.3f)", v.x(), v.y(), v.z());
@@ -272,6 +273,7 @@ int run_polytope_command(const PolytopeArgs& args) {
       std::filesystem::create_directories(dir);
       const std::string csv = args.out.empty() ? (dir / "polytope.csv").string() : args.out;
       if (args.out.empty()) write_csv(csv, r, title, pose);
+      std::fflush(stdout);  // the report before the script's own lines
       const int code = run_plot(csv, args.plot, dir);
       std::filesystem::remove_all(dir);
       if (code != 0) {
