@@ -4,6 +4,9 @@
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/control/controller.hpp"
+#include "craneassist/dynamics/cylinders.hpp"
+#include "craneassist/dynamics/flow_polytope.hpp"
+#include "craneassist/dynamics/kinematics.hpp"
 #include "craneassist/dynamics/rigid_body_terms.hpp"
 #include "craneassist/scaling/tip_path.hpp"
 #include "craneassist/scaling/tip_scaler.hpp"
@@ -179,6 +182,64 @@ void BM_ScalingStep(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_ScalingStep)->Unit(benchmark::kMicrosecond);
+
+// The flow manipulability polytope of the reference crane at its start pose
+// (dynamics/flow_polytope.hpp), in the three parts the controller runs each cycle. Argument: the
+// pump's maximum flow in L/min (325: the K70M's, at which the flow barely limits and the
+// polytope is the image of the speed box; 120: a pump that cuts it in every orthant).
+struct PolytopeRig {
+  config::CraneConfig cfg = config::default_crane_config();
+  dynamics::FlowPolytope poly{4, 3};
+  dynamics::JointVelocitySet set;
+  dynamics::TaskJacobian jacobian;
+  explicit PolytopeRig(double pump_lpm) {
+    cfg.model.pump.max_flow_m3_s = pump_lpm * 1e-3 / 60.0;
+    const dynamics::JointVector q = cfg.simulation.q_initial;
+    dynamics::JointVector arms;
+    dynamics::cylinder_arms(cfg.model, q, arms);
+    dynamics::KinematicsData kin;
+    dynamics::tip_jacobian(cfg.model, kin, q, jacobian);
+    const double r = cfg.control.flow_reserve;
+    dynamics::joint_velocity_set(cfg.model, q, arms,
+                                 {.flow_reserve = r, .cylinder_speed_reserve = r}, set);
+    poly.update(set, jacobian);
+    poly.build_hull();
+  }
+};
+
+// The joint-velocity set's vertices and their tip images.
+void BM_PolytopeVertices(benchmark::State& state) {
+  PolytopeRig rig(static_cast<double>(state.range(0)));
+  for (auto _ : state) {
+    rig.poly.update(rig.set, rig.jacobian);
+    benchmark::DoNotOptimize(rig.poly.task_points().data());
+  }
+  state.counters["points"] = rig.poly.point_count();
+}
+BENCHMARK(BM_PolytopeVertices)->Arg(325)->Arg(120)->Unit(benchmark::kMicrosecond);
+
+// Their convex hull and its volume.
+void BM_PolytopeHull(benchmark::State& state) {
+  PolytopeRig rig(static_cast<double>(state.range(0)));
+  for (auto _ : state) {
+    rig.poly.build_hull();
+    const double volume = rig.poly.volume();
+    benchmark::DoNotOptimize(&volume);
+  }
+  state.counters["hull_vertices"] = static_cast<double>(rig.poly.hull_vertices().size());
+}
+BENCHMARK(BM_PolytopeHull)->Arg(325)->Arg(120)->Unit(benchmark::kMicrosecond);
+
+// The LP: the largest tip speed along a direction over every joint velocity.
+void BM_PolytopeMaxSpeed(benchmark::State& state) {
+  PolytopeRig rig(static_cast<double>(state.range(0)));
+  const Eigen::Vector3d u = Eigen::Vector3d(0.3, 0.2, 0.4).normalized();
+  for (auto _ : state) {
+    const double s = rig.poly.max_speed(u);
+    benchmark::DoNotOptimize(&s);
+  }
+}
+BENCHMARK(BM_PolytopeMaxSpeed)->Arg(325)->Arg(120)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

@@ -16,6 +16,7 @@
 #include "craneassist/control/controller.hpp"
 #include "craneassist/control/csv_log.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
+#include "craneassist/dynamics/flow_polytope.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
 
 using namespace craneassist;
@@ -344,6 +345,64 @@ TEST(Controller, EveryResolutionRespectsCylinderAccelerationLimits) {
     // few per cent (the filter cannot meet a falling bound at once); a velocity step would be
     // many times the limit.
     EXPECT_LT(worst, 1.1) << dynamics::to_string(r);
+  }
+}
+
+TEST(Controller, PolytopeFiguresOfEachCycle) {
+  // Each cycle's polytope is the one at the configuration the cycle resolved at (the previous
+  // reference), with the reserves of the scaling in use; its LP speed is along the stick. The
+  // flow-only prescaling scales the command uniformly, so its reference speed is the speed
+  // along its resolution whenever the flow or a cylinder limits it.
+  for (const auto mode : {control::ScalingMode::kFull, control::ScalingMode::kFlowOnly}) {
+    Rig rig(mode, [](config::CraneConfig& c) { c.model.pump.max_flow_m3_s = 120e-3 / 60.0; });
+    auto& [cfg, controller, state, out] = rig;
+    const double reserve = cfg.control.flow_reserve;
+    const dynamics::FlowPolytopeSettings settings{
+        .flow_reserve = reserve,
+        .cylinder_speed_reserve = mode == control::ScalingMode::kFull ? reserve : 0.0};
+    dynamics::FlowPolytope poly(4, 3);
+    dynamics::KinematicsData kin;
+    dynamics::TaskJacobian jacobian;
+    dynamics::JointVector arms;
+    dynamics::JointVelocitySet set;
+    const Eigen::Vector3d v(1.2, 0.9, -0.8);  // more than the pump gives at this pose
+    int limited = 0;
+    for (int k = 0; k < 200; ++k) {
+      const dynamics::JointVector q = state.q;  // = the controller's reference
+      ASSERT_EQ(controller.update(state, v, out), control::ControllerStatus::kRunning);
+      dynamics::cylinder_arms(cfg.model, q, arms);
+      dynamics::tip_jacobian(cfg.model, kin, q, jacobian);
+      dynamics::joint_velocity_set(cfg.model, q, arms, settings, set);
+      poly.update(set, jacobian);
+      poly.build_hull();
+      EXPECT_EQ(out.polytope_volume_m3_s3, poly.volume());
+      EXPECT_GT(out.polytope_volume_m3_s3, 0.0);
+      EXPECT_EQ(out.avail_speed_m_s, poly.max_speed(v));
+      EXPECT_GT(out.avail_speed_resolved_m_s, 0.0);
+      EXPECT_LE(out.avail_speed_resolved_m_s, out.avail_speed_m_s * (1 + 1e-9));
+      const double ref_speed = out.ref_tip_velocity_m_s.norm();
+      if (mode == control::ScalingMode::kFlowOnly) {
+        EXPECT_LE(ref_speed, out.avail_speed_resolved_m_s * (1 + 1e-9));
+        if (out.limit == scaling::ActiveLimit::kFlow ||
+            out.limit == scaling::ActiveLimit::kCylinderSpeed) {
+          EXPECT_NEAR(ref_speed, out.avail_speed_resolved_m_s, 1e-9 * ref_speed);
+          ++limited;
+        }
+      } else {
+        limited += out.sdot > 0.0;
+      }
+      state.q = out.q_ref;
+    }
+    EXPECT_GT(limited, 100) << control::to_string(mode);
+    // The stick released: the LP keeps the last stick direction.
+    const dynamics::JointVector q = state.q;
+    controller.update(state, Eigen::Vector3d::Zero(), out);
+    dynamics::cylinder_arms(cfg.model, q, arms);
+    dynamics::tip_jacobian(cfg.model, kin, q, jacobian);
+    dynamics::joint_velocity_set(cfg.model, q, arms, settings, set);
+    poly.update(set, jacobian);
+    EXPECT_EQ(out.avail_speed_m_s, poly.max_speed(v));
+    EXPECT_GT(out.avail_speed_m_s, 0.0);
   }
 }
 

@@ -6,7 +6,7 @@ packages=(
   build-essential cmake pkg-config clang-format
   libeigen3-dev libode-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3 python3-matplotlib
+  python3 python3-matplotlib python3-scipy  # figures; scipy: the polytope's plot and Qhull check
   qemu-system-x86 busybox-static can-utils cpio  # the SocketCAN test VM (tools/can-vm/)
   libevdev-dev libsdl2-dev tmux  # joysticks; tmux drives the keyboard joystick in tests
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools openssl  # DDS telemetry and security

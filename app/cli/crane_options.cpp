@@ -42,6 +42,15 @@ CLI::Option* add_resolution_option(CLI::App& command, std::string& value, const 
   return command.add_option("--resolution", value, help)->check(CLI::IsMember(names));
 }
 
+double cli_quantity(const std::string& option, const std::string& text, config::Dimension dim) {
+  std::string error;
+  const auto q = config::parse_quantity(text, dim, error);
+  if (!q || q->si_values.size() != 1) {
+    throw CLI::ValidationError(option, error.empty() ? "expected one value" : error);
+  }
+  return q->si_values[0];
+}
+
 config::CraneConfig load_crane(const std::string& file) {
   return file.empty() ? config::default_crane_config() : config::load_crane_config(file);
 }

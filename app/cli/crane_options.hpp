@@ -8,6 +8,7 @@
 #include <string>
 
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/config/quantity.hpp"
 
 namespace craneassist::cli {
 
@@ -41,6 +42,11 @@ struct CraneOptions {
 // Applies the options to `cfg`. A value the config cannot take throws CLI::ValidationError
 // naming the option ("--initial: 'boom': no joint of that name").
 void apply_crane_options(config::CraneConfig& cfg, const CraneOptions& options);
+
+// A quantity given on the command line ("120 L/min"), in SI, or throws CLI::ValidationError
+// naming the option. Its range is the config field's, checked when it is applied
+// (apply_override).
+double cli_quantity(const std::string& option, const std::string& text, config::Dimension dim);
 
 // Applies a config field given on the command line with its config setter, set(), which checks
 // it against the file's range (config::set_pump_max_flow, ...): the setter's

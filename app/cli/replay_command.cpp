@@ -31,17 +31,6 @@
 namespace craneassist::cli {
 namespace {
 
-// A quantity given on the command line ("120 L/min"), in SI, or throws CLI-style. Its range is
-// the config field's, checked when it is applied (apply_override).
-double cli_quantity(const std::string& option, const std::string& text, config::Dimension dim) {
-  std::string error;
-  const auto q = config::parse_quantity(text, dim, error);
-  if (!q || q->si_values.size() != 1) {
-    throw CLI::ValidationError(option, error.empty() ? "expected one value" : error);
-  }
-  return q->si_values[0];
-}
-
 // A pressure given on the command line: a quantity ("200 bar", "20 MPa") or a bare number in MPa.
 double cli_pressure(const std::string& option, const std::string& text) {
   char* end = nullptr;

@@ -67,12 +67,20 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
       // The live loop keeps every section under feedback: the activation rule is for executing
       // planned trajectories (trajectory_runner.hpp), whose at-rest cylinders the planner counts
       // as closed.
-      follower_(config.model, config.control.position_gain_1_s, period_s_) {
+      follower_(config.model, config.control.position_gain_1_s, period_s_),
+      // The full scaling keeps the reserve on both the pump flow and the cylinder speeds
+      // (path_speed_limits), the flow-only prescaling on the flow only (flow_prescale).
+      polytope_settings_{.flow_reserve = config.control.flow_reserve,
+                         .cylinder_speed_reserve = options.mode == ScalingMode::kFull
+                                                       ? config.control.flow_reserve
+                                                       : 0.0},
+      polytope_(config.model.dof(), 3) {
   follower_.set_command_period(options.valve_command_period_s);
   const int n = model_.dof();
   q_ref_ = config.simulation.q_initial;
   dc_dq_.setZero(n);
   qddot_max_.setZero(n);
+  polytope_arms_.setZero(n);
   if (options_.mode == ScalingMode::kFull) {
     terms_ = std::make_unique<dynamics::RigidBodyTerms>(model_);
     tip_path_ = std::make_unique<scaling::TipPath>(model_, tip_path_config(config));
@@ -108,6 +116,7 @@ ControllerStatus Controller::update(const valves::MachineState& state, const Eig
   // reference starts again from where it is measured (no P-feedback jump towards the old one).
   if (neutral_ && !stale) reset(state);
 
+  const JointVector q_resolved = q_ref_;  // the cycle resolves here, then integrates q_ref_
   if (options_.mode == ScalingMode::kFull) {
     update_full(state, command_ok ? v_cmd : Eigen::Vector3d::Zero(), stale, out);
   } else if (stale) {
@@ -120,6 +129,7 @@ ControllerStatus Controller::update(const valves::MachineState& state, const Eig
     update_rate_prescaled(v_cmd, out);
   }
   out.q_ref = q_ref_;
+  update_polytope(q_resolved, command_ok ? v_cmd : Eigen::Vector3d::Zero(), stale, out);
 
   // A failed dynamics step stops the reference as a stale input does (the scaler's target is 0).
   const bool stopping = stale || dynamics_failed();
@@ -132,6 +142,32 @@ ControllerStatus Controller::update(const valves::MachineState& state, const Eig
   }
   follower_.update(q_ref_, out.qdot_ref, state_ok ? &state.q : nullptr, out.valves);
   return stopping ? ControllerStatus::kStopping : ControllerStatus::kRunning;
+}
+
+void Controller::update_polytope(const JointVector& q, const Eigen::Vector3d& v_cmd, bool stale,
+                                 ControllerOutput& out) noexcept {
+  dynamics::cylinder_arms(model_, q, polytope_arms_);
+  dynamics::tip_jacobian(model_, kin_, q, polytope_jacobian_);
+  dynamics::joint_velocity_set(model_, q, polytope_arms_, polytope_settings_, polytope_set_);
+  polytope_.update(polytope_set_, polytope_jacobian_);
+  polytope_.build_hull();
+  out.polytope_volume_m3_s3 = polytope_.volume();
+  const double stick = v_cmd.norm();
+  if (stick > 0.0) stick_direction_ = v_cmd / stick;
+  out.avail_speed_m_s = polytope_.max_speed(stick_direction_);
+  // Along the joint motion the cycle chose: the full scaling's f' (J f' = u, per unit path
+  // speed), the others' resolution of the command.
+  out.avail_speed_resolved_m_s = 0.0;
+  // A zero f' (the resolution gives up on u: a singular pose) has no speed along it.
+  if (options_.mode == ScalingMode::kFull) {
+    const JointVector& f1 = tip_out_.geometry.f1;
+    if (!f1.isZero(0.0)) out.avail_speed_resolved_m_s = dynamics::speed_along(polytope_set_, f1);
+  } else if (!stale && stick > 0.0) {
+    const double tip_speed = (polytope_jacobian_ * sns_.qdot).norm();
+    if (tip_speed > 0.0) {
+      out.avail_speed_resolved_m_s = dynamics::speed_along(polytope_set_, sns_.qdot) * tip_speed;
+    }
+  }
 }
 
 bool Controller::dynamics_failed() const noexcept {

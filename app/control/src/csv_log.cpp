@@ -13,6 +13,7 @@ std::string CsvLog::header(int dof) {
   h += ",pump_flow_m3s,pump_pressure_pa,pump_power_w,energy_j,active_limit,scale,flow_demand_m3s,"
        "pump_limit";
   h += ",s,sdot,sddot,sdddot,sddot_min,sddot_max,tip_error_m,ref_power_w";
+  h += ",avail_speed_m_s,avail_speed_resolved_m_s,polytope_volume_m3s3";
   for (int i = 1; i <= dof; ++i) h += ",spool" + std::to_string(i);
   for (int i = 1; i <= dof; ++i) h += ",p_load" + std::to_string(i) + "_pa";
   return h;
@@ -55,6 +56,8 @@ void CsvLog::write_row(const LogRow& r) {
                r.pump_limit);
   std::fprintf(file_, ",%.6f,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g", r.s, r.sdot, r.sddot, r.sdddot,
                r.sddot_min, r.sddot_max, r.tip_error_m, r.ref_power_w);
+  std::fprintf(file_, ",%.6g,%.6g,%.6g", r.avail_speed_m_s, r.avail_speed_resolved_m_s,
+               r.polytope_volume_m3s3);
   for (int i = 0; i < dof_; ++i) std::fprintf(file_, ",%.5f", r.spool[static_cast<std::size_t>(i)]);
   for (int i = 0; i < dof_; ++i) {
     std::fprintf(file_, ",%.6g", r.load_pressure[static_cast<std::size_t>(i)]);

@@ -28,6 +28,7 @@
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/control/control_loop.hpp"
 #include "craneassist/dynamics/enum_names.hpp"
+#include "craneassist/dynamics/flow_polytope.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
 #include "craneassist/dynamics/redundancy.hpp"
 #include "craneassist/dynamics/rigid_body_terms.hpp"
@@ -72,6 +73,21 @@ struct ControllerOutput {
   double sddot_min = 0.0, sddot_max = 0.0;
   double tip_error_m = 0.0;  // filtered tracking error used for the slow-down
   double ref_power_w = 0.0;  // pump power (LS, or p_s Q) the model predicts for the reference
+  // The flow manipulability polytope at the configuration this cycle resolved (docs/polytope.md,
+  // dynamics/flow_polytope.hpp), with the cylinder speeds and pump flow the scaling in use
+  // allows (the full scaling keeps control.flow_reserve of both, the flow-only prescaling of
+  // the flow only):
+  //   avail_speed_m_s           the fastest tip speed along the stick's direction (the last one
+  //                             while the stick is released) over every joint motion (LP);
+  //   avail_speed_resolved_m_s  the fastest along the joint motion this controller chose: the
+  //                             scaling's flow and cylinder-speed bound (full scaling: along the
+  //                             path direction u; flow-only and none: along the command; 0 with
+  //                             no command);
+  //   polytope_volume_m3_s3     the volume of the tip polytope (0 for a planar arm, whose
+  //                             polytope is flat).
+  double avail_speed_m_s = 0.0;
+  double avail_speed_resolved_m_s = 0.0;
+  double polytope_volume_m3_s3 = 0.0;
 };
 
 // The controller's status is the cycle status of the loop (control_loop.hpp).
@@ -117,6 +133,9 @@ class Controller {
   void update_rate_prescaled(const Eigen::Vector3d& v_cmd, ControllerOutput& out) noexcept;
   // This cycle's dynamics step failed (kFull only).
   bool dynamics_failed() const noexcept;
+  // The polytope's figures of ControllerOutput at q, the configuration the cycle resolved at.
+  void update_polytope(const JointVector& q, const Eigen::Vector3d& v_cmd, bool stale,
+                       ControllerOutput& out) noexcept;
 
   const dynamics::CraneModel& model_;
   ControllerOptions options_;
@@ -138,6 +157,13 @@ class Controller {
   scaling::TipScalerOutput scaler_out_;
   JointVector dc_dq_, qddot_max_;
   JointVector q_ref_;
+  // The flow manipulability polytope's working data.
+  dynamics::FlowPolytopeSettings polytope_settings_;
+  dynamics::FlowPolytope polytope_;
+  dynamics::JointVelocitySet polytope_set_;
+  dynamics::TaskJacobian polytope_jacobian_;
+  JointVector polytope_arms_;
+  Eigen::Vector3d stick_direction_ = Eigen::Vector3d::UnitX();
   double tip_error_filtered_m_ = 0.0;
   bool neutral_ = false;  // the last update returned kStopped (valves neutral)
 };

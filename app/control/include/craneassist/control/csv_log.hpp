@@ -29,7 +29,9 @@ struct LogRow {
   double scale = 0.0, flow_demand_m3s = 0.0;
   double s = 0.0, sdot = 0.0, sddot = 0.0, sdddot = 0.0, sddot_min = 0.0, sddot_max = 0.0;
   double tip_error_m = 0.0;
-  double ref_power_w = 0.0;       // pump power the model predicts for the reference
+  double ref_power_w = 0.0;  // pump power the model predicts for the reference
+  // The flow manipulability polytope (ControllerOutput).
+  double avail_speed_m_s = 0.0, avail_speed_resolved_m_s = 0.0, polytope_volume_m3s3 = 0.0;
   const char* active_limit = "";  // static strings only (to_string of the enums)
   const char* pump_limit = "";
   // Live-loop fields (the live loop and telemetry fill them; the CSV writer does not write them):
