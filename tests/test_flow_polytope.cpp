@@ -466,8 +466,9 @@ TEST(FlowPolytope, SpeedAlongTheResolutionIsTheScalingStagesBound) {
     const double product = std::min(limits.sdot_flow, limits.sdot_cylinder);
     const double polytope = dynamics::speed_along(p.set, out.geometry.f1);
     // Where u cannot be done without driving a joint into the end it is at (the slew at its
-    // stop and u sideways), the polytope allows nothing along f', and neither does the
-    // controller: its end damping caps the speed at 0.
+    // stop and u sideways), the polytope allows nothing along f' (a joint within 1e-4 of its end
+    // counts as at it), and the controller almost nothing: its end damping allows at most the
+    // speed that stops in the remaining 1e-4, a few cm/s of path speed (0.026 m/s measured).
     bool into_end = false;
     for (int i = 0; i < 4; ++i) {
       const double f = out.geometry.f1[i];
@@ -476,7 +477,7 @@ TEST(FlowPolytope, SpeedAlongTheResolutionIsTheScalingStagesBound) {
     }
     if (into_end) {
       EXPECT_EQ(polytope, 0.0) << trial;
-      EXPECT_EQ(out.sdot_joint_limit, 0.0) << trial;
+      EXPECT_LE(out.sdot_joint_limit, 0.05) << trial;
       ++into_ends;
       continue;
     }
