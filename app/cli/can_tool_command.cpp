@@ -1,10 +1,6 @@
 #include "can_tool_command.hpp"
 
-#include <spdlog/spdlog.h>
-
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
 
 #include "can_commands.hpp"
 #include "craneassist/can/dbc.hpp"
@@ -37,19 +33,8 @@ int run_can_tool_command(const CanToolArgs& args) {
   const std::string title = args.mapping_file.empty()
                                 ? std::string("k70m_can.yaml")
                                 : std::filesystem::path(args.mapping_file).filename().string();
-  const std::string text = can::write_dbc(mapping, title);
-  if (args.output.empty()) {
-    std::fputs(text.c_str(), stdout);
-    return kExitOk;
-  }
-  std::ofstream out(args.output, std::ios::binary);
-  out << text;
-  if (!out) {
-    spdlog::error("{}: cannot write", args.output);
-    return kExitRuntime;
-  }
-  spdlog::info("wrote {} ({} joints)", args.output, mapping.joints.size());
-  return kExitOk;
+  return write_output(can::write_dbc(mapping, title), args.output,
+                      std::to_string(mapping.joints.size()) + " joints");
 }
 
 }  // namespace craneassist::cli

@@ -2,7 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cstdio>
 #include <exception>
+#include <fstream>
 
 #include "craneassist/config/config_error.hpp"
 #include "craneassist/input/file_error.hpp"
@@ -20,6 +22,21 @@ int input_error_exit(const char* file_kind) {
     spdlog::error("{}", e.what());
   }
   return kExitUsage;
+}
+
+int write_output(const std::string& text, const std::string& path, const std::string& what) {
+  if (path.empty()) {
+    std::fputs(text.c_str(), stdout);
+    return kExitOk;
+  }
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  if (!out) {
+    spdlog::error("{}: cannot write", path);
+    return kExitRuntime;
+  }
+  spdlog::info("wrote {} ({})", path, what);
+  return kExitOk;
 }
 
 }  // namespace craneassist::cli

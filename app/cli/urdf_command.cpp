@@ -1,10 +1,5 @@
 #include "urdf_command.hpp"
 
-#include <spdlog/spdlog.h>
-
-#include <cstdio>
-#include <fstream>
-
 #include "crane_options.hpp"
 #include "craneassist/dynamics/urdf.hpp"
 #include "exit_codes.hpp"
@@ -29,19 +24,8 @@ int run_urdf_command(const UrdfArgs& args) {
   } catch (...) {
     return input_error_exit("config");
   }
-  const std::string text = dynamics::to_urdf(cfg.model, args.name);
-  if (args.output.empty()) {
-    std::fputs(text.c_str(), stdout);
-    return kExitOk;
-  }
-  std::ofstream out(args.output, std::ios::binary);
-  out << text;
-  if (!out) {
-    spdlog::error("{}: cannot write", args.output);
-    return kExitRuntime;
-  }
-  spdlog::info("wrote {} ({} joints)", args.output, cfg.model.dof());
-  return kExitOk;
+  return write_output(dynamics::to_urdf(cfg.model, args.name), args.output,
+                      std::to_string(cfg.model.dof()) + " joints");
 }
 
 }  // namespace craneassist::cli

@@ -755,34 +755,19 @@ std::string write_dbc(const CanMapping& mapping, std::string_view title) {
   // Feedback: what the machine sends. Its cycle is the machine's; the mapping does not say it.
   for (const auto& jm : mapping.joints) {
     const std::string owner = identifier(jm.name);
-    messages.add({owner + "_position",
-                  owner,
-                  "position",
-                  in_file_units(jm.position),
-                  "craneassist",
-                  "joint " + jm.name + ": position",
-                  {}},
-                 "machine", 0.0);
-    if (jm.pressure_a) {
-      messages.add({owner + "_pressure_a",
+    const auto feedback = [&](const char* role, const SignalSpec& spec, const char* what) {
+      messages.add({owner + "_" + role,
                     owner,
-                    "pressure_a",
-                    in_file_units(*jm.pressure_a),
+                    role,
+                    in_file_units(spec),
                     "craneassist",
-                    "joint " + jm.name + ": cylinder pressure, piston side",
+                    "joint " + jm.name + ": " + what,
                     {}},
                    "machine", 0.0);
-    }
-    if (jm.pressure_b) {
-      messages.add({owner + "_pressure_b",
-                    owner,
-                    "pressure_b",
-                    in_file_units(*jm.pressure_b),
-                    "craneassist",
-                    "joint " + jm.name + ": cylinder pressure, rod side",
-                    {}},
-                   "machine", 0.0);
-    }
+    };
+    feedback("position", jm.position, "position");
+    if (jm.pressure_a) feedback("pressure_a", *jm.pressure_a, "cylinder pressure, piston side");
+    if (jm.pressure_b) feedback("pressure_b", *jm.pressure_b, "cylinder pressure, rod side");
   }
   // The valves' replies: Estimated Flow of ISO 11783 valves, a driver's status signal; DM1.
   for (const auto& jm : mapping.joints) {
