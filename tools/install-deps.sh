@@ -15,6 +15,7 @@ packages=(
   libboost-dev nlohmann-json3-dev chromium  # the web view (docs/web.md) and its browser test
   liburdfdom-dev liburdfdom-tools  # reads back the URDF of craneassist urdf (docs/ros.md)
   python3-can python3-canmatrix  # decode craneassist's CAN logs through its DBC (docs/can.md)
+  libnlopt-dev  # the MHSB planner's optimal posture table (SLSQP; docs/mhsb.md)
 )
 # npm bundles the web page at build time (Debian's npm, unless node and npm are already there).
 command -v npm >/dev/null || packages+=(npm)

@@ -401,9 +401,50 @@ void read_valve_tables(Reader& r, const YAML::Node& tables, const std::string& p
   }
 }
 
+// hydraulics.mhsb (docs/mhsb.md): the boost modules and the servo-valves of an MHSB arm. The main
+// pump must be a constant-pressure pump: its setpoint is the circuit's P0.
+void read_mhsb(Reader& r, const YAML::Node& node, dynamics::CraneModel& model) {
+  const std::string mp = "hydraulics.mhsb";
+  r.check_keys(node, mp,
+               {"modules", "servo_pump_max_flow", "max_boost", "servo_pump_efficiency",
+                "tank_pressure", "velocity_limit", "servo_valve"});
+  if (model.pump.mode != dynamics::PumpMode::kConstantPressure) {
+    r.fail(node, mp,
+           "an MHSB circuit needs a constant-pressure main pump (hydraulics.pump.mode: "
+           "constant-pressure; its supply_pressure is P0)");
+  }
+  dynamics::Mhsb m;
+  const double modules = r.value_in(node, "modules", mp, Dimension::kDimensionless, 0.0, 16.0,
+                                    "a whole number from 0 to 16");
+  if (modules != std::floor(modules)) {
+    r.fail(node["modules"], mp + ".modules", "must be a whole number from 0 to 16");
+  }
+  m.modules = static_cast<int>(modules);
+  m.servo_pump_max_flow_m3_s =
+      r.value_in(node, "servo_pump_max_flow", mp, Dimension::kFlow, kPumpMaxFlow);
+  m.max_boost_pa =
+      r.value_in(node, "max_boost", mp, Dimension::kPressure, 1e4, 1e8, "between 0.1 and 1000 bar");
+  m.servo_pump_efficiency = r.value_in(node, "servo_pump_efficiency", mp, Dimension::kDimensionless,
+                                       0.05, 1.0, "between 0.05 and 1");
+  m.tank_pressure_pa = r.value_in(node, "tank_pressure", mp, Dimension::kPressure, 0.0,
+                                  0.5 * model.pump.supply_pressure_pa,
+                                  "between 0 and half the main pump's supply pressure");
+  m.velocity_limit_m_s = r.value_in(node, "velocity_limit", mp, Dimension::kVelocity, 1e-4, 10.0,
+                                    "between 0.1 mm/s and 10 m/s");
+  const YAML::Node sv = r.child(node, "servo_valve", mp);
+  const std::string svp = mp + ".servo_valve";
+  r.check_keys(sv, svp, {"rated_flow", "rated_pressure_drop", "leakage"});
+  m.valve.rated_flow_m3_s = r.value_in(sv, "rated_flow", svp, Dimension::kFlow, kPumpMaxFlow);
+  m.valve.rated_pressure_drop_pa = r.value_in(sv, "rated_pressure_drop", svp, Dimension::kPressure,
+                                              1e4, 1e8, "between 0.1 and 1000 bar");
+  m.valve.leakage_m3_s =
+      r.value_in(sv, "leakage", svp, Dimension::kFlow, 0.0, 1.0, "between 0 and 60000 L/min");
+  model.mhsb = m;
+}
+
 void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& model) {
   const YAML::Node h = r.child(root, "hydraulics", "");
-  r.check_keys(h, "hydraulics", {"pump", "valves"});
+  r.check_keys(h, "hydraulics", {"pump", "valves", "mhsb"});
   const YAML::Node pump = r.child(h, "pump", "hydraulics");
   const std::string pp = "hydraulics.pump";
   r.check_keys(pump, pp,
@@ -442,6 +483,7 @@ void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& mo
       r.value_in(valves, "time_constant", vp, Dimension::kTime, 0.0, 5.0, "between 0 and 5 s");
   v.delay_s = r.value_in(valves, "delay", vp, Dimension::kTime, 0.0, 2.0, "between 0 and 2 s");
   if (valves["tables"].IsDefined()) read_valve_tables(r, valves["tables"], vp + ".tables", model);
+  if (h["mhsb"].IsDefined() && !h["mhsb"].IsNull()) read_mhsb(r, h["mhsb"], model);
 }
 
 // `backend: sim | can` and the optional `can:` section; both may be left out (sim).
@@ -613,6 +655,10 @@ CraneConfig default_crane_config() {
 
 CraneConfig planar_2r_config() {
   return parse_crane_config(embedded::kPlanar2rYaml, "<embedded config/cranes/planar_2r.yaml>");
+}
+
+CraneConfig mhsb_3link_config() {
+  return parse_crane_config(embedded::kMhsb3linkYaml, "<embedded config/cranes/mhsb_3link.yaml>");
 }
 
 void apply_energy_optimal(CraneConfig& cfg) {

@@ -91,6 +91,8 @@ CraneConfig parse_crane_config(std::string_view yaml_text, std::string_view sour
 // The shipped models, embedded in the binary (config/cranes/k70m.yaml, planar_2r.yaml).
 CraneConfig default_crane_config();
 CraneConfig planar_2r_config();
+// The three-link MHSB arm of paper 001 (config/cranes/mhsb_3link.yaml; docs/mhsb.md).
+CraneConfig mhsb_3link_config();
 
 // With redundancy.energy_optimal, sets the resolution for the model's present pump mode.
 void apply_energy_optimal(CraneConfig& cfg);

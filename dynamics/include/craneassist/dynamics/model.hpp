@@ -151,6 +151,37 @@ struct ValveSections {
   std::vector<ValveTable> tables;
 };
 
+// A four-way servo-valve in front of each cylinder (MHSB arms; paper 001 eqs. 1-2): at full
+// opening each metering edge passes rated_flow at rated_pressure_drop (Q = Q_R sqrt(dp / P_R)),
+// and the valve leaks `leakage` from supply to tank whatever its opening.
+struct ServoValve {
+  double rated_flow_m3_s = 0.0;
+  double rated_pressure_drop_pa = 0.0;
+  double leakage_m3_s = 0.0;
+};
+
+// The Modular Hydraulic Servo Booster circuit (paper 001 section 1; docs/mhsb.md). The main pump
+// (CraneModel::pump, constant pressure P0 = supply_pressure) feeds every actuator's servo-valve;
+// boost modules, each a servo-pump (an electric-motor-driven fixed pump) with a check valve and
+// switching valves, can be put in series between the main pump and an actuator's valve:
+//  - N (normal): no module; supply P0, the main pump's flow shared by all actuators;
+//  - DB (decoupled boost): one module; supply up to P0 + max_boost, the actuator's flow at most
+//    one servo-pump's servo_pump_max_flow;
+//  - SB (shared boost): two modules' flows summed into one actuator (the reading of the paper that
+//    gives its 23 mode patterns for three actuators and four modules, and its Table 2 speed limits:
+//    DB 8.2/10.7 mm/s, SB the full 12 mm/s).
+// The main pump also supplies what the servo-pumps deliver (they are in series with it).
+struct Mhsb {
+  int modules = 0;  // boost modules fitted
+  double servo_pump_max_flow_m3_s = 0.0;
+  double max_boost_pa = 0.0;  // highest pressure a servo-pump adds
+  double servo_pump_efficiency = 1.0;
+  double tank_pressure_pa = 0.0;
+  // The planner's quasi-static cylinder speed limit V_L (paper 001 section 2.2, assumption 2).
+  double velocity_limit_m_s = 0.0;
+  ServoValve valve;
+};
+
 struct CraneModel {
   std::string name;
   std::vector<DhJoint> joints;      // n joints
@@ -161,6 +192,9 @@ struct CraneModel {
   Eigen::Matrix3d task_from_base = Eigen::Matrix3d::Identity();
   Pump pump;
   ValveSections valves;
+  // An MHSB circuit (hydraulics.mhsb); absent: valve sections on a load-sensing or
+  // constant-pressure pump.
+  std::optional<Mhsb> mhsb;
 
   int dof() const { return static_cast<int>(joints.size()); }
 };
