@@ -198,4 +198,49 @@ TEST(MhsbPolytope, ModeBoxesCutTheJointVelocities) {
   EXPECT_DOUBLE_EQ(n.max_flow_m3_s, model.pump.max_flow_m3_s);
 }
 
+// Every vertex of a pattern's joint-velocity set is a motion the circuit can make: each cylinder's
+// speed needs at most its mode's supply pressure against its load, and a boosted cylinder's flow
+// is at most its servo-pumps'.
+TEST(MhsbPolytope, EveryVertexIsWithinTheValveAndPumpLaws) {
+  const auto cfg = craneassist::config::mhsb_3link_config();
+  const CraneModel& model = cfg.model;
+  const Mhsb& m = *model.mhsb;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0), load(-4000.0, 4000.0);
+  const auto patterns = mode_patterns(3, m.modules);
+  Eigen::MatrixXd vertices(3, max_joint_vertices(3));
+  int checked = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    JointVector q(3), arms(3), force(3);
+    for (int i = 0; i < 3; ++i) {
+      const auto& j = model.joints[static_cast<std::size_t>(i)];
+      q[i] = j.q_min + unit(rng) * (j.q_max - j.q_min);
+      force[i] = load(rng);
+    }
+    cylinder_arms(model, q, arms);
+    const ModePattern& pattern = patterns[static_cast<std::size_t>(trial) % patterns.size()];
+    JointVelocitySet set;
+    mhsb_joint_velocity_set(model, q, arms, force, pattern, FlowPolytopeSettings{}, set);
+    const int count = joint_velocity_vertices(set, vertices);
+    for (int k = 0; k < count; ++k) {
+      double flow = 0.0;
+      for (int i = 0; i < 3; ++i) {
+        const double v = arms[i] * vertices(i, k);
+        const Cylinder& c = model.cylinders[static_cast<std::size_t>(i)];
+        flow += flow_area_m2(c, v) * std::abs(v);
+        if (std::abs(v) < 1e-12) continue;
+        const MhsbMode mode = pattern.mode[static_cast<std::size_t>(i)];
+        EXPECT_LE(required_supply_pressure_pa(c, m.valve, m.tank_pressure_pa, force[i], v),
+                  mode_supply_pressure_pa(model, mode) * (1 + 1e-9) + 1e-3)
+            << to_string(pattern) << " joint " << i;
+        EXPECT_LE(flow_area_m2(c, v) * std::abs(v), mode_flow_cap_m3_s(m, mode) * (1 + 1e-9));
+        EXPECT_LE(std::abs(v), c.v_max_m_s * (1 + 1e-9));
+        ++checked;
+      }
+      EXPECT_LE(flow, model.pump.max_flow_m3_s * (1 + 1e-9));
+    }
+  }
+  EXPECT_GT(checked, 500);
+}
+
 }  // namespace

@@ -171,6 +171,9 @@ CLI::App* add_polytope_command(CLI::App& cli, PolytopeArgs& args) {
   add_resolution_option(*cmd, args.resolution, "of the controller");
   cmd->add_option("--pump-max-flow", args.pump_max_flow,
                   "Override the pump's maximum flow, e.g. \"120 L/min\"");
+  cmd->add_option("--modes", args.modes,
+                  "An MHSB arm's mode per joint, N, DB or SB, e.g. \"N-DB-N\" (docs/mhsb.md; "
+                  "default: all N)");
   cmd->add_option("--out", args.out, "Write the polytope's vertices to this CSV");
   cmd->add_option("--plot", args.plot,
                   "Draw the polytope into this PNG (tools/plot_polytope.py; needs python3 with "
@@ -182,6 +185,7 @@ int run_polytope_command(const PolytopeArgs& args) {
   config::CraneConfig cfg;
   dynamics::JointVector q;
   std::vector<Eigen::Vector3d> directions;
+  std::optional<dynamics::ModePattern> modes;
   try {
     cfg = load_crane(args.config_file);
     apply_crane_options(cfg, {.resolution = args.resolution});
@@ -196,6 +200,24 @@ int run_polytope_command(const PolytopeArgs& args) {
         q = config::parse_joint_pose(cfg.model, args.pose, q);
       } catch (const std::invalid_argument& e) {
         throw CLI::ValidationError("--pose", e.what());
+      }
+    }
+    if (!args.modes.empty()) {
+      if (!cfg.model.mhsb) {
+        throw CLI::ValidationError("--modes",
+                                   "the crane has no MHSB circuit (hydraulics.mhsb in its config)");
+      }
+      modes = dynamics::parse_mode_pattern(args.modes, cfg.model.dof());
+      if (!modes) {
+        throw CLI::ValidationError(
+            "--modes", "'" + args.modes + "': expected one of N, DB, SB per joint (" +
+                           std::to_string(cfg.model.dof()) + "), joined by '-', e.g. N-DB-N");
+      }
+      if (modes->modules() > cfg.model.mhsb->modules) {
+        throw CLI::ValidationError(
+            "--modes", "'" + args.modes + "' takes " + std::to_string(modes->modules()) +
+                           " boost modules (DB one, SB two); the circuit has " +
+                           std::to_string(cfg.model.mhsb->modules));
       }
     }
     const Plane plane = dynamics::planar_task_basis(cfg.model);
@@ -214,7 +236,8 @@ int run_polytope_command(const PolytopeArgs& args) {
   } catch (...) {
     return input_error_exit("config");
   }
-  const offline::PolytopeReport r = offline::polytope_report(cfg, q, directions, args.speed_m_s);
+  const offline::PolytopeReport r =
+      offline::polytope_report(cfg, q, directions, args.speed_m_s, modes);
 
   const int dim = r.task_dim;
   const std::string pose = pose_text(cfg.model, q);
@@ -223,10 +246,30 @@ int run_polytope_command(const PolytopeArgs& args) {
   for (const auto& j : r.joints_at_end) ends += (ends.empty() ? "at an end: " : ", ") + j;
   std::printf("  pose: %s (%s)\n", pose.c_str(),
               ends.empty() ? "no joint at an end" : ends.c_str());
-  std::printf(
-      "  limits: each cylinder's speed and the pump's %.0f L/min, less the %.0f %% reserve of the "
-      "full scaling (%.1f L/min); joints at an end move only away from it\n",
-      cfg.model.pump.max_flow_m3_s / kLpm, 100.0 * r.flow_reserve, r.max_flow_m3_s / kLpm);
+  if (r.modes) {
+    const auto& m = *cfg.model.mhsb;
+    std::printf(
+        "  MHSB modes %s: each servo-valve from its supply (N: P0 %.1f MPa; DB, SB: up to %.1f "
+        "MPa) against its cylinder's load, DB one servo-pump's %.3f L/min, SB two; the main "
+        "pump's %.2f L/min in all, less the %.0f %% reserve (%.2f L/min); joints at an end move "
+        "only away from it\n",
+        dynamics::to_string(*r.modes).c_str(), cfg.model.pump.supply_pressure_pa * 1e-6,
+        dynamics::mode_supply_pressure_pa(cfg.model, dynamics::MhsbMode::kDecoupledBoost) * 1e-6,
+        m.servo_pump_max_flow_m3_s / kLpm, cfg.model.pump.max_flow_m3_s / kLpm,
+        100.0 * r.flow_reserve, r.max_flow_m3_s / kLpm);
+    std::printf("  cylinder loads at the pose (gravity, + pushing the rod in):");
+    for (int i = 0; i < cfg.model.dof(); ++i) {
+      std::printf("%s %s %.0f N", i ? "," : "",
+                  cfg.model.joints[static_cast<std::size_t>(i)].name.c_str(),
+                  r.cylinder_force_n[i]);
+    }
+    std::printf("\n");
+  } else {
+    std::printf(
+        "  limits: each cylinder's speed and the pump's %.0f L/min, less the %.0f %% reserve of "
+        "the full scaling (%.1f L/min); joints at an end move only away from it\n",
+        cfg.model.pump.max_flow_m3_s / kLpm, 100.0 * r.flow_reserve, r.max_flow_m3_s / kLpm);
+  }
   if (dim == 3) {
     std::printf(
         "  joint-velocity set: %d vertices; tip polytope: %zu vertices, volume %.4g m^3/s^3",
@@ -255,6 +298,21 @@ int run_polytope_command(const PolytopeArgs& args) {
     if (s.resolved_limit.empty()) std::printf(" (the resolution finds no joint motion for u here)");
     if (args.speed_m_s) std::printf(", shaped for %.2f m/s", s.intended_m_s);
     std::printf("\n");
+  }
+  if (!r.pattern_measures.empty()) {
+    std::printf("  %s per mode pattern, %s (* the largest):\n", dim == 3 ? "volume" : "area",
+                dim == 3 ? "m^3/s^3" : "m^2/s^2");
+    double best = 0.0;
+    for (const auto& [pattern, measure] : r.pattern_measures) best = std::max(best, measure);
+    for (std::size_t k = 0; k < r.pattern_measures.size(); ++k) {
+      const auto& [pattern, measure] = r.pattern_measures[k];
+      char value[32];
+      std::snprintf(value, sizeof value, "%.4g%s", measure,
+                    measure == best && best > 0.0 ? "*" : "");
+      std::printf("%s%-9s %-8s", k % 4 == 0 ? "    " : " ", dynamics::to_string(pattern).c_str(),
+                  value);
+      if (k % 4 == 3 || k + 1 == r.pattern_measures.size()) std::printf("\n");
+    }
   }
   std::printf("  vertices, m/s (%s):\n",
               dim == 3 ? "crane frame: x forward, y up, z lateral"

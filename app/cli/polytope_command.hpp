@@ -17,6 +17,7 @@ struct PolytopeArgs {
   std::optional<double> speed_m_s;
   std::string resolution;     // empty: the config's
   std::string pump_max_flow;  // empty: the config's
+  std::string modes;          // an MHSB arm's mode pattern, e.g. "N-DB-N"; empty: all N
   std::string out;            // CSV of the vertices; empty: none
   std::string plot;           // PNG; empty: none
 };

@@ -6,6 +6,7 @@
 #include "craneassist/control/controller.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
+#include "craneassist/dynamics/rigid_body_terms.hpp"
 #include "craneassist/scaling/tip_path.hpp"
 
 namespace craneassist::offline {
@@ -36,7 +37,8 @@ std::string limit_of(const dynamics::CraneModel& model, const dynamics::JointVel
 
 PolytopeReport polytope_report(const config::CraneConfig& cfg, const dynamics::JointVector& q,
                                const std::vector<Eigen::Vector3d>& directions,
-                               std::optional<double> intended_speed_m_s) {
+                               std::optional<double> intended_speed_m_s,
+                               std::optional<dynamics::ModePattern> modes) {
   const auto& model = cfg.model;
   const int n = model.dof();
   PolytopeReport r;
@@ -65,13 +67,29 @@ PolytopeReport polytope_report(const config::CraneConfig& cfg, const dynamics::J
   dynamics::JointVelocitySet set;
   const dynamics::FlowPolytopeSettings settings{.flow_reserve = cfg.control.flow_reserve,
                                                 .cylinder_speed_reserve = cfg.control.flow_reserve};
+  // Joints at an end: the plain set's (an MHSB mode may also stop a joint one way, by its load).
   dynamics::joint_velocity_set(model, q, arms, settings, set);
-  r.max_flow_m3_s = set.max_flow_m3_s;
   for (int i = 0; i < n; ++i) {
     if (set.qdot_max[i] == 0.0 || set.qdot_min[i] == 0.0) {
       r.joints_at_end.push_back(model.joints[static_cast<std::size_t>(i)].name);
     }
   }
+  if (model.mhsb) {
+    // The cylinders' loads: the joint efforts that hold the arm against gravity, through the arms.
+    dynamics::JointVector holding;
+    dynamics::RigidBodyTerms(model).gravity(q, holding);
+    r.cylinder_force_n = dynamics::JointVector::Zero(n);
+    for (int i = 0; i < n; ++i) {
+      if (std::abs(arms[i]) > 1e-12) r.cylinder_force_n[i] = holding[i] / arms[i];
+    }
+    if (!modes) {
+      modes = dynamics::ModePattern{};
+      modes->dof = n;
+    }
+    r.modes = modes;
+    dynamics::mhsb_joint_velocity_set(model, q, arms, r.cylinder_force_n, *modes, settings, set);
+  }
+  r.max_flow_m3_s = set.max_flow_m3_s;
 
   const dynamics::TaskMatrix task =
       r.plane ? dynamics::TaskMatrix(*r.plane * jacobian) : dynamics::TaskMatrix(jacobian);
@@ -92,6 +110,18 @@ PolytopeReport polytope_report(const config::CraneConfig& cfg, const dynamics::J
   for (const int v : order) {
     r.vertices.push_back(points[static_cast<std::size_t>(v)]);
     r.vertex_qdot.emplace_back(poly.joint_vertex(v));
+  }
+
+  if (model.mhsb) {
+    dynamics::JointVelocitySet other;
+    dynamics::FlowPolytope each(n, r.task_dim);
+    for (const auto& pattern : dynamics::mode_patterns(n, model.mhsb->modules)) {
+      dynamics::mhsb_joint_velocity_set(model, q, arms, r.cylinder_force_n, pattern, settings,
+                                        other);
+      each.update(other, task);
+      each.build_hull();
+      r.pattern_measures.emplace_back(pattern, r.task_dim == 3 ? each.volume() : each.area());
+    }
   }
 
   // The controller's resolution of each direction, fresh (no previous cycle to smooth from) and

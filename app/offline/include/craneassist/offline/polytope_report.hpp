@@ -14,6 +14,7 @@
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/dynamics/flow_polytope.hpp"
+#include "craneassist/dynamics/mhsb.hpp"
 
 namespace craneassist::offline {
 
@@ -46,14 +47,23 @@ struct PolytopeReport {
   double max_flow_m3_s = 0.0;  // the pump flow the set allows (less the reserve)
   double flow_reserve = 0.0;
   std::string resolution;  // the controller's resolution, e.g. "min-ls-power"
+  // An MHSB arm (hydraulics.mhsb; docs/mhsb.md): the mode pattern of the polytope above, each
+  // cylinder's gravity load at the pose (N, positive pushing the rod in), and the polytope's
+  // measure (area, or volume for a 3-D task) in every pattern the modules allow, in
+  // mode_patterns() order.
+  std::optional<dynamics::ModePattern> modes;
+  dynamics::JointVector cylinder_force_n;
+  std::vector<std::pair<dynamics::ModePattern, double>> pattern_measures;
 };
 
 // The polytope of cfg's crane at q. directions: crane-frame vectors (any length but not zero; a
 // planar arm uses their part in its plane). intended_speed_m_s: the speed the controller's
 // resolution is shaped for (it chooses joint motions that serve that speed); nullopt: the LP's
-// speed along each direction (the operator asks for all the machine can give there).
+// speed along each direction (the operator asks for all the machine can give there). modes: an
+// MHSB arm's mode pattern (nullopt: all N); ignored without hydraulics.mhsb.
 PolytopeReport polytope_report(const config::CraneConfig& cfg, const dynamics::JointVector& q,
                                const std::vector<Eigen::Vector3d>& directions,
-                               std::optional<double> intended_speed_m_s);
+                               std::optional<double> intended_speed_m_s,
+                               std::optional<dynamics::ModePattern> modes = std::nullopt);
 
 }  // namespace craneassist::offline
