@@ -1,0 +1,87 @@
+// "Move the tip to this point": a command source that follows a planned tip trajectory
+// (docs/mhsb.md, "The K70M: a goal for sim"). A planner outside the control thread publishes a
+// plan, a time-stamped sequence of tip positions, whenever the goal changes; each cycle this input
+// samples the newest plan at machine time and commands
+//     v = v_ref(t) + k (p_ref(t) - tip),   the feedback part at most feedback_speed_cap_m_s,
+// through the normal controller, so scaling, joint ends and every stop apply as to a stick. At
+// the plan's end it keeps pulling the tip to the goal until it is within goal_tolerance_m, then
+// gives no command ("goal reached": the controller's jerk-limited stop, valves neutral); before
+// any plan it gives none ("no goal").
+//
+// Threads: publish() on one producer thread, next() on the control thread. The handoff is a
+// triple buffer (three preallocated plans, one atomic index exchange each way): next() never
+// blocks, never allocates and always sees a whole plan. The measured tip goes the other way
+// through a sequence lock (last_tip()), for the producer to plan from.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "craneassist/control/tip_command_task.hpp"
+
+namespace craneassist::control {
+
+struct TipSample {
+  double t_s = 0.0;                                 // from the plan's start
+  Eigen::Vector3d p_m = Eigen::Vector3d::Zero();    // crane frame
+  Eigen::Vector3d v_m_s = Eigen::Vector3d::Zero();  // crane frame
+};
+
+struct GoalInputSettings {
+  std::size_t capacity = 8192;          // samples per plan
+  double position_gain_1_s = 2.0;       // k
+  double feedback_speed_cap_m_s = 0.3;  // |k e| at most this
+  double goal_tolerance_m = 0.02;       // within this of the goal at the plan's end: reached
+};
+
+class GoalInput final : public TipCommandInput {
+ public:
+  explicit GoalInput(const GoalInputSettings& settings);  // allocates the three plans
+
+  // Producer thread. samples: times strictly increasing from 0, at most capacity (more: false,
+  // nothing published); start_t_s: the machine time of sample 0. Replaces any earlier plan.
+  bool publish(std::span<const TipSample> samples, double start_t_s);
+  // Producer thread: the newest measured tip and its machine time (false before any cycle, or
+  // while the tip measurement is invalid).
+  bool last_tip(Eigen::Vector3d& tip_m, double& t_s) const noexcept;
+  // Producer thread: how many plans the control thread has taken up.
+  std::uint64_t plans_taken() const noexcept { return taken_.load(std::memory_order_acquire); }
+
+  void next(const CycleTime& time, const Eigen::Vector3d& tip_m, TipCommand& out) noexcept override;
+  const char* name() const noexcept override { return "goal"; }
+
+  // Control thread (or after the run): the plan in use and where on it the last cycle was.
+  bool has_plan() const noexcept { return front_ != nullptr && front_->count > 0; }
+  bool reached() const noexcept { return reached_; }
+  const Eigen::Vector3d& reference() const noexcept { return reference_; }
+
+ private:
+  struct Plan {
+    std::vector<TipSample> samples;  // capacity preallocated
+    std::size_t count = 0;
+    double start_t_s = 0.0;
+  };
+  void sample(double tau_s, Eigen::Vector3d& p, Eigen::Vector3d& v) noexcept;
+
+  GoalInputSettings settings_;
+  std::array<Plan, 3> plans_;
+  // Triple buffer: the producer owns back_, the consumer front_; middle_ holds the third plan's
+  // index with bit 2 set when it is newer than the consumer's.
+  int back_index_ = 0;
+  std::atomic<int> middle_{1};
+  int front_index_ = 2;
+  Plan* front_ = nullptr;
+  std::size_t cursor_ = 0;
+  bool reached_ = false;
+  Eigen::Vector3d reference_ = Eigen::Vector3d::Zero();
+  std::atomic<std::uint64_t> taken_{0};
+  // Sequence lock on the measured tip: odd while being written.
+  std::atomic<std::uint64_t> tip_seq_{0};
+  std::array<std::atomic<double>, 4> tip_{};  // x, y, z, t
+};
+
+}  // namespace craneassist::control

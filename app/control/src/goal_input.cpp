@@ -1,0 +1,137 @@
+#include "craneassist/control/goal_input.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace craneassist::control {
+namespace {
+
+constexpr int kFresh = 4;
+constexpr int kIndexMask = 3;
+
+}  // namespace
+
+GoalInput::GoalInput(const GoalInputSettings& settings) : settings_(settings) {
+  for (auto& plan : plans_) plan.samples.resize(settings.capacity);
+}
+
+bool GoalInput::publish(std::span<const TipSample> samples, double start_t_s) {
+  if (samples.empty() || samples.size() > settings_.capacity || !std::isfinite(start_t_s)) {
+    return false;
+  }
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const auto& s = samples[k];
+    if (!std::isfinite(s.t_s) || !s.p_m.allFinite() || !s.v_m_s.allFinite()) return false;
+    if (k > 0 && !(s.t_s > samples[k - 1].t_s)) return false;
+  }
+  Plan& plan = plans_[static_cast<std::size_t>(back_index_)];
+  std::copy(samples.begin(), samples.end(), plan.samples.begin());
+  plan.count = samples.size();
+  plan.start_t_s = start_t_s;
+  // Hand the written plan over; take back whichever the middle held.
+  back_index_ = middle_.exchange(back_index_ | kFresh, std::memory_order_acq_rel) & kIndexMask;
+  return true;
+}
+
+bool GoalInput::last_tip(Eigen::Vector3d& tip_m, double& t_s) const noexcept {
+  for (int attempt = 0; attempt < 1000; ++attempt) {
+    const std::uint64_t before = tip_seq_.load(std::memory_order_acquire);
+    if (before == 0) return false;
+    if (before & 1U) continue;
+    const double x = tip_[0].load(std::memory_order_relaxed);
+    const double y = tip_[1].load(std::memory_order_relaxed);
+    const double z = tip_[2].load(std::memory_order_relaxed);
+    const double t = tip_[3].load(std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_acquire);
+    if (tip_seq_.load(std::memory_order_relaxed) == before) {
+      tip_m = {x, y, z};
+      t_s = t;
+      return std::isfinite(x) && std::isfinite(y) && std::isfinite(z);
+    }
+  }
+  return false;
+}
+
+void GoalInput::sample(double tau_s, Eigen::Vector3d& p, Eigen::Vector3d& v) noexcept {
+  const auto& s = front_->samples;
+  const std::size_t n = front_->count;
+  if (tau_s <= s[0].t_s) {
+    p = s[0].p_m;
+    v = tau_s < s[0].t_s ? Eigen::Vector3d::Zero() : s[0].v_m_s;
+    return;
+  }
+  if (tau_s >= s[n - 1].t_s) {
+    p = s[n - 1].p_m;
+    v.setZero();
+    return;
+  }
+  // Machine time only moves forward within a plan: walk the cursor (bounded work per cycle on
+  // average; a step back, never expected, restarts the walk).
+  if (cursor_ >= n - 1 || s[cursor_].t_s > tau_s) cursor_ = 0;
+  while (cursor_ + 1 < n - 1 && s[cursor_ + 1].t_s <= tau_s) ++cursor_;
+  const TipSample& a = s[cursor_];
+  const TipSample& b = s[cursor_ + 1];
+  // Cubic Hermite between the samples: positions and velocities both continuous.
+  const double h = b.t_s - a.t_s, u = (tau_s - a.t_s) / h;
+  const double u2 = u * u, u3 = u2 * u;
+  const double h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u, h01 = -2 * u3 + 3 * u2,
+               h11 = u3 - u2;
+  p = h00 * a.p_m + h10 * h * a.v_m_s + h01 * b.p_m + h11 * h * b.v_m_s;
+  const double d00 = (6 * u2 - 6 * u) / h, d10 = 3 * u2 - 4 * u + 1, d01 = (-6 * u2 + 6 * u) / h,
+               d11 = 3 * u2 - 2 * u;
+  v = d00 * a.p_m + d10 * a.v_m_s + d01 * b.p_m + d11 * b.v_m_s;
+}
+
+void GoalInput::next(const CycleTime& time, const Eigen::Vector3d& tip_m,
+                     TipCommand& out) noexcept {
+  // The measured tip for the producer.
+  tip_seq_.fetch_add(1, std::memory_order_acq_rel);
+  for (int a = 0; a < 3; ++a)
+    tip_[static_cast<std::size_t>(a)].store(tip_m[a], std::memory_order_relaxed);
+  tip_[3].store(time.t_s, std::memory_order_relaxed);
+  tip_seq_.fetch_add(1, std::memory_order_release);
+
+  // A newer plan?
+  if (middle_.load(std::memory_order_acquire) & kFresh) {
+    front_index_ = middle_.exchange(front_index_, std::memory_order_acq_rel) & kIndexMask;
+    front_ = &plans_[static_cast<std::size_t>(front_index_)];
+    cursor_ = 0;
+    reached_ = false;
+    taken_.fetch_add(1, std::memory_order_acq_rel);
+  }
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  if (!has_plan()) {
+    out.v_m_s.setConstant(kNaN);
+    out.reason = "no goal";
+    out.deadman = false;
+    return;
+  }
+  Eigen::Vector3d v_ref;
+  sample(time.t_s - front_->start_t_s, reference_, v_ref);
+  const bool ended = time.t_s - front_->start_t_s >= front_->samples[front_->count - 1].t_s;
+  if (!tip_m.allFinite()) {
+    out.v_m_s.setConstant(kNaN);
+    out.reason = "no tip measurement";
+    out.deadman = false;
+    return;
+  }
+  const Eigen::Vector3d error = reference_ - tip_m;
+  if (ended && (reached_ || error.norm() <= settings_.goal_tolerance_m)) {
+    reached_ = true;
+    out.v_m_s.setConstant(kNaN);
+    out.reason = "goal reached";
+    out.deadman = false;
+    return;
+  }
+  Eigen::Vector3d feedback = settings_.position_gain_1_s * error;
+  const double norm = feedback.norm();
+  if (norm > settings_.feedback_speed_cap_m_s) {
+    feedback *= settings_.feedback_speed_cap_m_s / norm;
+  }
+  out.v_m_s = v_ref + feedback;
+  out.reason = "";
+  out.deadman = true;
+}
+
+}  // namespace craneassist::control
