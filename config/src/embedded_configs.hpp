@@ -7,5 +7,6 @@ extern const char* const kPlanar2rYaml;
 extern const char* const kGamepadYaml;
 extern const char* const kWebJoystickYaml;
 extern const char* const kTelemetryYaml;
+extern const char* const kMobileBaseYaml;
 
 }  // namespace craneassist::config::embedded
