@@ -8,5 +8,6 @@ extern const char* const kMhsb3linkYaml;
 extern const char* const kGamepadYaml;
 extern const char* const kWebJoystickYaml;
 extern const char* const kTelemetryYaml;
+extern const char* const kMobileBaseYaml;
 
 }  // namespace craneassist::config::embedded

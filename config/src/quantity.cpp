@@ -45,6 +45,11 @@ constexpr UnitDef kUnits[] = {
     {"1/s", Dimension::kInverseTime, 1.0},
     {"rad/s", Dimension::kAngularVelocity, 1.0},
     {"deg/s", Dimension::kAngularVelocity, kPi / 180.0},
+    {"rpm", Dimension::kAngularVelocity, 2.0 * kPi / 60.0},
+    {"m^3", Dimension::kVolume, 1.0},
+    {"L", Dimension::kVolume, 1e-3},
+    {"cm^3", Dimension::kVolume, 1e-6},
+    {"1/m", Dimension::kInverseLength, 1.0},
 };
 
 std::string_view trim(std::string_view s) {
@@ -114,6 +119,10 @@ const char* to_string(Dimension d) {
       return "inverse time";
     case Dimension::kAngularVelocity:
       return "angular velocity";
+    case Dimension::kVolume:
+      return "volume";
+    case Dimension::kInverseLength:
+      return "inverse length";
   }
   return "?";
 }

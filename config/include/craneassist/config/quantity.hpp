@@ -28,6 +28,8 @@ enum class Dimension {
   kFrequency,
   kInverseTime,
   kAngularVelocity,
+  kVolume,         // a displacement per revolution (hub motors)
+  kInverseLength,  // a gain per metre (path-following gains)
 };
 
 const char* to_string(Dimension dimension);
