@@ -3,15 +3,17 @@
 // plan, a time-stamped sequence of tip positions, whenever the goal changes; each cycle this input
 // samples the newest plan at machine time and commands
 //     v = v_ref(t) + k (p_ref(t) - tip),   the feedback part at most feedback_speed_cap_m_s,
-// through the normal controller, so scaling, joint ends and every stop apply as to a stick. At
-// the plan's end it keeps pulling the tip to the goal until it is within goal_tolerance_m, then
-// gives no command ("goal reached": the controller's jerk-limited stop, valves neutral); before
-// any plan it gives none ("no goal").
+// as a stick's source would, with the deadman held: through the input monitor and the normal
+// controller, so scaling, joint ends and every stop apply as to a stick. At the plan's end it
+// keeps pulling the tip to the goal until it is within goal_tolerance_m, then releases the
+// deadman (state() "goal reached": the controller's jerk-limited stop, valves neutral); before any
+// plan it has no data ("no goal"). Times are the loop's clock (begin_cycle's now_s: steady_clock
+// seconds when paced, machine time otherwise).
 //
-// Threads: publish() on one producer thread, next() on the control thread. The handoff is a
-// triple buffer (three preallocated plans, one atomic index exchange each way): next() never
-// blocks, never allocates and always sees a whole plan. The measured tip goes the other way
-// through a sequence lock (last_tip()), for the producer to plan from.
+// Threads: publish() on one producer thread, begin_cycle()/poll() on the control thread. The
+// handoff is a triple buffer (three preallocated plans, one atomic index exchange each way): the
+// control thread never blocks, never allocates and always sees a whole plan. The measured tip goes
+// the other way through a sequence lock (last_tip()), for the producer to plan from.
 #pragma once
 
 #include <Eigen/Core>
@@ -21,9 +23,9 @@
 #include <span>
 #include <vector>
 
-#include "craneassist/control/tip_command_task.hpp"
+#include "craneassist/input/command_source.hpp"
 
-namespace craneassist::control {
+namespace craneassist::input {
 
 struct TipSample {
   double t_s = 0.0;                                 // from the plan's start
@@ -31,32 +33,35 @@ struct TipSample {
   Eigen::Vector3d v_m_s = Eigen::Vector3d::Zero();  // crane frame
 };
 
-struct GoalInputSettings {
+struct GoalSourceSettings {
   std::size_t capacity = 8192;          // samples per plan
   double position_gain_1_s = 2.0;       // k
   double feedback_speed_cap_m_s = 0.3;  // |k e| at most this
   double goal_tolerance_m = 0.02;       // within this of the goal at the plan's end: reached
 };
 
-class GoalInput final : public TipCommandInput {
+class GoalSource final : public CommandSource {
  public:
-  explicit GoalInput(const GoalInputSettings& settings);  // allocates the three plans
+  explicit GoalSource(const GoalSourceSettings& settings);  // allocates the three plans
 
   // Producer thread. samples: times strictly increasing from 0, at most capacity (more: false,
-  // nothing published); start_t_s: the machine time of sample 0. Replaces any earlier plan.
+  // nothing published); start_t_s: the loop-clock time of sample 0. Replaces any earlier plan.
   bool publish(std::span<const TipSample> samples, double start_t_s);
-  // Producer thread: the newest measured tip and its machine time (false before any cycle, or
-  // while the tip measurement is invalid).
+  // Producer thread: the newest measured tip and its loop-clock time (false before any cycle,
+  // or while the tip measurement is invalid).
   bool last_tip(Eigen::Vector3d& tip_m, double& t_s) const noexcept;
   // Producer thread: how many plans the control thread has taken up.
   std::uint64_t plans_taken() const noexcept { return taken_.load(std::memory_order_acquire); }
 
-  void next(const CycleTime& time, const Eigen::Vector3d& tip_m, TipCommand& out) noexcept override;
+  void begin_cycle(double now_s, const Eigen::Vector3d& tip_m) noexcept override;
+  SourceState poll(OperatorCommand& out) noexcept override;
   const char* name() const noexcept override { return "goal"; }
 
   // Control thread (or after the run): the plan in use and where on it the last cycle was.
   bool has_plan() const noexcept { return front_ != nullptr && front_->count > 0; }
   bool reached() const noexcept { return reached_; }
+  // "no goal", "following", "goal reached", "no tip measurement".
+  const char* state() const noexcept { return state_; }
   const Eigen::Vector3d& reference() const noexcept { return reference_; }
 
  private:
@@ -67,7 +72,10 @@ class GoalInput final : public TipCommandInput {
   };
   void sample(double tau_s, Eigen::Vector3d& p, Eigen::Vector3d& v) noexcept;
 
-  GoalInputSettings settings_;
+  GoalSourceSettings settings_;
+  double now_s_ = 0.0;
+  Eigen::Vector3d tip_m_ = Eigen::Vector3d::Zero();
+  const char* state_ = "no goal";
   std::array<Plan, 3> plans_;
   // Triple buffer: the producer owns back_, the consumer front_; middle_ holds the third plan's
   // index with bit 2 set when it is newer than the consumer's.
@@ -84,4 +92,4 @@ class GoalInput final : public TipCommandInput {
   std::array<std::atomic<double>, 4> tip_{};  // x, y, z, t
 };
 
-}  // namespace craneassist::control
+}  // namespace craneassist::input

@@ -1,10 +1,10 @@
-#include "craneassist/control/goal_input.hpp"
+#include "craneassist/input/goal_source.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-namespace craneassist::control {
+namespace craneassist::input {
 namespace {
 
 constexpr int kFresh = 4;
@@ -12,11 +12,11 @@ constexpr int kIndexMask = 3;
 
 }  // namespace
 
-GoalInput::GoalInput(const GoalInputSettings& settings) : settings_(settings) {
+GoalSource::GoalSource(const GoalSourceSettings& settings) : settings_(settings) {
   for (auto& plan : plans_) plan.samples.resize(settings.capacity);
 }
 
-bool GoalInput::publish(std::span<const TipSample> samples, double start_t_s) {
+bool GoalSource::publish(std::span<const TipSample> samples, double start_t_s) {
   if (samples.empty() || samples.size() > settings_.capacity || !std::isfinite(start_t_s)) {
     return false;
   }
@@ -34,7 +34,7 @@ bool GoalInput::publish(std::span<const TipSample> samples, double start_t_s) {
   return true;
 }
 
-bool GoalInput::last_tip(Eigen::Vector3d& tip_m, double& t_s) const noexcept {
+bool GoalSource::last_tip(Eigen::Vector3d& tip_m, double& t_s) const noexcept {
   for (int attempt = 0; attempt < 1000; ++attempt) {
     const std::uint64_t before = tip_seq_.load(std::memory_order_acquire);
     if (before == 0) return false;
@@ -53,7 +53,7 @@ bool GoalInput::last_tip(Eigen::Vector3d& tip_m, double& t_s) const noexcept {
   return false;
 }
 
-void GoalInput::sample(double tau_s, Eigen::Vector3d& p, Eigen::Vector3d& v) noexcept {
+void GoalSource::sample(double tau_s, Eigen::Vector3d& p, Eigen::Vector3d& v) noexcept {
   const auto& s = front_->samples;
   const std::size_t n = front_->count;
   if (tau_s <= s[0].t_s) {
@@ -83,15 +83,18 @@ void GoalInput::sample(double tau_s, Eigen::Vector3d& p, Eigen::Vector3d& v) noe
   v = d00 * a.p_m + d10 * a.v_m_s + d01 * b.p_m + d11 * b.v_m_s;
 }
 
-void GoalInput::next(const CycleTime& time, const Eigen::Vector3d& tip_m,
-                     TipCommand& out) noexcept {
+void GoalSource::begin_cycle(double now_s, const Eigen::Vector3d& tip_m) noexcept {
+  now_s_ = now_s;
+  tip_m_ = tip_m;
   // The measured tip for the producer.
   tip_seq_.fetch_add(1, std::memory_order_acq_rel);
-  for (int a = 0; a < 3; ++a)
-    tip_[static_cast<std::size_t>(a)].store(tip_m[a], std::memory_order_relaxed);
-  tip_[3].store(time.t_s, std::memory_order_relaxed);
+  for (std::size_t a = 0; a < 3; ++a)
+    tip_[a].store(tip_m[static_cast<int>(a)], std::memory_order_relaxed);
+  tip_[3].store(now_s, std::memory_order_relaxed);
   tip_seq_.fetch_add(1, std::memory_order_release);
+}
 
+SourceState GoalSource::poll(OperatorCommand& out) noexcept {
   // A newer plan?
   if (middle_.load(std::memory_order_acquire) & kFresh) {
     front_index_ = middle_.exchange(front_index_, std::memory_order_acq_rel) & kIndexMask;
@@ -100,29 +103,26 @@ void GoalInput::next(const CycleTime& time, const Eigen::Vector3d& tip_m,
     reached_ = false;
     taken_.fetch_add(1, std::memory_order_acq_rel);
   }
-  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   if (!has_plan()) {
-    out.v_m_s.setConstant(kNaN);
-    out.reason = "no goal";
-    out.deadman = false;
-    return;
+    state_ = "no goal";
+    return SourceState::kNoData;
   }
+  out.stamp_s = now_s_;
+  out.v_m_s.setZero();
+  out.deadman = false;
   Eigen::Vector3d v_ref;
-  sample(time.t_s - front_->start_t_s, reference_, v_ref);
-  const bool ended = time.t_s - front_->start_t_s >= front_->samples[front_->count - 1].t_s;
-  if (!tip_m.allFinite()) {
-    out.v_m_s.setConstant(kNaN);
-    out.reason = "no tip measurement";
-    out.deadman = false;
-    return;
+  const double tau = now_s_ - front_->start_t_s;
+  sample(tau, reference_, v_ref);
+  if (!tip_m_.allFinite()) {
+    state_ = "no tip measurement";
+    return SourceState::kOk;
   }
-  const Eigen::Vector3d error = reference_ - tip_m;
+  const Eigen::Vector3d error = reference_ - tip_m_;
+  const bool ended = tau >= front_->samples[front_->count - 1].t_s;
   if (ended && (reached_ || error.norm() <= settings_.goal_tolerance_m)) {
     reached_ = true;
-    out.v_m_s.setConstant(kNaN);
-    out.reason = "goal reached";
-    out.deadman = false;
-    return;
+    state_ = "goal reached";
+    return SourceState::kOk;
   }
   Eigen::Vector3d feedback = settings_.position_gain_1_s * error;
   const double norm = feedback.norm();
@@ -130,8 +130,9 @@ void GoalInput::next(const CycleTime& time, const Eigen::Vector3d& tip_m,
     feedback *= settings_.feedback_speed_cap_m_s / norm;
   }
   out.v_m_s = v_ref + feedback;
-  out.reason = "";
   out.deadman = true;
+  state_ = "following";
+  return SourceState::kOk;
 }
 
-}  // namespace craneassist::control
+}  // namespace craneassist::input
