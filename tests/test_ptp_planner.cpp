@@ -237,7 +237,7 @@ TEST(PtpPlanner, TheTrajectoryRestsAtTheEndsAndPassesThroughTheNodes) {
   const auto& first = plan.samples.front();
   const auto& last = plan.samples.back();
   EXPECT_EQ(first.t_s, 0.0);
-  EXPECT_NEAR(last.t_s, plan.path.time_s, 1e-9);
+  EXPECT_NEAR(last.t_s, plan.node_times_s.back(), 1e-9);
   EXPECT_LT(first.qdot.norm() + first.qddot.norm() + last.qdot.norm() + last.qddot.norm(), 1e-9);
   EXPECT_LT((first.q - plan.path.steps.front().q).norm(), 1e-12);
   EXPECT_LT((last.q - plan.path.steps.back().q).norm(), 1e-9);
@@ -245,14 +245,17 @@ TEST(PtpPlanner, TheTrajectoryRestsAtTheEndsAndPassesThroughTheNodes) {
   // time between), and the rates are the positions' derivatives.
   double peak_rate = 0.0;
   for (const auto& s : plan.samples) peak_rate = std::max(peak_rate, s.qdot.cwiseAbs().maxCoeff());
-  for (const auto& step : plan.path.steps) {
+  ASSERT_EQ(plan.node_times_s.size(), plan.path.steps.size());
+  for (std::size_t i = 0; i < plan.path.steps.size(); ++i) {
+    const double t = plan.node_times_s[i];
+    EXPECT_GE(t, plan.path.steps[i].t_s - 1e-9);  // S3 only ever lengthens a segment
     const auto it = std::min_element(
-        plan.samples.begin(), plan.samples.end(), [&](const auto& l, const auto& r) {
-          return std::abs(l.t_s - step.t_s) < std::abs(r.t_s - step.t_s);
-        });
-    EXPECT_LE((it->q - step.q).cwiseAbs().maxCoeff(),
-              peak_rate * std::abs(it->t_s - step.t_s) + 1e-9);
+        plan.samples.begin(), plan.samples.end(),
+        [&](const auto& l, const auto& r) { return std::abs(l.t_s - t) < std::abs(r.t_s - t); });
+    EXPECT_LE((it->q - plan.path.steps[i].q).cwiseAbs().maxCoeff(),
+              peak_rate * std::abs(it->t_s - t) + 1e-9);
   }
+  EXPECT_LE(plan.peak_speed_ratio, 1.5 * 1.05);  // checked on 17 points per segment
   for (std::size_t i = 1; i < plan.samples.size(); ++i) {
     const auto& a = plan.samples[i - 1];
     const auto& b = plan.samples[i];
@@ -262,7 +265,6 @@ TEST(PtpPlanner, TheTrajectoryRestsAtTheEndsAndPassesThroughTheNodes) {
   }
   EXPECT_GT(plan.energy_j, 0.0);
   EXPECT_NEAR(plan.energy_j, plan.path.energy_j, 0.3 * plan.path.energy_j);
-  EXPECT_LT(plan.peak_speed_ratio, 2.0);
 }
 
 TEST(PtpPlanner, APointOutsideTheWorkspaceIsRefused) {

@@ -331,21 +331,79 @@ PtpPlan PtpPlanner::plan(const Eigen::Vector2d& from, const Eigen::Vector2d& to,
       for (std::size_t i = 1; i < nn; ++i) t[i] += shift;
     }
   }
-  for (std::size_t i = 0; i < nn; ++i) v[i] = ArmVector::Zero(m);
-  for (std::size_t i = 1; i + 1 < nn; ++i) {
-    for (int k = 0; k < m; ++k) {
-      const double s0 = (q[i][k] - q[i - 1][k]) / (t[i] - t[i - 1]);
-      const double s1 = (q[i + 1][k] - q[i][k]) / (t[i + 1] - t[i]);
-      v[i][k] = s0 * s1 > 0.0 ? sign(s0) * std::min(std::abs(s0), std::abs(s1)) : 0.0;
+  // Node rates: 0 at the ends and where a joint turns, else the slower of its two segments' mean
+  // rates (no overshoot of the node postures).
+  const auto node_rates = [&] {
+    for (std::size_t i = 0; i < nn; ++i) v[i] = ArmVector::Zero(m);
+    for (std::size_t i = 1; i + 1 < nn; ++i) {
+      for (int k = 0; k < m; ++k) {
+        const double s0 = (q[i][k] - q[i - 1][k]) / (t[i] - t[i - 1]);
+        const double s1 = (q[i + 1][k] - q[i][k]) / (t[i + 1] - t[i]);
+        v[i][k] = s0 * s1 > 0.0 ? sign(s0) * std::min(std::abs(s0), std::abs(s1)) : 0.0;
+      }
     }
+  };
+  using Coefficients = Eigen::Matrix<double, 7, dynamics::kMaxJoints>;
+  std::vector<Coefficients> coeffs(nn > 1 ? nn - 1 : 0);
+  const auto fit = [&](std::size_t seg) {
+    const double h = t[seg + 1] - t[seg];
+    Coefficients& c = coeffs[seg];
+    for (int k = 0; k < m; ++k) {
+      c(0, k) = q[seg][k];
+      c(1, k) = h * v[seg][k];
+      c(2, k) = 0.0;
+      const Eigen::Vector4d rhs(q[seg + 1][k] - c(0, k) - c(1, k), h * v[seg + 1][k] - c(1, k), 0.0,
+                                0.5 * (q[seg][k] + q[seg + 1][k]) - c(0, k) - 0.5 * c(1, k));
+      c.block<4, 1>(3, k) = segment_inverse() * rhs;
+    }
+  };
+  // Position, rate and acceleration of segment seg at tau in [0, 1].
+  const auto evaluate = [&](std::size_t seg, double tau, ArmVector& pos, ArmVector& rate,
+                            ArmVector& acc) {
+    const double h = t[seg + 1] - t[seg];
+    const Coefficients& c = coeffs[seg];
+    for (int k = 0; k < m; ++k) {
+      double p = 0.0, d = 0.0, dd = 0.0;  // Horner, on the derived coefficients too
+      for (int j = 6; j >= 0; --j) p = p * tau + c(j, k);
+      for (int j = 6; j >= 1; --j) d = d * tau + j * c(j, k);
+      for (int j = 6; j >= 2; --j) dd = dd * tau + j * (j - 1) * c(j, k);
+      pos[k] = p;
+      rate[k] = d / h;
+      acc[k] = dd / (h * h);
+    }
+  };
+  // Quasi-static speeds: a segment whose cylinder speed peaks above max_speed_ratio V_L (at most
+  // the cylinder's max_speed) is lengthened by the excess, the later nodes shifted; a few passes.
+  PlanarArm::Statics st;
+  ArmVector pos(m), rate(m), acc(m);
+  for (int pass = 0; pass < 4; ++pass) {
+    node_rates();
+    bool stretched = false;
+    for (std::size_t seg = 0; seg + 1 < nn; ++seg) {
+      fit(seg);
+      double ratio = 0.0;
+      for (int j = 0; j <= 16; ++j) {
+        evaluate(seg, j / 16.0, pos, rate, acc);
+        arm_->statics(pos, data_, st);
+        for (int k = 0; k < m; ++k) {
+          const double cap = std::min(settings_.max_speed_ratio * v_limit_[at(k)],
+                                      model.cylinders[at(arm_->joint(k))].v_max_m_s);
+          ratio = std::max(ratio, std::abs(st.arm[k] * rate[k]) / cap);
+        }
+      }
+      if (ratio > 1.0 + 1e-6) {
+        const double extra = (t[seg + 1] - t[seg]) * (ratio - 1.0);
+        for (std::size_t i = seg + 1; i < nn; ++i) t[i] += extra;
+        stretched = true;
+      }
+    }
+    if (!stretched) break;
   }
+  for (std::size_t seg = 0; seg + 1 < nn; ++seg) fit(seg);
   const double dt = settings_.sample_period_s;
   const double total = t[nn - 1];
   const int count = nn == 1 ? 1 : static_cast<int>(std::ceil(total / dt - 1e-9)) + 1;
   std::size_t seg = 0;
-  Eigen::Matrix<double, 7, dynamics::kMaxJoints> coeff;
-  std::size_t coeff_seg = static_cast<std::size_t>(-1);
-  PlanarArm::Statics st;
   for (int i = 0; i < count; ++i) {
     PtpSample sample;
     sample.t_s = std::min(i * dt, total);
@@ -354,29 +412,8 @@ PtpPlan PtpPlanner::plan(const Eigen::Vector2d& from, const Eigen::Vector2d& to,
     sample.qddot = ArmVector::Zero(m);
     if (nn > 1) {
       while (seg + 2 < nn && sample.t_s > t[seg + 1]) ++seg;
-      const double h = t[seg + 1] - t[seg];
-      if (coeff_seg != seg) {
-        for (int k = 0; k < m; ++k) {
-          coeff(0, k) = q[seg][k];
-          coeff(1, k) = h * v[seg][k];
-          coeff(2, k) = 0.0;
-          const Eigen::Vector4d rhs(
-              q[seg + 1][k] - coeff(0, k) - coeff(1, k), h * v[seg + 1][k] - coeff(1, k), 0.0,
-              0.5 * (q[seg][k] + q[seg + 1][k]) - coeff(0, k) - 0.5 * coeff(1, k));
-          coeff.block<4, 1>(3, k) = segment_inverse() * rhs;
-        }
-        coeff_seg = seg;
-      }
-      const double tau = std::clamp((sample.t_s - t[seg]) / h, 0.0, 1.0);
-      for (int k = 0; k < m; ++k) {
-        double p = 0.0, d = 0.0, dd = 0.0;  // Horner, on the derived coefficients too
-        for (int c = 6; c >= 0; --c) p = p * tau + coeff(c, k);
-        for (int c = 6; c >= 1; --c) d = d * tau + c * coeff(c, k);
-        for (int c = 6; c >= 2; --c) dd = dd * tau + c * (c - 1) * coeff(c, k);
-        sample.q[k] = p;
-        sample.qdot[k] = d / h;
-        sample.qddot[k] = dd / (h * h);
-      }
+      const double tau = std::clamp((sample.t_s - t[seg]) / (t[seg + 1] - t[seg]), 0.0, 1.0);
+      evaluate(seg, tau, sample.q, sample.qdot, sample.qddot);
     }
     // S4: the modes the sample's cylinder velocities and forces call for.
     arm_->statics(sample.q, data_, st);
@@ -419,6 +456,7 @@ PtpPlan PtpPlanner::plan(const Eigen::Vector2d& from, const Eigen::Vector2d& to,
     prev_tip = tip;
   }
   plan.time_s = plan.samples.back().t_s;
+  plan.node_times_s = t;
   plan.planning_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return plan;

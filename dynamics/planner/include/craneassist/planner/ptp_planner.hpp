@@ -61,6 +61,10 @@ struct PtpSettings {
   // The MHSB energy model (ignored without the circuit, whose pump mode decides).
   dynamics::MhsbEnergyModel energy_model = dynamics::MhsbEnergyModel::kSeries;
   double sample_period_s = 0.02;  // of the S3 time trajectory
+  // S3 keeps every cylinder's speed within this share of V_L (and within its max_speed),
+  // lengthening segments where the polynomial would exceed it: 1.5 keeps the paper's arm under its
+  // 20 mm/s quasi-static speed (12 mm/s V_L).
+  double max_speed_ratio = 1.5;
 };
 
 struct PtpWeights {
@@ -98,9 +102,10 @@ struct PtpSample {
 };
 
 struct PtpPlan {
-  PtpPath path;                    // S2
-  std::vector<PtpSample> samples;  // S3 + S4
-  double energy_j = 0.0;           // along the samples, with the S4 modes
+  PtpPath path;                      // S2
+  std::vector<PtpSample> samples;    // S3 + S4
+  std::vector<double> node_times_s;  // when the trajectory passes each S2 node
+  double energy_j = 0.0;             // along the samples, with the S4 modes
   double time_s = 0.0;
   double length_m = 0.0;                         // tip path length of the samples
   int switches = 0;                              // S4 mode changes, all joints
