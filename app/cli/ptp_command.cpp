@@ -176,18 +176,23 @@ int run_ptp_command(const PtpArgs& args) {
 
   const auto& grid = table->grid();
   std::printf("craneassist ptp: %s\n", cfg.model.name.c_str());
-  std::printf("  posture table: %d nodes x %d patterns, %.0f mm grid: %s\n", grid.nodes(),
+  std::printf("  posture table: %d nodes x %d patterns, %.0f mm grid, %s\n", grid.nodes(),
               table->pattern_count(), 1000.0 * grid.spacing_m,
-              loaded ? ("loaded from " + file->string()).c_str() : "");
+              loaded ? ("loaded from " + file->string()).c_str() : "built");
   if (!loaded) {
     std::printf(
-        "    built in %.1f s (%d threads, %ld SLSQP runs, %ld entries without a converged "
-        "run)%s\n",
+        "    in %.1f s (%d threads, %ld SLSQP runs, %ld entries without a converged run)%s\n",
         table->build_time_s, table_settings.threads, table->optimisations, table->unconverged,
         file ? (", written to " + file->string()).c_str() : "");
   }
-  std::printf("  graph: %ld transitions; V_L %.1f mm/s; energy: %s\n", ptp.transitions(),
-              1000.0 * ptp.velocity_limit_m_s(0), planner::to_string(ptp.energy()));
+  std::string limits;
+  for (int k = 0; k < arm->moving(); ++k) {
+    char part[64];
+    std::snprintf(part, sizeof part, "%s%.1f", k ? "/" : "", 1000.0 * ptp.velocity_limit_m_s(k));
+    limits += part;
+  }
+  std::printf("  graph: %ld transitions; V_L %s mm/s; energy: %s\n", ptp.transitions(),
+              limits.c_str(), planner::to_string(ptp.energy()));
   std::printf("  from %s to %s (nodes %s, %s), weights %g, %g, %g; heuristic %.4g per m\n",
               point_text(from).c_str(), point_text(to).c_str(),
               point_text(grid.node_xz[static_cast<std::size_t>(ptp.node_near(from))]).c_str(),
