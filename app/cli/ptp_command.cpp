@@ -181,9 +181,10 @@ int run_ptp_command(const PtpArgs& args) {
               loaded ? ("loaded from " + file->string()).c_str() : "built");
   if (!loaded) {
     std::printf(
-        "    in %.1f s (%d threads, %ld SLSQP runs, %ld entries without a converged run)%s\n",
+        "    in %.1f s (%d threads, %ld SLSQP runs, %ld entries without a converged run, %ld "
+        "without polytope area)%s\n",
         table->build_time_s, table_settings.threads, table->optimisations, table->unconverged,
-        file ? (", written to " + file->string()).c_str() : "");
+        table->degenerate, file ? (", written to " + file->string()).c_str() : "");
   }
   std::string limits;
   for (int k = 0; k < arm->moving(); ++k) {

@@ -14,18 +14,17 @@ namespace {
 // The highest mode number (SB).
 constexpr double kMaxMode = 2.0;
 
-// The format for n joints: t, then q_1..q_n, qdot_1..qdot_n, qddot_1..qddot_n, and optionally
-// mode_1..mode_n (all or none; parse() checks that).
-detail::CsvFormat trajectory_format(int n) {
+// The format for n joints: t, then q_1..q_n, qdot_1..qdot_n, qddot_1..qddot_n, and with_modes
+// mode_1..mode_n.
+detail::CsvFormat trajectory_format(int n, bool with_modes) {
   detail::CsvFormat format;
   format.columns.push_back({"t", detail::CsvKind::kTime});
   for (const char* name : {"q_", "qdot_", "qddot_"}) {
     for (int i = 1; i <= n; ++i) format.columns.push_back({name + std::to_string(i)});
   }
-  for (int i = 1; i <= n; ++i) {
+  for (int i = 1; with_modes && i <= n; ++i) {
     format.columns.push_back({"mode_" + std::to_string(i), detail::CsvKind::kNumber, kMaxMode});
   }
-  format.optional_columns = static_cast<std::size_t>(n);
   format.max_rows = JointTrajectory::kMaxRows;
   return format;
 }
@@ -54,13 +53,15 @@ JointTrajectory JointTrajectory::load_file(const std::filesystem::path& path,
 
 JointTrajectory JointTrajectory::parse(std::string_view text, std::string_view source_name,
                                        const TrajectoryLimits& limits) {
-  const int n = std::max(joints_in_header(detail::header_line(text)), 1);
+  const std::string_view header = detail::header_line(text);
+  const int n = std::max(joints_in_header(header), 1);
+  const bool with_modes = header.find("mode_1") != std::string_view::npos;
   const auto crane_joints = static_cast<int>(limits.joints.size());
   const bool check_ranges = crane_joints == n;
   JointTrajectory traj(n);
   const auto plain_columns = static_cast<std::size_t>(1 + 3 * n);
-  detail::CsvFile file =
-      detail::read_csv(text, source_name, trajectory_format(n), [&](const detail::CsvRow& row) {
+  detail::CsvFile file = detail::read_csv(
+      text, source_name, trajectory_format(n, with_modes), [&](const detail::CsvRow& row) {
         const std::size_t columns = row.values.size();
         for (std::size_t c = plain_columns; c < columns; ++c) {
           const double mode = row.values[c];
@@ -86,12 +87,6 @@ JointTrajectory JointTrajectory::parse(std::string_view text, std::string_view s
         traj.values_.insert(traj.values_.end(), row.values.begin() + 1,
                             row.values.begin() + static_cast<std::ptrdiff_t>(plain_columns));
       });
-  if (file.columns != plain_columns &&
-      file.columns != plain_columns + static_cast<std::size_t>(n)) {
-    throw FileError(std::string(source_name), file.header_line, "",
-                    "the mode columns must be all of mode_1..mode_" + std::to_string(n) +
-                        " or none, got " + std::to_string(file.columns - plain_columns));
-  }
   if (crane_joints > 0 && !check_ranges) {
     const std::string columns =
         n == 1 ? "1 joint (q_1)" : std::to_string(n) + " joints (q_1..q_" + std::to_string(n) + ")";
@@ -189,8 +184,7 @@ void JointTrajectory::sample(double t, Eigen::Ref<Eigen::VectorXd> q,
 void write_joint_trajectory(std::ostream& out, const JointTrajectory& traj) {
   for (const auto& c : traj.comments) out << "# " << c << '\n';
   const int n = traj.joints();
-  const auto columns = static_cast<std::size_t>(1 + (traj.has_modes() ? 4 : 3) * n);
-  out << detail::csv_header(trajectory_format(n), columns) << '\n';
+  out << detail::csv_header(trajectory_format(n, traj.has_modes())) << '\n';
   for (std::size_t r = 0; r < traj.size(); ++r) {
     out << detail::number(traj.t_s(r));
     for (const auto& v : {traj.q(r), traj.qdot(r), traj.qddot(r)}) {

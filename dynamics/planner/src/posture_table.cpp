@@ -23,7 +23,8 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr char kMagic[8] = {'C', 'A', 'P', 'T', 'T', 'A', 'B', '1'};
-constexpr double kTipTolerance_m = 1e-6;  // a posture is on its node within this
+constexpr double kTipTolerance_m = 1e-6;   // a posture is on its node within this
+constexpr double kDegenerateArea = 1e-12;  // m^2/s^2: a polytope without area
 
 std::size_t at(int i) {
   return static_cast<std::size_t>(i);
@@ -212,7 +213,7 @@ double PolytopeArea::operator()(const ArmVector& a, const dynamics::ModePattern&
   PlanarArm::Statics s;
   arm_->statics(a, data_, s);
   force.setZero();
-  for (int k = 0; k < arm_->moving(); ++k) force[arm_->joint(k)] = s.force_n[k];
+  for (int k = 0; k < arm_->moving() && !ignore_load_; ++k) force[arm_->joint(k)] = s.force_n[k];
   dynamics::mhsb_joint_velocity_set(model, q, dc_dq, force, pattern, {}, full_set_);
   arm_->restrict_set(full_set_, set_);
   ArmJacobian j;
@@ -360,7 +361,7 @@ PostureTable PostureTable::build(const PlanarArm& arm, const PostureTableSetting
   for (const auto& p : t.patterns_) full.push_back(full_pattern(arm, p));
 
   std::atomic<int> next{0};
-  std::atomic<long> runs{0}, unconverged{0};
+  std::atomic<long> runs{0}, unconverged{0}, degenerate{0};
   std::mutex progress_mutex;
   int done = 0;
   auto work = [&] {
@@ -371,25 +372,42 @@ PostureTable PostureTable::build(const PlanarArm& arm, const PostureTableSetting
       const auto& starts = w.starts[at(node)];
       const Eigen::Vector2d target = t.grid_.node_xz[at(node)];
       for (int p = 0; p < np; ++p) {
-        ranked.clear();
-        for (std::size_t s = 0; s < starts.size(); ++s) {
-          ranked.emplace_back(area(starts[s], full[at(p)]), static_cast<int>(s));
-        }
-        std::sort(ranked.begin(), ranked.end(), std::greater<>());
-        ArmVector best = starts[at(ranked[0].second)];
-        double best_area = ranked[0].first;
-        bool converged = false;
-        const int tries = std::min(static_cast<int>(ranked.size()), settings.refined_starts);
-        for (int r = 0; r < tries; ++r) {
-          ArmVector a = starts[at(ranked[at(r)].second)];
-          const double s = maximise(arm, area, data, full[at(p)], target, a);
-          runs.fetch_add(1);
-          if (s < 0.0) continue;
-          converged = true;
-          if (s > best_area) {
-            best_area = s;
-            best = a;
+        // The best of the starts, then SLSQP from the best few.
+        const auto optimise = [&](ArmVector& best, double& best_area) {
+          ranked.clear();
+          for (std::size_t s = 0; s < starts.size(); ++s) {
+            ranked.emplace_back(area(starts[s], full[at(p)]), static_cast<int>(s));
           }
+          std::sort(ranked.begin(), ranked.end(), std::greater<>());
+          best = starts[at(ranked[0].second)];
+          best_area = ranked[0].first;
+          bool converged = false;
+          const int tries = std::min(static_cast<int>(ranked.size()), settings.refined_starts);
+          for (int r = 0; r < tries; ++r) {
+            ArmVector a = starts[at(ranked[at(r)].second)];
+            const double s = maximise(arm, area, data, full[at(p)], target, a);
+            runs.fetch_add(1);
+            if (s < 0.0) continue;
+            converged = true;
+            if (s > best_area) {
+              best_area = s;
+              best = a;
+            }
+          }
+          return converged;
+        };
+        ArmVector best;
+        double best_area = 0.0;
+        bool converged = optimise(best, best_area);
+        if (!(best_area > kDegenerateArea)) {
+          // No posture lets every joint move both ways in this pattern (a joint cannot hold its
+          // load from its mode's supply anywhere): the posture of the largest polytope without
+          // the load instead, a well-defined one (the stored area stays the true one).
+          area.set_ignore_load(true);
+          converged = optimise(best, best_area);
+          area.set_ignore_load(false);
+          best_area = area(best, full[at(p)]);
+          degenerate.fetch_add(1);
         }
         if (!converged) unconverged.fetch_add(1);
         const std::size_t e = t.entry(node, p);
@@ -409,6 +427,7 @@ PostureTable PostureTable::build(const PlanarArm& arm, const PostureTableSetting
   for (auto& th : pool) th.join();
   t.optimisations = runs.load();
   t.unconverged = unconverged.load();
+  t.degenerate = degenerate.load();
   t.build_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return t;
 }
@@ -506,7 +525,7 @@ std::optional<PostureTable> PostureTable::load(const std::filesystem::path& file
 std::uint64_t posture_table_fingerprint(const PlanarArm& arm,
                                         const PostureTableSettings& settings) {
   Fingerprint f;
-  f.add(2);  // the table's own version: bump when the build changes
+  f.add(3);  // the table's own version: bump when the build changes
   const auto& m = arm.model();
   for (const auto& j : m.joints) {
     f.add(static_cast<int>(j.type));

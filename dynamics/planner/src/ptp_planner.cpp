@@ -374,6 +374,10 @@ PtpPlan PtpPlanner::plan(const Eigen::Vector2d& from, const Eigen::Vector2d& to,
   };
   // Quasi-static speeds: a segment whose cylinder speed peaks above max_speed_ratio V_L (at most
   // the cylinder's max_speed) is lengthened by the excess, the later nodes shifted; a few passes.
+  // Cylinder velocity of moving joint k at joint position qk and rate.
+  const auto arm_rate = [&](int k, double qk, double rate_k) {
+    return dynamics::cylinder_arm(model.cylinders[at(arm_->joint(k))], qk) * rate_k;
+  };
   PlanarArm::Statics st;
   ArmVector pos(m), rate(m), acc(m);
   for (int pass = 0; pass < 4; ++pass) {
@@ -384,11 +388,10 @@ PtpPlan PtpPlanner::plan(const Eigen::Vector2d& from, const Eigen::Vector2d& to,
       double ratio = 0.0;
       for (int j = 0; j <= 16; ++j) {
         evaluate(seg, j / 16.0, pos, rate, acc);
-        arm_->statics(pos, data_, st);
         for (int k = 0; k < m; ++k) {
           const double cap = std::min(settings_.max_speed_ratio * v_limit_[at(k)],
                                       model.cylinders[at(arm_->joint(k))].v_max_m_s);
-          ratio = std::max(ratio, std::abs(st.arm[k] * rate[k]) / cap);
+          ratio = std::max(ratio, std::abs(arm_rate(k, pos[k], rate[k])) / cap);
         }
       }
       if (ratio > 1.0 + 1e-6) {
@@ -404,6 +407,11 @@ PtpPlan PtpPlanner::plan(const Eigen::Vector2d& from, const Eigen::Vector2d& to,
   const double total = t[nn - 1];
   const int count = nn == 1 ? 1 : static_cast<int>(std::ceil(total / dt - 1e-9)) + 1;
   std::size_t seg = 0;
+  std::vector<double> powers;
+  std::vector<Eigen::Vector2d> tips;
+  powers.reserve(static_cast<std::size_t>(count));
+  tips.reserve(static_cast<std::size_t>(count));
+  plan.samples.reserve(static_cast<std::size_t>(count));
   for (int i = 0; i < count; ++i) {
     PtpSample sample;
     sample.t_s = std::min(i * dt, total);
@@ -432,6 +440,14 @@ PtpPlan PtpPlanner::plan(const Eigen::Vector2d& from, const Eigen::Vector2d& to,
                                ? MhsbMode::kDecoupledBoost
                                : MhsbMode::kSharedBoost;
     }
+    // Its power and tip, from the same statics (the frames are those of sample.q).
+    dynamics::ModePattern modes;
+    modes.dof = m;
+    modes.mode = sample.mode;
+    powers.push_back(
+        stage_power_w({st.length_m, st.force_n}, st.arm.cwiseProduct(sample.qdot), modes));
+    tips.push_back(arm_->plane() *
+                   (model.task_from_base * data_.frames[at(model.dof())].translation()));
     plan.samples.push_back(sample);
   }
   // What the samples do.
@@ -439,12 +455,11 @@ PtpPlan PtpPlanner::plan(const Eigen::Vector2d& from, const Eigen::Vector2d& to,
   Eigen::Vector2d prev_tip = Eigen::Vector2d::Zero();
   for (std::size_t i = 0; i < plan.samples.size(); ++i) {
     const PtpSample& s = plan.samples[i];
-    const double p = power_w(s.q, s.qdot, s.mode);
-    const Eigen::Vector2d tip = arm_->tip(s.q, data_);
-    arm_->statics(s.q, data_, st);
+    const double p = powers[i];
+    const Eigen::Vector2d tip = tips[i];
     for (int k = 0; k < m; ++k) {
-      plan.peak_speed_ratio =
-          std::max(plan.peak_speed_ratio, std::abs(st.arm[k] * s.qdot[k]) / v_limit_[at(k)]);
+      plan.peak_speed_ratio = std::max(plan.peak_speed_ratio,
+                                       std::abs(arm_rate(k, s.q[k], s.qdot[k])) / v_limit_[at(k)]);
     }
     if (i > 0) {
       const PtpSample& r = plan.samples[i - 1];

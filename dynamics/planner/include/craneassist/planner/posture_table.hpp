@@ -14,7 +14,11 @@
 // spacing); the samples nearest each node, one per slice of the last moving joint's range, are
 // pulled onto the node (damped least squares); they are the node's feasible starting postures
 // (a node none of them reaches is outside the workspace). Per pattern the polytope is evaluated at
-// each, and SLSQP runs from the best few; the best feasible result is kept.
+// each, and SLSQP runs from the best few; the best feasible result is kept. Where the pattern's
+// polytope has no area at any posture of the node (a joint that cannot hold its load from its
+// mode's supply: N where the arm needs a boost to hold), every posture is as good as another; the
+// table then keeps the posture of the largest polytope without the load, so that neighbouring
+// nodes get neighbouring postures rather than arbitrary ones.
 //
 // The table is built in parallel over nodes and kept in a binary file whose header holds a
 // fingerprint of everything it depends on (model, held joints, grid, settings): a file that does
@@ -77,9 +81,13 @@ class PolytopeArea {
  public:
   explicit PolytopeArea(const PlanarArm& arm);
   double operator()(const ArmVector& a, const dynamics::ModePattern& full_pattern);
+  // With the cylinder forces taken as 0 (the table's fallback for a pattern whose polytope has no
+  // area anywhere at a node).
+  void set_ignore_load(bool ignore) { ignore_load_ = ignore; }
 
  private:
   const PlanarArm* arm_;
+  bool ignore_load_ = false;
   dynamics::KinematicsData data_;
   dynamics::FlowPolytope polytope_;
   dynamics::JointVelocitySet full_set_, set_;
@@ -116,6 +124,7 @@ class PostureTable {
   double build_time_s = 0.0;
   long optimisations = 0;
   long unconverged = 0;
+  long degenerate = 0;  // entries whose polytope has no area (posture: the load-free optimum)
 
  private:
   std::size_t entry(int node, int pattern) const {
