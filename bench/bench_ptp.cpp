@@ -71,7 +71,7 @@ void BM_PtpSearch(benchmark::State& state) {
   planner::PtpPath path;
   for (auto _ : state) {
     path = s.ptp->search(from, to, w);
-    benchmark::DoNotOptimize(path.cost);
+    benchmark::DoNotOptimize(path.steps.data());
   }
   state.counters["expanded"] = path.expanded;
   state.counters["energy_J"] = path.energy_j;
@@ -86,7 +86,7 @@ void BM_PtpPlan(benchmark::State& state) {
   planner::PtpPlan plan;
   for (auto _ : state) {
     plan = s.ptp->plan({0.55, -0.05}, {0.55, 0.6}, w);
-    benchmark::DoNotOptimize(plan.energy_j);
+    benchmark::DoNotOptimize(plan.samples.data());
   }
   state.counters["energy_J"] = plan.energy_j;
   state.counters["time_s"] = plan.time_s;
@@ -99,7 +99,7 @@ void BM_PtpGraph(benchmark::State& state) {
   auto& s = setup();
   for (auto _ : state) {
     planner::PtpPlanner ptp(s.arm, *s.table, {});
-    benchmark::DoNotOptimize(ptp.transitions());
+    benchmark::DoNotOptimize(&ptp);
   }
 }
 BENCHMARK(BM_PtpGraph)->Unit(benchmark::kMillisecond);

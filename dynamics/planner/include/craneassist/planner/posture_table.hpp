@@ -63,7 +63,7 @@ std::vector<dynamics::ModePattern> planner_patterns(const PlanarArm& arm);
 dynamics::ModePattern full_pattern(const PlanarArm& arm, const dynamics::ModePattern& moving);
 
 // The default grid spacing: 5 cm (the paper's), or for an arm reaching further than 2 m its
-// reach / 40 rounded up to 5 cm (the K70M: 0.25 m).
+// reach / 40 rounded up to 5 cm (the K70M: 0.2 m).
 double default_spacing(const PlanarArm& arm);
 
 struct PostureTableSettings {
