@@ -267,6 +267,22 @@ TEST(PtpPlanner, TheTrajectoryRestsAtTheEndsAndPassesThroughTheNodes) {
   EXPECT_NEAR(plan.energy_j, plan.path.energy_j, 0.3 * plan.path.energy_j);
 }
 
+// A live loop replans from where the arm is: the trajectory starts at that posture, at rest, and
+// then follows the table's nodes.
+TEST(PtpPlanner, ReplansFromTheArmsPosture) {
+  planner::PtpPlanner ptp(arm(), small_table(), {});
+  const int start = ptp.node_near({0.5, -0.1});
+  ASSERT_GE(start, 0);
+  // Another posture on the start node: the table's for another pattern.
+  const ArmVector here = small_table().posture(start, 7);
+  const auto plan = ptp.plan({0.5, -0.1}, {0.7, 0.3}, W(0.5, 0, 2), here);
+  ASSERT_TRUE(plan.path.found);
+  EXPECT_LT((plan.samples.front().q - here).norm(), 1e-12);
+  EXPECT_LT(plan.samples.front().qdot.norm(), 1e-12);
+  EXPECT_LT((plan.samples.back().q - plan.path.steps.back().q).norm(), 1e-9);
+  EXPECT_LE(plan.peak_speed_ratio, 1.5 * 1.05);
+}
+
 TEST(PtpPlanner, APointOutsideTheWorkspaceIsRefused) {
   planner::PtpPlanner ptp(arm(), small_table(), {});
   EXPECT_THROW(ptp.plan({2.0, 0.0}, {0.5, 0.0}, W(0.5, 0, 2)), std::invalid_argument);
