@@ -20,6 +20,7 @@
 #include "follow_command.hpp"
 #include "plan_command.hpp"
 #include "polytope_command.hpp"
+#include "ptp_command.hpp"
 #include "replay_command.hpp"
 #include "sim_command.hpp"
 #include "suite_command.hpp"
@@ -69,6 +70,7 @@ int main(int argc, char** argv) {
   add(commands, cli, add_urdf_command, run_urdf_command);
   add(commands, cli, add_polytope_command, run_polytope_command);
   add(commands, cli, add_follow_command, run_follow_command);
+  add(commands, cli, add_ptp_command, run_ptp_command);
 #if CRANEASSIST_WITH_DDS  // a build without DDS (CRANEASSIST_DDS=OFF) has none of these
   add(commands, cli, add_remote_command, run_remote_command);
   add(commands, cli, add_echo_command, run_echo_command);

@@ -11,12 +11,19 @@
 namespace craneassist::input {
 namespace {
 
-// The format for n joints: t, then q_1..q_n, qdot_1..qdot_n, qddot_1..qddot_n.
-detail::CsvFormat trajectory_format(int n) {
+// The highest mode number (SB).
+constexpr double kMaxMode = 2.0;
+
+// The format for n joints: t, then q_1..q_n, qdot_1..qdot_n, qddot_1..qddot_n, and with_modes
+// mode_1..mode_n.
+detail::CsvFormat trajectory_format(int n, bool with_modes) {
   detail::CsvFormat format;
   format.columns.push_back({"t", detail::CsvKind::kTime});
   for (const char* name : {"q_", "qdot_", "qddot_"}) {
     for (int i = 1; i <= n; ++i) format.columns.push_back({name + std::to_string(i)});
+  }
+  for (int i = 1; with_modes && i <= n; ++i) {
+    format.columns.push_back({"mode_" + std::to_string(i), detail::CsvKind::kNumber, kMaxMode});
   }
   format.max_rows = JointTrajectory::kMaxRows;
   return format;
@@ -46,12 +53,25 @@ JointTrajectory JointTrajectory::load_file(const std::filesystem::path& path,
 
 JointTrajectory JointTrajectory::parse(std::string_view text, std::string_view source_name,
                                        const TrajectoryLimits& limits) {
-  const int n = std::max(joints_in_header(detail::header_line(text)), 1);
+  const std::string_view header = detail::header_line(text);
+  const int n = std::max(joints_in_header(header), 1);
+  const bool with_modes = header.find("mode_1") != std::string_view::npos;
   const auto crane_joints = static_cast<int>(limits.joints.size());
   const bool check_ranges = crane_joints == n;
   JointTrajectory traj(n);
-  detail::CsvFile file =
-      detail::read_csv(text, source_name, trajectory_format(n), [&](const detail::CsvRow& row) {
+  const auto plain_columns = static_cast<std::size_t>(1 + 3 * n);
+  detail::CsvFile file = detail::read_csv(
+      text, source_name, trajectory_format(n, with_modes), [&](const detail::CsvRow& row) {
+        const std::size_t columns = row.values.size();
+        for (std::size_t c = plain_columns; c < columns; ++c) {
+          const double mode = row.values[c];
+          if (!(mode >= 0.0 && mode == std::floor(mode))) {
+            throw row.error(
+                "mode_" + std::to_string(c - plain_columns + 1),
+                "expected a mode 0 (N), 1 (DB) or 2 (SB), got " + std::string(row.text[c]));
+          }
+          traj.modes_.push_back(static_cast<std::uint8_t>(mode));
+        }
         for (int i = 0; check_ranges && i < n; ++i) {
           const TrajectoryJoint& joint = limits.joints[static_cast<std::size_t>(i)];
           const double q = row.values[static_cast<std::size_t>(1 + i)];
@@ -64,7 +84,8 @@ JointTrajectory JointTrajectory::parse(std::string_view text, std::string_view s
           }
         }
         traj.t_s_.push_back(row.values[0]);
-        traj.values_.insert(traj.values_.end(), row.values.begin() + 1, row.values.end());
+        traj.values_.insert(traj.values_.end(), row.values.begin() + 1,
+                            row.values.begin() + static_cast<std::ptrdiff_t>(plain_columns));
       });
   if (crane_joints > 0 && !check_ranges) {
     const std::string columns =
@@ -87,10 +108,35 @@ void JointTrajectory::append(double t_s, const Eigen::Ref<const Eigen::VectorXd>
   if (!std::isfinite(t_s) || (!t_s_.empty() && !(t_s > t_s_.back()))) {
     throw std::invalid_argument("JointTrajectory::append: time not increasing");
   }
+  if (has_modes()) {
+    throw std::invalid_argument("JointTrajectory::append: modes on some samples only");
+  }
   t_s_.push_back(t_s);
   for (const auto* v : {&q, &qdot, &qddot}) {
     for (Eigen::Index i = 0; i < joints_; ++i) values_.push_back((*v)[i]);
   }
+}
+
+void JointTrajectory::append(double t_s, const Eigen::Ref<const Eigen::VectorXd>& q,
+                             const Eigen::Ref<const Eigen::VectorXd>& qdot,
+                             const Eigen::Ref<const Eigen::VectorXd>& qddot,
+                             const std::vector<int>& modes) {
+  if (!empty() && !has_modes()) {
+    throw std::invalid_argument("JointTrajectory::append: modes on some samples only");
+  }
+  if (modes.size() != static_cast<std::size_t>(joints_)) {
+    throw std::invalid_argument("JointTrajectory::append: wrong number of modes");
+  }
+  for (int m : modes) {
+    if (m < 0 || m > static_cast<int>(kMaxMode)) {
+      throw std::invalid_argument("JointTrajectory::append: mode out of range");
+    }
+  }
+  std::vector<std::uint8_t> kept;
+  kept.swap(modes_);  // append() takes a trajectory without modes
+  append(t_s, q, qdot, qddot);
+  kept.swap(modes_);
+  for (int m : modes) modes_.push_back(static_cast<std::uint8_t>(m));
 }
 
 void JointTrajectory::sample(double t, Eigen::Ref<Eigen::VectorXd> q,
@@ -137,12 +183,14 @@ void JointTrajectory::sample(double t, Eigen::Ref<Eigen::VectorXd> q,
 
 void write_joint_trajectory(std::ostream& out, const JointTrajectory& traj) {
   for (const auto& c : traj.comments) out << "# " << c << '\n';
-  out << detail::csv_header(trajectory_format(traj.joints())) << '\n';
+  const int n = traj.joints();
+  out << detail::csv_header(trajectory_format(n, traj.has_modes())) << '\n';
   for (std::size_t r = 0; r < traj.size(); ++r) {
     out << detail::number(traj.t_s(r));
     for (const auto& v : {traj.q(r), traj.qdot(r), traj.qddot(r)}) {
       for (Eigen::Index j = 0; j < v.size(); ++j) out << ',' << detail::number(v[j]);
     }
+    for (int j = 0; traj.has_modes() && j < n; ++j) out << ',' << traj.mode(r, j);
     out << '\n';
   }
 }

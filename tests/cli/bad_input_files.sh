@@ -126,5 +126,25 @@ expect calibrate_nan_level "--levels: 'nan' is not a finite number" calibrate --
 expect calibrate_zero_level "--levels: each level must be in (0, 1], got 0" calibrate --levels 0,1
 expect calibrate_level_order "--levels: the levels must be strictly ascending" \
   calibrate --levels 0.6,0.3
+# craneassist ptp (docs/mhsb.md#the-planner): bad points and weights, a point outside the
+# workspace, an option the crane cannot take; all found before a posture table is built.
+arm=$data/../../config/cranes/mhsb_3link.yaml
+nt=$work/no-table.bin
+expect ptp_bad_point "--from: '0.55': expected two numbers X,Z (m)" \
+  ptp --config "$arm" --table "$nt" --from 0.55 --to 0.5,0
+expect ptp_nan_point "--to: 'nan,0': expected two numbers X,Z (m)" \
+  ptp --config "$arm" --table "$nt" --from 0.5,0 --to nan,0
+expect ptp_outside "--to: (3.000, 0.000) m is outside the workspace of MHSB three-link arm (paper 001)" \
+  ptp --config "$arm" --table "$nt" --from 0.55,-0.05 --to 3,0
+expect ptp_bad_weights "--weights: '1,x,2': expected three numbers w1,w2,w3" \
+  ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --weights 1,x,2
+expect ptp_negative_weight "--weights: '1,-1,2': negative" \
+  ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --weights 1,-1,2
+expect ptp_no_circuit "--energy-model: K70M forestry loader (reference crane) has no MHSB circuit" \
+  ptp --table "$nt" --from 4,1 --to 7,4 --energy-model paper
+expect ptp_bad_velocity "--velocity-limit: unit 'bar' is not a velocity unit" \
+  ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --velocity-limit "3 bar"
+expect ptp_bad_grid "--grid: must be between 5 mm and 5 m" \
+  ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --grid "1 mm"
 [ "$failed" -eq 0 ] && echo "bad input files OK"
 exit "$failed"

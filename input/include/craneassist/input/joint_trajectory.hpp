@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <filesystem>
 #include <iosfwd>
 #include <string>
@@ -43,10 +44,14 @@ class JointTrajectory {
                                const TrajectoryLimits& limits = {});
 
   // Appends a sample; t must exceed the last one and the vectors have joints() entries (else
-  // std::invalid_argument).
+  // std::invalid_argument). The second form adds each joint's MHSB mode (0 N, 1 DB, 2 SB;
+  // docs/trajectory-format.md#mode-columns): a trajectory has modes on every sample or on none.
   void append(double t_s, const Eigen::Ref<const Eigen::VectorXd>& q,
               const Eigen::Ref<const Eigen::VectorXd>& qdot,
               const Eigen::Ref<const Eigen::VectorXd>& qddot);
+  void append(double t_s, const Eigen::Ref<const Eigen::VectorXd>& q,
+              const Eigen::Ref<const Eigen::VectorXd>& qdot,
+              const Eigen::Ref<const Eigen::VectorXd>& qddot, const std::vector<int>& modes);
 
   int joints() const { return joints_; }
   std::size_t size() const { return t_s_.size(); }
@@ -64,6 +69,13 @@ class JointTrajectory {
   // q and qdot must have joints() entries. No allocation.
   void sample(double t_s, Eigen::Ref<Eigen::VectorXd> q, Eigen::Ref<Eigen::VectorXd> qdot) const;
 
+  // Whether the samples carry modes (the file's optional mode_1..mode_n columns), and joint j's
+  // (0-based) mode at sample i: 0 N, 1 DB, 2 SB (dynamics::MhsbMode's order).
+  bool has_modes() const { return !modes_.empty(); }
+  int mode(std::size_t i, int j) const {
+    return modes_[i * static_cast<std::size_t>(joints_) + static_cast<std::size_t>(j)];
+  }
+
   // The comment lines of the file (without '#'), e.g. the planner's summary.
   std::vector<std::string> comments;
 
@@ -76,7 +88,8 @@ class JointTrajectory {
 
   int joints_ = 0;
   std::vector<double> t_s_;
-  std::vector<double> values_;  // per sample: q, qdot, qddot
+  std::vector<double> values_;       // per sample: q, qdot, qddot
+  std::vector<std::uint8_t> modes_;  // per sample: one per joint, or empty
 };
 
 void write_joint_trajectory(std::ostream& out, const JointTrajectory& trajectory);

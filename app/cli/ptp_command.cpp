@@ -1,0 +1,269 @@
+#include "ptp_command.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "crane_options.hpp"
+#include "craneassist/input/joint_trajectory.hpp"
+#include "craneassist/planner/ptp_planner.hpp"
+#include "exit_codes.hpp"
+#include "option_checks.hpp"
+
+namespace craneassist::cli {
+namespace {
+
+// "a,b,..." as exactly `count` finite numbers, or a CLI::ValidationError naming the option.
+std::vector<double> parse_numbers(const std::string& option, const std::string& text,
+                                  std::size_t count, const char* what) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string part;
+  bool ok = true;
+  while (std::getline(in, part, ',')) {
+    char* end = nullptr;
+    const double v = std::strtod(part.c_str(), &end);
+    while (end != nullptr && *end == ' ') ++end;
+    ok = ok && !part.empty() && end != part.c_str() && *end == '\0' && std::isfinite(v);
+    values.push_back(v);
+  }
+  if (!ok || values.size() != count || (!text.empty() && text.back() == ',')) {
+    throw CLI::ValidationError(option, "'" + text + "': expected " + what);
+  }
+  return values;
+}
+
+std::string point_text(const Eigen::Vector2d& p) {
+  char text[64];
+  std::snprintf(text, sizeof text, "(%.3f, %.3f) m", p.x(), p.y());
+  return text;
+}
+
+}  // namespace
+
+CLI::App* add_ptp_command(CLI::App& cli, PtpArgs& args) {
+  auto* cmd = cli.add_subcommand(
+      "ptp",
+      "Plan an energy-optimal point-to-point move of the tip in the arm's vertical plane with "
+      "posture and MHSB modes (paper 001: posture table, A*, time trajectory, mode retiming)");
+  add_config_option(*cmd, args.config_file);
+  cmd->add_option("--from", args.from, "Start X,Z in m (X horizontal outwards, Z up)")->required();
+  cmd->add_option("--to", args.to, "Goal X,Z in m")->required();
+  cmd->add_option("--weights", args.weights,
+                  "w1,w2,w3: weights of energy (per J), time (per s) and mode switches (per "
+                  "switched joint); default 0.5,0,2 (paper 001 case 1-1)");
+  cmd->add_option("--velocity-limit", args.velocity_limit,
+                  "The cylinders' speed limit V_L, e.g. \"12 mm/s\" (default: "
+                  "hydraulics.mhsb.velocity_limit, or each cylinder's max_speed)");
+  cmd->add_option("--grid", args.grid,
+                  "Grid spacing, e.g. \"5 cm\" (default 5 cm, or reach / 40 for a larger arm)");
+  cmd->add_option("--energy-model", args.energy_model,
+                  "MHSB energy: series (default: main pump at P0, servo-pump adds the boost at its "
+                  "efficiency) or paper (eq. 9 as printed)")
+      ->check(CLI::IsMember({"series", "paper"}));
+  cmd->add_option("--table", args.table,
+                  "The posture table file (built and written when missing or out of date; "
+                  "default: $XDG_CACHE_HOME or ~/.cache, craneassist/ptp-table-<hash>.bin)");
+  cmd->add_option("--heuristic-scale", args.heuristic_scale,
+                  "k of the A* heuristic k * distance (cost per m; default: the admissible bound, "
+                  "which keeps A* optimal)")
+      ->check(FiniteRange(0.0, 1e12));
+  cmd->add_option("--threads", args.threads, "Threads for building the posture table (default 2)")
+      ->check(CLI::Range(1, 64));
+  cmd->add_option("-o,--out", args.out, "Write the joint trajectory with mode columns to this CSV");
+  return cmd;
+}
+
+int run_ptp_command(const PtpArgs& args) {
+  config::CraneConfig cfg;
+  std::optional<planner::PlanarArm> arm;
+  planner::PtpSettings settings;
+  planner::PostureTableSettings table_settings;
+  planner::PtpWeights weights;
+  Eigen::Vector2d from, to;
+  try {
+    cfg = load_crane(args.config_file);
+    try {
+      arm.emplace(cfg.model, cfg.simulation.q_initial);
+    } catch (const std::invalid_argument& e) {
+      throw CLI::ValidationError("--config", cfg.model.name + ": " + e.what());
+    }
+    const auto f = parse_numbers("--from", args.from, 2, "two numbers X,Z (m)");
+    const auto t = parse_numbers("--to", args.to, 2, "two numbers X,Z (m)");
+    const auto w = parse_numbers("--weights", args.weights, 3, "three numbers w1,w2,w3");
+    for (double x : w) {
+      if (x < 0.0) throw CLI::ValidationError("--weights", "'" + args.weights + "': negative");
+    }
+    from = {f[0], f[1]};
+    to = {t[0], t[1]};
+    weights = {w[0], w[1], w[2], args.heuristic_scale};
+    if (!args.velocity_limit.empty()) {
+      settings.velocity_limit_m_s =
+          cli_quantity("--velocity-limit", args.velocity_limit, config::Dimension::kVelocity);
+      if (!(settings.velocity_limit_m_s > 0.0 && settings.velocity_limit_m_s <= 10.0)) {
+        throw CLI::ValidationError("--velocity-limit", "must be positive and at most 10 m/s");
+      }
+    }
+    if (!args.grid.empty()) {
+      table_settings.spacing_m = cli_quantity("--grid", args.grid, config::Dimension::kLength);
+      if (!(table_settings.spacing_m >= 0.005 && table_settings.spacing_m <= 5.0)) {
+        throw CLI::ValidationError("--grid", "must be between 5 mm and 5 m");
+      }
+    }
+    if (!args.energy_model.empty()) {
+      if (!cfg.model.mhsb) {
+        throw CLI::ValidationError("--energy-model", cfg.model.name +
+                                                         " has no MHSB circuit "
+                                                         "(hydraulics.mhsb); its pump's energy "
+                                                         "is used");
+      }
+      settings.energy_model = *dynamics::parse_mhsb_energy_model(args.energy_model);
+    }
+    table_settings.threads = args.threads;
+  } catch (const CLI::Error&) {
+    throw;
+  } catch (...) {
+    return input_error_exit("config");
+  }
+
+  // The table: from its file when it matches, else built (the points checked first against the
+  // sampled workspace, which is quick) and written.
+  const std::optional<std::filesystem::path> file =
+      args.table.empty() ? planner::default_table_file(*arm, table_settings)
+                         : std::optional<std::filesystem::path>(args.table);
+  std::optional<planner::PostureTable> table;
+  if (file) table = planner::PostureTable::load(*file, *arm, table_settings);
+  const bool loaded = table.has_value();
+  const auto check_points = [&](const planner::WorkspaceGrid& grid) {
+    const double reach = 0.5 * std::sqrt(2.0) * grid.spacing_m + 1e-9;
+    for (const auto& [option, p] : {std::pair{"--from", from}, std::pair{"--to", to}}) {
+      if (grid.nearest_node(p, reach) < 0) {
+        char why[160];
+        std::snprintf(why, sizeof why,
+                      "%s is outside the workspace of %s (no reachable grid node within %.1f cm)",
+                      point_text(p).c_str(), cfg.model.name.c_str(), 100.0 * reach);
+        throw CLI::ValidationError(option, why);
+      }
+    }
+  };
+  if (loaded) {
+    check_points(table->grid());
+  } else {
+    check_points(planner::sample_workspace(*arm, table_settings).grid);
+    std::fprintf(stderr, "craneassist ptp: building the posture table (%d threads)...\n",
+                 table_settings.threads);
+    table = planner::PostureTable::build(*arm, table_settings);
+    if (file) {
+      try {
+        table->save(*file);
+      } catch (const std::exception& e) {
+        spdlog::warn("{} (the table is not cached)", e.what());
+      }
+    }
+  }
+  planner::PtpPlanner ptp(*arm, *table, settings);
+  planner::PtpPlan plan;
+  try {
+    plan = ptp.plan(from, to, weights);
+  } catch (const std::invalid_argument& e) {
+    spdlog::error("{}", e.what());
+    return kExitUsage;
+  }
+
+  const auto& grid = table->grid();
+  std::printf("craneassist ptp: %s\n", cfg.model.name.c_str());
+  std::printf("  posture table: %d nodes x %d patterns, %.0f mm grid, %s\n", grid.nodes(),
+              table->pattern_count(), 1000.0 * grid.spacing_m,
+              loaded ? ("loaded from " + file->string()).c_str() : "built");
+  if (!loaded) {
+    std::printf(
+        "    in %.1f s (%d threads, %ld SLSQP runs, %ld entries without a converged run, %ld "
+        "without polytope area)%s\n",
+        table->build_time_s, table_settings.threads, table->optimisations, table->unconverged,
+        table->degenerate, file ? (", written to " + file->string()).c_str() : "");
+  }
+  std::string limits;
+  for (int k = 0; k < arm->moving(); ++k) {
+    char part[64];
+    std::snprintf(part, sizeof part, "%s%.1f", k ? "/" : "", 1000.0 * ptp.velocity_limit_m_s(k));
+    limits += part;
+  }
+  std::printf("  graph: %ld transitions; V_L %s mm/s; energy: %s\n", ptp.transitions(),
+              limits.c_str(), planner::to_string(ptp.energy()));
+  std::printf("  from %s to %s (nodes %s, %s), weights %g, %g, %g; heuristic %.4g per m\n",
+              point_text(from).c_str(), point_text(to).c_str(),
+              point_text(grid.node_xz[static_cast<std::size_t>(ptp.node_near(from))]).c_str(),
+              point_text(grid.node_xz[static_cast<std::size_t>(ptp.node_near(to))]).c_str(),
+              weights.energy, weights.time, weights.switches, ptp.heuristic_per_m(weights));
+  if (!plan.path.found) {
+    std::printf("  no path: the goal cannot be reached within the mode rules\n");
+    return kExitRuntime;
+  }
+  const auto& path = plan.path;
+  std::printf(
+      "  S2 path: %zu nodes, %.3f m, %.2f s, %.0f J, %d mode switches (cost %.4g, %d "
+      "states expanded)\n",
+      path.steps.size(), path.length_m, path.time_s, path.energy_j, path.switches, path.cost,
+      path.expanded);
+  std::printf(
+      "  S3/S4 trajectory: %.2f s, %.0f J, tip path %.3f m, %d mode switches, peak "
+      "cylinder speed %.2f V_L\n",
+      plan.time_s, plan.energy_j, plan.length_m, plan.switches, plan.peak_speed_ratio);
+  std::printf("  planning time (S2-S4): %.3f ms\n", 1000.0 * plan.planning_time_s);
+  std::string modes_line;
+  for (std::size_t i = 0; i < path.steps.size(); ++i) {
+    const auto& p = table->patterns()[static_cast<std::size_t>(path.steps[i].pattern)];
+    if (i == 0 || !(p == table->patterns()[static_cast<std::size_t>(path.steps[i - 1].pattern)])) {
+      char part[96];
+      std::snprintf(part, sizeof part, "%s%s from %.2f s", modes_line.empty() ? "" : ", ",
+                    dynamics::to_string(p).c_str(), i == 0 ? 0.0 : path.steps[i - 1].t_s);
+      modes_line += part;
+    }
+  }
+  if (cfg.model.mhsb) std::printf("  S2 modes: %s\n", modes_line.c_str());
+
+  if (!args.out.empty()) {
+    const int n = cfg.model.dof();
+    input::JointTrajectory traj(n);
+    traj.comments.push_back("craneassist ptp: " + cfg.model.name + ", from " + point_text(from) +
+                            " to " + point_text(to) + ", weights " + args.weights);
+    char summary[200];
+    std::snprintf(summary, sizeof summary,
+                  "energy %.1f J, time %.3f s, tip path %.3f m, mode switches %d (S2: %.1f J, "
+                  "%.3f s)",
+                  plan.energy_j, plan.time_s, plan.length_m, plan.switches, path.energy_j,
+                  path.time_s);
+    traj.comments.emplace_back(summary);
+    Eigen::VectorXd qdot(n), qddot(n);
+    std::vector<int> modes(static_cast<std::size_t>(n), 0);
+    for (const auto& s : plan.samples) {
+      const dynamics::JointVector q = arm->full(s.q);
+      qdot.setZero();
+      qddot.setZero();
+      std::fill(modes.begin(), modes.end(), 0);
+      for (int k = 0; k < arm->moving(); ++k) {
+        qdot[arm->joint(k)] = s.qdot[k];
+        qddot[arm->joint(k)] = s.qddot[k];
+        modes[static_cast<std::size_t>(arm->joint(k))] =
+            static_cast<int>(s.mode[static_cast<std::size_t>(k)]);
+      }
+      if (cfg.model.mhsb) {
+        traj.append(s.t_s, Eigen::VectorXd(q), qdot, qddot, modes);
+      } else {
+        traj.append(s.t_s, Eigen::VectorXd(q), qdot, qddot);
+      }
+    }
+    std::ostringstream text;
+    input::write_joint_trajectory(text, traj);
+    char what[64];
+    std::snprintf(what, sizeof what, "%zu samples", traj.size());
+    return write_output(text.str(), args.out, what);
+  }
+  return kExitOk;
+}
+
+}  // namespace craneassist::cli

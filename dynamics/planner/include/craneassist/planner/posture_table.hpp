@@ -1,0 +1,149 @@
+// S1 of paper 001 (section 2.1, eq. 7; docs/mhsb.md#s1-the-optimal-posture-table): for every node
+// of a square grid over the arm's reachable workspace and every mode pattern, the posture with the
+// largest flow manipulability polytope (its area in the arm's plane, flow_polytope.hpp) among those
+// that put the tip on the node within the joint ranges:
+//     max_q S(q)  subject to  tip(q) = node,  q_min <= q <= q_max.
+// The polytope of a pattern is that of mhsb_joint_velocity_set (each joint's servo-valve from its
+// mode's supply against the cylinder force that holds the load at q, the servo-pumps' flow in
+// DB/SB, the main pump's flow on the sum); a crane without the circuit has one pattern, all N, and
+// its cylinders' and pump's limits (joint_velocity_set).
+//
+// The solver is NLopt's SLSQP (sequential least-squares quadratic programming, as the paper's SQP):
+// the area's gradient by central differences, the tip constraint's by the Jacobian. Multi-start:
+// the joint space is sampled (each joint's range in steps that move the tip by at most half a grid
+// spacing); the samples nearest each node, one per slice of the last moving joint's range, are
+// pulled onto the node (damped least squares); they are the node's feasible starting postures
+// (a node none of them reaches is outside the workspace). Per pattern the polytope is evaluated at
+// each, and SLSQP runs from the best few; the best feasible result is kept. Where the pattern's
+// polytope has no area at any posture of the node (a joint that cannot hold its load from its
+// mode's supply: N where the arm needs a boost to hold), every posture is as good as another; the
+// table then keeps the posture of the largest polytope without the load, so that neighbouring
+// nodes get neighbouring postures rather than arbitrary ones.
+//
+// The table is built in parallel over nodes and kept in a binary file whose header holds a
+// fingerprint of everything it depends on (model, held joints, grid, settings): a file that does
+// not match is rebuilt (save(), load()).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "craneassist/dynamics/mhsb.hpp"
+#include "craneassist/planner/planar_arm.hpp"
+
+namespace craneassist::planner {
+
+// Nodes at (i h, k h) in the arm's plane, i and k integers: the reachable ones numbered 0..N-1.
+struct WorkspaceGrid {
+  double spacing_m = 0.05;
+  int ix0 = 0, iz0 = 0;             // the first cell's indices
+  int nx = 0, nz = 0;               // cells
+  std::vector<int> node_of_cell;    // nx * nz, cell (i, k) at i + nx k; -1: not reachable
+  std::vector<int> node_i, node_k;  // each node's cell
+  std::vector<Eigen::Vector2d> node_xz;
+
+  int nodes() const { return static_cast<int>(node_xz.size()); }
+  // Node of the cell (ix, iz) (absolute indices), -1 for none.
+  int node_at(int ix, int iz) const;
+  // The node nearest to xz and within max_distance_m of it, or -1.
+  int nearest_node(const Eigen::Vector2d& xz, double max_distance_m) const;
+  // The neighbour of a node in direction d (0..7: E, NE, N, NW, W, SW, S, SE), or -1.
+  int neighbour(int node, int d) const;
+};
+
+// The mode patterns the planner considers, over the moving joints: with the MHSB circuit every
+// pattern of its modules (23 for three joints and four modules); without it, all N only.
+std::vector<dynamics::ModePattern> planner_patterns(const PlanarArm& arm);
+// A pattern over the moving joints as one over all the crane's joints (held joints N).
+dynamics::ModePattern full_pattern(const PlanarArm& arm, const dynamics::ModePattern& moving);
+
+// The default grid spacing: 5 cm (the paper's), or for an arm reaching further than 2 m its
+// reach / 40 rounded up to 5 cm (the K70M: 0.2 m).
+double default_spacing(const PlanarArm& arm);
+
+struct PostureTableSettings {
+  double spacing_m = 0.0;  // 0: default_spacing()
+  int threads = 2;
+  int seeds_per_node = 36;  // starting postures per node (slices of the last joint's range)
+  int refined_starts = 4;   // SLSQP runs per node and pattern
+  // Only nodes inside this box (X, Z min, max; tests); empty: the whole workspace.
+  std::optional<Eigen::Vector4d> region;
+  int max_patterns = 0;  // the first patterns only (tests); 0: all
+};
+
+// The polytope area (m^2/s^2) of a pattern at moving-joint posture a; one per thread.
+class PolytopeArea {
+ public:
+  explicit PolytopeArea(const PlanarArm& arm);
+  double operator()(const ArmVector& a, const dynamics::ModePattern& full_pattern);
+  // With the cylinder forces taken as 0 (the table's fallback for a pattern whose polytope has no
+  // area anywhere at a node).
+  void set_ignore_load(bool ignore) { ignore_load_ = ignore; }
+
+ private:
+  const PlanarArm* arm_;
+  bool ignore_load_ = false;
+  dynamics::KinematicsData data_;
+  dynamics::FlowPolytope polytope_;
+  dynamics::JointVelocitySet full_set_, set_;
+};
+
+// The reachable grid and each node's starting postures (already on the node).
+struct Workspace {
+  WorkspaceGrid grid;
+  std::vector<std::vector<ArmVector>> starts;  // per node
+};
+Workspace sample_workspace(const PlanarArm& arm, const PostureTableSettings& settings);
+
+class PostureTable {
+ public:
+  int moving() const { return moving_; }
+  const WorkspaceGrid& grid() const { return grid_; }
+  const std::vector<dynamics::ModePattern>& patterns() const { return patterns_; }
+  int pattern_count() const { return static_cast<int>(patterns_.size()); }
+  ArmVector posture(int node, int pattern) const;
+  double area(int node, int pattern) const { return area_[entry(node, pattern)]; }
+  std::uint64_t fingerprint() const { return fingerprint_; }
+
+  // Builds it (progress: called with nodes done and in all, from the building threads, serially).
+  static PostureTable build(const PlanarArm& arm, const PostureTableSettings& settings,
+                            const std::function<void(int, int)>& progress = {});
+  // Writes the binary file (throws std::runtime_error naming it when it cannot).
+  void save(const std::filesystem::path& file) const;
+  // The table in the file when it exists and matches arm and settings; nullopt otherwise.
+  static std::optional<PostureTable> load(const std::filesystem::path& file, const PlanarArm& arm,
+                                          const PostureTableSettings& settings);
+
+  // What the build did (not saved): wall time, SLSQP runs, entries where none converged (the best
+  // starting posture is kept).
+  double build_time_s = 0.0;
+  long optimisations = 0;
+  long unconverged = 0;
+  long degenerate = 0;  // entries whose polytope has no area (posture: the load-free optimum)
+
+ private:
+  std::size_t entry(int node, int pattern) const {
+    return static_cast<std::size_t>(node) * patterns_.size() + static_cast<std::size_t>(pattern);
+  }
+  int moving_ = 0;
+  WorkspaceGrid grid_;
+  std::vector<dynamics::ModePattern> patterns_;
+  std::vector<double> q_;  // per entry: moving() coordinates
+  std::vector<double> area_;
+  std::uint64_t fingerprint_ = 0;
+};
+
+// What the table depends on, hashed: the model, the held joints, spacing, seeds and starts.
+std::uint64_t posture_table_fingerprint(const PlanarArm& arm, const PostureTableSettings& settings);
+
+// The default cache file: $XDG_CACHE_HOME/craneassist (else ~/.cache/craneassist) /
+// ptp-table-<fingerprint>.bin; nullopt when neither variable is set.
+std::optional<std::filesystem::path> default_table_file(const PlanarArm& arm,
+                                                        const PostureTableSettings& settings);
+
+}  // namespace craneassist::planner
