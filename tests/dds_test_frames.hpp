@@ -24,7 +24,8 @@ inline dds::TelemetryInfo test_telemetry_info() {
 }
 
 // Cycle `cycle` of a crane holding still with the pump at 12.5 kW and 60 L/min, limited by
-// power, the tip moving at 0.5 m/s in the command's direction.
+// power, the tip moving at 0.5 m/s in the command's direction, where the hydraulics allow
+// 1.25 m/s.
 inline dds::TelemetryFrame test_frame(std::uint64_t cycle) {
   dds::TelemetryFrame f;
   f.cycle = cycle;
@@ -63,6 +64,10 @@ inline dds::TelemetryFrame test_frame(std::uint64_t cycle) {
   f.loop_latency_max_s = 120e-6;
   f.loop_compute_s = 40e-6;
   f.loop_overruns = 2;
+  f.avail_speed_m_s = 1.25;  // the stick's 0.625 m/s is half of it
+  f.avail_speed_resolved_m_s = 1.0;
+  f.polytope_dim = 3;
+  f.polytope_volume_m3_s3 = 51.51;
   return f;
 }
 

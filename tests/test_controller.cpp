@@ -1,6 +1,7 @@
 // The control pipeline per cycle: direction kept, bad input stops, no heap allocation.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstdlib>
@@ -377,6 +378,8 @@ TEST(Controller, PolytopeFiguresOfEachCycle) {
       poly.build_hull();
       EXPECT_EQ(out.polytope_volume_m3_s3, poly.volume());
       EXPECT_GT(out.polytope_volume_m3_s3, 0.0);
+      EXPECT_EQ(out.polytope_dim, 3);  // a solid: its measure is the volume, no area
+      EXPECT_EQ(out.polytope_area_m2_s2, 0.0);
       EXPECT_EQ(out.avail_speed_m_s, poly.max_speed(v));
       EXPECT_GT(out.avail_speed_resolved_m_s, 0.0);
       EXPECT_LE(out.avail_speed_resolved_m_s, out.avail_speed_m_s * (1 + 1e-9));
@@ -404,6 +407,57 @@ TEST(Controller, PolytopeFiguresOfEachCycle) {
     EXPECT_EQ(out.avail_speed_m_s, poly.max_speed(v));
     EXPECT_GT(out.avail_speed_m_s, 0.0);
   }
+}
+
+TEST(Controller, PlanarArmReportsThePolytopeAreaInItsPlane) {
+  // A planar arm's tip polytope is flat: the cycle reports dimension 2, no volume, and the area
+  // of the polygon of its plane's own 2 x n task (planar_task_basis), computed here apart, at
+  // poses across its range. (The controller does not move a planar arm: its resolution needs
+  // three independent Jacobian columns, docs/polytope.md; the polytope does not.) Stretched out
+  // it is singular: a segment, no area.
+  const auto cfg = config::planar_2r_config();
+  control::Controller controller(cfg, {control::ScalingMode::kFlowOnly});
+  control::ControllerOutput out;
+  const auto basis = dynamics::planar_task_basis(cfg.model);
+  ASSERT_TRUE(basis.has_value());
+  const dynamics::FlowPolytopeSettings settings{.flow_reserve = cfg.control.flow_reserve};
+  dynamics::FlowPolytope plane(cfg.model.dof(), 2);
+  dynamics::KinematicsData kin;
+  dynamics::TaskJacobian jacobian;
+  dynamics::JointVector arms;
+  dynamics::JointVelocitySet set;
+  const Eigen::Vector3d v(0.3, -0.2, 0.0);  // in the arm's plane (x, y)
+  std::vector<double> areas;
+  for (const double shoulder : {-0.5, 0.2, 0.9, 1.6}) {
+    for (const double elbow : {-1.2, -0.6, 0.3}) {
+      valves::MachineState state = still_state(cfg);
+      state.q << shoulder, elbow;
+      controller.reset(state);
+      controller.update(state, v, out);
+      dynamics::cylinder_arms(cfg.model, state.q, arms);
+      dynamics::tip_jacobian(cfg.model, kin, state.q, jacobian);
+      dynamics::joint_velocity_set(cfg.model, state.q, arms, settings, set);
+      plane.update(set, *basis * jacobian);
+      plane.build_hull();
+      ASSERT_EQ(plane.dimension(), 2);
+      EXPECT_EQ(out.polytope_dim, 2);
+      EXPECT_EQ(out.polytope_volume_m3_s3, 0.0);
+      EXPECT_GT(out.polytope_area_m2_s2, 0.0);
+      EXPECT_NEAR(out.polytope_area_m2_s2, plane.area(), 1e-9 * plane.area());
+      EXPECT_NEAR(out.avail_speed_m_s, plane.max_speed(*basis * v), 1e-9 * out.avail_speed_m_s);
+      areas.push_back(out.polytope_area_m2_s2);
+    }
+  }
+  // The poses differ: not one figure checked twelve times.
+  EXPECT_GT(*std::max_element(areas.begin(), areas.end()),
+            1.5 * *std::min_element(areas.begin(), areas.end()));
+  valves::MachineState stretched = still_state(cfg);
+  stretched.q << 0.5, 0.0;
+  controller.reset(stretched);
+  controller.update(stretched, v, out);
+  EXPECT_EQ(out.polytope_dim, 1);
+  EXPECT_EQ(out.polytope_volume_m3_s3, 0.0);
+  EXPECT_EQ(out.polytope_area_m2_s2, 0.0);
 }
 
 TEST(CsvLog, PushDoesNotAllocateAndEveryRowArrives) {

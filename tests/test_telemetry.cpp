@@ -34,6 +34,7 @@
 #include "craneassist_msgs.h"
 #include "dds_test_frames.hpp"
 #include "participant.hpp"
+#include "sample_views.hpp"
 
 // Heap allocations counted per thread: the publisher thread allocates (sample sequences and
 // strings) while the loop's thread pushes; only the pusher's count is asserted.
@@ -226,6 +227,12 @@ cdds::TelemetryFrame frame(std::uint64_t k) {
   f.sddot_max = 0.8;
   f.tip_error_m = 0.004;
   f.input_source = "keyboard";
+  // A planar arm's polytope: flat, its measure the area.
+  f.avail_speed_m_s = 1.5;
+  f.avail_speed_resolved_m_s = 1.25;
+  f.polytope_dim = 2;
+  f.polytope_volume_m3_s3 = 0.0;
+  f.polytope_area_m2_s2 = 3.5;
   return f;
 }
 
@@ -262,6 +269,11 @@ TEST(Telemetry, EveryTopicRoundTripsEveryField) {
   EXPECT_EQ(s.loop_latency_max_s(), 120e-6);
   EXPECT_EQ(s.loop_compute_s(), 40e-6);
   EXPECT_EQ(s.loop_overruns(), 2u);
+  EXPECT_EQ(s.avail_speed_m_s(), 1.5);
+  EXPECT_EQ(s.avail_speed_resolved_m_s(), 1.25);
+  EXPECT_EQ(s.polytope_dim(), 2u);
+  EXPECT_EQ(s.polytope_volume_m3_s3(), 0.0);
+  EXPECT_EQ(s.polytope_area_m2_s2(), 3.5);
 
   const auto j = sub.joints.samples().front();
   EXPECT_EQ(j.header().cycle(), 0u);
@@ -371,6 +383,11 @@ TEST(Telemetry, TheWatchAssemblesThePublishedFrame) {
   EXPECT_EQ(got.loop_latency_max_s, want.loop_latency_max_s);
   EXPECT_EQ(got.loop_compute_s, want.loop_compute_s);
   EXPECT_EQ(got.loop_overruns, want.loop_overruns);
+  EXPECT_EQ(got.avail_speed_m_s, want.avail_speed_m_s);
+  EXPECT_EQ(got.avail_speed_resolved_m_s, want.avail_speed_resolved_m_s);
+  EXPECT_EQ(got.polytope_dim, want.polytope_dim);
+  EXPECT_EQ(got.polytope_volume_m3_s3, want.polytope_volume_m3_s3);
+  EXPECT_EQ(got.polytope_area_m2_s2, want.polytope_area_m2_s2);
   const cdds::WatchedRun run = watch.run();
   EXPECT_EQ(run.crane, "test crane");
   EXPECT_EQ(run.backend, "sim");
@@ -509,6 +526,47 @@ void cross_process_figures(int domain, const char* transport, const char* label)
 
 TEST(Telemetry, CrossProcessLatencyFiguresSharedMemory) {
   cross_process_figures(104, "default", "default transports (shared memory)");
+}
+
+// The dashboard's polytope lines (docs/dashboard.md), from the samples alone: the stick's speed
+// (command_path) against the available speed along it (status), and the polytope's measure in
+// the unit of its dimension.
+TEST(Dashboard, ShowsTheStickAgainstTheAvailableSpeedAndThePolytopeMeasure) {
+  craneassist::msg::Status status;
+  status.avail_speed_m_s(1.25);
+  status.avail_speed_resolved_m_s(1.0);
+  status.polytope_dim(3);
+  status.polytope_volume_m3_s3(51.51);
+  craneassist::msg::CommandPath path;
+  path.command_m_s({0.3, 0.4, 0.0});
+  auto shows = [&](std::initializer_list<const char*> texts) {
+    const auto lines = cdds::dashboard_view(&status, nullptr, nullptr, &path);
+    std::string all;
+    for (const auto& line : lines) all += line + "\n";
+    for (const char* text : texts) {
+      EXPECT_NE(all.find(text), std::string::npos) << "missing: " << text << "\n" << all;
+    }
+  };
+  shows({"stick     [############..................]  0.50 /  1.25 m/s available   40 %",
+         "polytope  volume 51.51 m^3/s^3        along the chosen joint motion 1.00 m/s"});
+  // A planar arm (or a singular pose): flat, its area; a segment has neither.
+  status.polytope_dim(2);
+  status.polytope_volume_m3_s3(0.0);
+  status.polytope_area_m2_s2(3.5);
+  shows({"polytope  area 3.5 m^2/s^2 (flat)"});
+  status.polytope_dim(1);
+  status.polytope_area_m2_s2(0.0);
+  shows({"polytope  dimension 1: no motion across it"});
+  // Asking for more than there is: the bar full, the share above 100 %.
+  path.command_m_s({2.0, 0.0, 0.0});
+  shows({"stick     [##############################]  2.00 /  1.25 m/s available  160 %"});
+  // No valid operator input (NaN command): no stick speed.
+  path.command_m_s({NAN, NAN, NAN});
+  shows({"stick     [..............................]     - /  1.25 m/s available"});
+  // No status yet.
+  const auto lines = cdds::dashboard_view(nullptr, nullptr, nullptr, &path);
+  EXPECT_NE(std::find(lines.begin(), lines.end(), "stick     -"), lines.end());
+  EXPECT_NE(std::find(lines.begin(), lines.end(), "polytope  -"), lines.end());
 }
 
 }  // namespace

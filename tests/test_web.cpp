@@ -115,6 +115,10 @@ TEST(WebServer, StreamsTheCyclesWithTheCraneDrawnAsPoints) {
   row.t = 1.5;
   row.q = {0.2, 0.5, -1.5, 1.0};
   row.status = "running";
+  row.avail_speed_m_s = 1.25;
+  row.avail_speed_resolved_m_s = 0.875;
+  row.polytope_dim = 3;
+  row.polytope_volume_m3s3 = 51.51;
   control::CycleTime time{};
   valves::MachineState state;
   valves::ValveCommand command;
@@ -126,6 +130,12 @@ TEST(WebServer, StreamsTheCyclesWithTheCraneDrawnAsPoints) {
   EXPECT_EQ(frame["points"].size(), 5u);     // base and four joint frames
   EXPECT_GE(frame["cylinders"].size(), 2u);  // lift, tilt, extension drawn
   EXPECT_EQ(frame["status"], "running");
+  // The polytope's figures (the page's stick gauge, arrow and measure).
+  EXPECT_EQ(frame["avail"], 1.25);
+  EXPECT_EQ(frame["avail_resolved"], 0.875);
+  EXPECT_EQ(frame["polytope"]["dim"], 3);
+  EXPECT_EQ(frame["polytope"]["volume"], 51.51);
+  EXPECT_EQ(frame["polytope"]["area"], 0.0);
 }
 
 TEST(WebServer, ThePageIsAGamepadThatStopsWhenItLeaves) {

@@ -49,6 +49,11 @@ void each_field(Row& row, Frame& f, int n, Copy copy) {
   copy(row.loop_latency_max_s, f.loop_latency_max_s);
   copy(row.loop_compute_s, f.loop_compute_s);
   copy(row.loop_overruns, f.loop_overruns);
+  copy(row.avail_speed_m_s, f.avail_speed_m_s);
+  copy(row.avail_speed_resolved_m_s, f.avail_speed_resolved_m_s);
+  copy(row.polytope_dim, f.polytope_dim);
+  copy(row.polytope_volume_m3s3, f.polytope_volume_m3_s3);
+  copy(row.polytope_area_m2s2, f.polytope_area_m2_s2);
 }
 
 }  // namespace

@@ -37,6 +37,10 @@ struct TopicState {
 static struct TopicState g_state[kTopics];
 static char g_last_status[32] = "";
 static long g_nan_commands = 0; /* command_path samples without a valid operator command */
+/* The flow manipulability polytope's figures of the status samples. */
+static long g_solid_polytopes = 0;     /* dimension 3, volume > 0, area 0 */
+static double g_avail_speed_max = 0.0; /* the largest available speed along the stick */
+static double g_volume_min = INFINITY, g_volume_max = 0.0;
 
 static bool finite_all(const double* v, size_t n) {
   for (size_t i = 0; i < n; ++i) {
@@ -101,6 +105,24 @@ static void check_status(const craneassist_msg_Status* m) {
         "loop_compute_s %g", m->loop_compute_s);
   CHECK(m->loop_overruns < 1000000u, kStatus, "loop_overruns %llu",
         (unsigned long long)m->loop_overruns);
+  /* The polytope: the K70M's is a solid at every pose of the replay (no singular pose). */
+  CHECK(isfinite(m->avail_speed_m_s) && m->avail_speed_m_s >= 0.0 && m->avail_speed_m_s < 20.0,
+        kStatus, "avail_speed_m_s %g", m->avail_speed_m_s);
+  CHECK(isfinite(m->avail_speed_resolved_m_s) && m->avail_speed_resolved_m_s >= 0.0 &&
+            m->avail_speed_resolved_m_s < 20.0,
+        kStatus, "avail_speed_resolved_m_s %g", m->avail_speed_resolved_m_s);
+  CHECK(m->polytope_dim == 3, kStatus, "polytope_dim %u", (unsigned)m->polytope_dim);
+  CHECK(isfinite(m->polytope_volume_m3_s3) && m->polytope_volume_m3_s3 > 0.0 &&
+            m->polytope_volume_m3_s3 < 1e4,
+        kStatus, "polytope_volume_m3_s3 %g", m->polytope_volume_m3_s3);
+  CHECK(m->polytope_area_m2_s2 == 0.0, kStatus, "polytope_area_m2_s2 %g (a solid has none)",
+        m->polytope_area_m2_s2);
+  if (m->polytope_dim == 3 && m->polytope_volume_m3_s3 > 0.0 && m->polytope_area_m2_s2 == 0.0) {
+    ++g_solid_polytopes;
+  }
+  g_avail_speed_max = fmax(g_avail_speed_max, m->avail_speed_m_s);
+  g_volume_min = fmin(g_volume_min, m->polytope_volume_m3_s3);
+  g_volume_max = fmax(g_volume_max, m->polytope_volume_m3_s3);
   if (m->state != NULL) snprintf(g_last_status, sizeof g_last_status, "%s", m->state);
 }
 
@@ -247,6 +269,19 @@ int main(int argc, char** argv) {
     dds_sleepfor(DDS_MSECS(5));
   }
   dds_delete(pp);
+
+  /* The polytope's figures arrived: a speed available along the stick (the replay commands a
+   * direction), a volume that changes as the crane moves. */
+  const long statuses = g_state[kStatus].count;
+  printf(
+      "cyclone reader: polytope: dimension 3 in %s status (%ld of %ld); available speed "
+      "along the stick up to %.3f m/s; volume %.4g to %.4g m^3/s^3\n",
+      statuses > 0 && g_solid_polytopes == statuses ? "every" : "not every", g_solid_polytopes,
+      statuses, g_avail_speed_max, statuses > 0 ? g_volume_min : 0.0, g_volume_max);
+  CHECK(statuses == 0 || g_avail_speed_max > 0.0, kStatus,
+        "no available speed along the stick in any status");
+  CHECK(statuses == 0 || g_volume_max > g_volume_min, kStatus,
+        "the polytope's volume never changed (%g)", g_volume_max);
 
   printf(
       "cyclone reader: received status %ld, joints %ld, hydraulics %ld, command_path %ld; "

@@ -66,6 +66,11 @@ int main(int argc, char** argv) {
   status.loop_latency_max_s = 0.000125;
   status.loop_compute_s = 0.00025;
   status.loop_overruns = 3;
+  status.avail_speed_m_s = 1.25;
+  status.avail_speed_resolved_m_s = 0.875;
+  status.polytope_dim = 2; /* flat: a planar arm's area */
+  status.polytope_volume_m3_s3 = 0.0;
+  status.polytope_area_m2_s2 = 3.5;
 
   char* names[4] = {"slew", "lift", "tilt", "extension"};
   bool prismatic[4] = {false, false, false, true};

@@ -4,7 +4,7 @@
 // discovery data (on_type_discovery) or through the TypeLookup service from TYPE_INFORMATION
 // (on_type_information_received, register_remote_type). Prints each telemetry topic's type once:
 //
-//   type_object craneassist/status: craneassist::msg::Status, 14 members: active_limit ...
+//   type_object craneassist/status: craneassist::msg::Status, 19 members: active_limit ...
 //
 // Usage: fastdds_type_discovery DOMAIN SECONDS. Ends when the four telemetry topics have a type,
 // or after SECONDS. Must run in another process than craneassist: a process that registered the

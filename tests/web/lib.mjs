@@ -45,6 +45,40 @@ export async function launchChromium(nodeModules) {
   });
 }
 
+// What the page's gauges show of the flow polytope, with the frame they show (read at once, so
+// the two belong together): the stick against the available speed, the speed along the chosen
+// joint motion, the polytope's measure, and the available-speed arrow ({length, dir} or null).
+export function polytopeShown(page) {
+  return page.evaluate(() => ({
+    frame: window.craneassist.shown,
+    gauge: document.getElementById('avail-text')?.textContent,
+    resolved: document.getElementById('avail-resolved')?.textContent,
+    polytope: document.getElementById('polytope')?.textContent,
+    arrow: window.craneassist.avail_arrow,
+  }));
+}
+
+// Checks that `shown` (polytopeShown) displays its frame's figures: the stick's speed against
+// the available speed along it, the volume of a solid polytope, the arrow along the stick.
+export function checkPolytopeShown(shown, what) {
+  const f = shown.frame;
+  if (!f) { check(false, `${what}: no frame shown`); return; }
+  const stick = f.cmd.every((x) => x !== null) ? Math.hypot(...f.cmd) : null;
+  const want = `${stick === null ? '-' : stick.toFixed(2)} / ${f.avail.toFixed(2)} m/s`;
+  check(shown.gauge === want, `${what}: stick / available shows '${shown.gauge}' (frame: ${want})`);
+  check(shown.resolved === `${f.avail_resolved.toFixed(2)} m/s`,
+    `${what}: along the chosen joint motion '${shown.resolved}' (frame: ${f.avail_resolved})`);
+  const volume = `volume ${Number(f.polytope.volume.toPrecision(4))} m³/s³`;
+  check(f.polytope.dim === 3 && f.polytope.volume > 0 && shown.polytope === volume,
+    `${what}: the polytope shows '${shown.polytope}' (frame: dimension ${f.polytope.dim}, volume ${f.polytope.volume})`);
+  if (f.avail > 1e-3 && stick !== null && stick > 1e-3) {
+    const a = shown.arrow;
+    const along = a ? a.dir.reduce((s, v, i) => s + v * f.cmd[i], 0) / stick : 0;
+    check(a !== null && Math.abs(a.length - (0.3 + 2 * f.avail)) < 1e-9 && along > 0.999,
+      `${what}: the available-speed arrow is along the stick, ${a ? a.length.toFixed(2) : '-'} m for ${f.avail.toFixed(2)} m/s`);
+  }
+}
+
 // A page of the given size whose script errors and console errors are collected in `errors`.
 export async function openPage(browser, errors) {
   const context = await browser.newContext({ viewport: { width: 1360, height: 1020 } });

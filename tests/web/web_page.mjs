@@ -6,7 +6,8 @@
 //
 // Prints the figures (frames per second the page received, stick-to-drawing latency) and exits
 // 0 when every check holds. docs/web.md#tests.
-import { check, failed, launchChromium, openPage, printedUrl, run, sleep } from './lib.mjs';
+import { check, checkPolytopeShown, failed, launchChromium, openPage, polytopeShown, printedUrl, run,
+  sleep } from './lib.mjs';
 
 const [craneassist, nodeModules, screenshot] = process.argv.slice(2);
 if (!craneassist || !nodeModules) {
@@ -36,6 +37,9 @@ try {
   await sleep(1200);
   const rate = await page.evaluate(() => window.craneassist.rate_hz);
   check(rate >= 20 && rate <= 40, `frames received: ${rate} per second (30 streamed)`);
+  // Before any stick motion: the polytope's volume at the start pose, no stick direction yet.
+  const idle = await polytopeShown(page);
+  checkPolytopeShown(idle, 'at rest');
 
   // 2. Hold the deadman, then push the left stick forward: the tip goes out (radial, +x at slew
   //    0), and the drawing follows the simulator.
@@ -51,6 +55,14 @@ try {
     `... and not sideways or up (${dz.toFixed(3)} m, ${dy.toFixed(3)} m)`);
   const moved = Math.hypot(...out.points[4].map((v, i) => v - before.points[4][i]));
   check(moved > 0.3, `the drawn boom end moved ${moved.toFixed(2)} m`);
+  // The available speed along the stick and the polytope's volume, shown and updated as the
+  // crane moves.
+  const going = await polytopeShown(page);
+  checkPolytopeShown(going, 'stick forward');
+  check(going.frame.avail > 0 && going.frame.avail >= Math.hypot(...going.frame.ref) - 1e-9,
+    `available along the stick ${going.frame.avail.toFixed(2)} m/s, the reference ${Math.hypot(...going.frame.ref).toFixed(2)} m/s within it`);
+  check(going.polytope !== idle.polytope && going.gauge !== idle.gauge,
+    `the polytope's figures follow the crane: '${idle.polytope}', '${idle.gauge}' at rest, then '${going.polytope}', '${going.gauge}'`);
   const latency = await page.evaluate(() => window.craneassist.latency_ms);
   check(latency.length > 0, `stick to drawing: ${latency.map((v) => v.toFixed(0)).join(', ')} ms`);
 

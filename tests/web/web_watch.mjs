@@ -9,7 +9,8 @@
 import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { check, failed, launchChromium, openPage, printedUrl, run, sleep } from './lib.mjs';
+import { check, checkPolytopeShown, failed, launchChromium, openPage, polytopeShown, printedUrl, run,
+  sleep } from './lib.mjs';
 
 const [craneassist, nodeModules, domain] = process.argv.slice(2);
 if (!craneassist || !nodeModules || !domain) {
@@ -51,6 +52,10 @@ try {
     `the drawn tip follows the replay out along +x: ${dx.toFixed(2)} m in 1.5 s`);
   const moved = Math.hypot(...later.points[4].map((v, i) => v - first.points[4][i]));
   check(moved > 0.2, `the drawn boom end moved ${moved.toFixed(2)} m`);
+  // The polytope's figures came over DDS (the status topic): shown as in sim --web.
+  const shown = await polytopeShown(page);
+  checkPolytopeShown(shown, 'watched run');
+  check(shown.frame.avail > 0, `available along the stick: ${shown.frame.avail.toFixed(2)} m/s`);
   const rate = await page.evaluate(() => window.craneassist.rate_hz);
   check(rate >= 20 && rate <= 40, `frames received: ${rate} per second (30 streamed)`);
 

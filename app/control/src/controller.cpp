@@ -151,7 +151,9 @@ void Controller::update_polytope(const JointVector& q, const Eigen::Vector3d& v_
   dynamics::joint_velocity_set(model_, q, polytope_arms_, polytope_settings_, polytope_set_);
   polytope_.update(polytope_set_, polytope_jacobian_);
   polytope_.build_hull();
+  out.polytope_dim = polytope_.dimension();
   out.polytope_volume_m3_s3 = polytope_.volume();
+  out.polytope_area_m2_s2 = polytope_.area();
   const double stick = v_cmd.norm();
   if (stick > 0.0) stick_direction_ = v_cmd / stick;
   out.avail_speed_m_s = polytope_.max_speed(stick_direction_);

@@ -64,6 +64,8 @@ void LogRowBuilder::fill(LogRow& row, double t, const Eigen::Vector3d& cmd,
   row.avail_speed_m_s = out.avail_speed_m_s;
   row.avail_speed_resolved_m_s = out.avail_speed_resolved_m_s;
   row.polytope_volume_m3s3 = out.polytope_volume_m3_s3;
+  row.polytope_dim = out.polytope_dim;
+  row.polytope_area_m2s2 = out.polytope_area_m2_s2;
 }
 
 }  // namespace craneassist::control

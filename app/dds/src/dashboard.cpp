@@ -164,6 +164,19 @@ double norm(const std::array<double, 3>& v) {
   return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
 }
 
+// The tip polytope's measure with its unit: a volume when it is a solid, an area when it is
+// flat (a planar arm, a singular pose).
+std::string polytope_measure(const msg::Status& m) {
+  switch (m.polytope_dim()) {
+    case 3:
+      return fmt("volume %.4g m^3/s^3", m.polytope_volume_m3_s3());
+    case 2:
+      return fmt("area %.4g m^2/s^2 (flat)", m.polytope_area_m2_s2());
+    default:
+      return fmt("dimension %u: no motion across it", static_cast<unsigned>(m.polytope_dim()));
+  }
+}
+
 // A joint position for people: deg for angular joints, m for prismatic ones.
 std::string joint_value(const msg::JointState& m, const std::vector<double>& values,
                         std::size_t i) {
@@ -240,6 +253,23 @@ std::vector<std::string> render(const Snapshot& s, const DashboardOptions& o, st
     lines.push_back(fmt("%-10s-", "power"));
     lines.push_back(fmt("%-10s-", "flow"));
     lines.push_back(fmt("%-10s-", "pump"));
+  }
+
+  // The stick's speed against what the cylinders and the pump allow along its direction, and
+  // the flow manipulability polytope (status; the stick's speed from command_path).
+  if (st) {
+    const double avail = s.status.avail_speed_m_s();
+    const double stick = cp ? norm(s.command_path.command_m_s()) : NAN;  // NaN: no valid input
+    const bool known = std::isfinite(stick);
+    lines.push_back(fmt("%-10s%s %5s / %5.2f m/s available  %s", "stick",
+                        bar(known ? stick : 0.0, avail, kBar).c_str(),
+                        known ? fmt("%.2f", stick).c_str() : "-", avail,
+                        known ? percent(stick, avail).c_str() : ""));
+    lines.push_back(fmt("%-10s%-27s along the chosen joint motion %.2f m/s", "polytope",
+                        polytope_measure(s.status).c_str(), s.status.avail_speed_resolved_m_s()));
+  } else {
+    lines.push_back(fmt("%-10s-", "stick"));
+    lines.push_back(fmt("%-10s-", "polytope"));
   }
 
   // Operator command and scaled reference (command_path topic).

@@ -69,6 +69,11 @@ void describe(const msg::Status& m, FieldVisitor& v) {
   v.number("loop_latency_max_s", m.loop_latency_max_s(), "s");
   v.number("loop_compute_s", m.loop_compute_s(), "s");
   v.number("loop_overruns", static_cast<double>(m.loop_overruns()), "");
+  v.number("avail_speed_m_s", m.avail_speed_m_s(), "m/s");
+  v.number("avail_speed_resolved_m_s", m.avail_speed_resolved_m_s(), "m/s");
+  v.integer("polytope_dim", m.polytope_dim(), "");
+  v.number("polytope_volume_m3_s3", m.polytope_volume_m3_s3(), "m^3/s^3");
+  v.number("polytope_area_m2_s2", m.polytope_area_m2_s2(), "m^2/s^2");
 }
 
 void describe(const msg::JointState& m, FieldVisitor& v) {

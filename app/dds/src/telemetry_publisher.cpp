@@ -3,6 +3,7 @@
 #include <semaphore.h>
 #include <time.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cmath>
@@ -183,6 +184,11 @@ struct TelemetryPublisher::Impl {
     status.loop_latency_max_s(f.loop_latency_max_s);
     status.loop_compute_s(f.loop_compute_s);
     status.loop_overruns(f.loop_overruns);
+    status.avail_speed_m_s(f.avail_speed_m_s);
+    status.avail_speed_resolved_m_s(f.avail_speed_resolved_m_s);
+    status.polytope_dim(static_cast<std::uint16_t>(std::clamp(f.polytope_dim, 0, 3)));
+    status.polytope_volume_m3_s3(f.polytope_volume_m3_s3);
+    status.polytope_area_m2_s2(f.polytope_area_m2_s2);
     return writers[0]->write(&status);
   }
 

@@ -97,6 +97,11 @@ struct TelemetryWatch::Impl {
     frame.loop_latency_max_s = s.loop_latency_max_s();
     frame.loop_compute_s = s.loop_compute_s();
     frame.loop_overruns = s.loop_overruns();
+    frame.avail_speed_m_s = s.avail_speed_m_s();
+    frame.avail_speed_resolved_m_s = s.avail_speed_resolved_m_s();
+    frame.polytope_dim = s.polytope_dim();
+    frame.polytope_volume_m3_s3 = s.polytope_volume_m3_s3();
+    frame.polytope_area_m2_s2 = s.polytope_area_m2_s2();
     updated();
   }
 

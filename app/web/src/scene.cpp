@@ -170,6 +170,15 @@ void SceneBuilder::frame_json(const control::LogRow& row, std::uint64_t seq, std
       .number("power", row.pump_power_w)
       .number("energy", row.energy_j)
       .close();
+  // The flow manipulability polytope: the fastest tip speed along the stick's direction (the
+  // last one while the stick is released) and along the chosen joint motion, m/s; its dimension
+  // and its measure in that dimension (volume m^3/s^3, or a flat one's area m^2/s^2).
+  f.number("avail", row.avail_speed_m_s).number("avail_resolved", row.avail_speed_resolved_m_s);
+  Object(f.nested("polytope"))
+      .integer("dim", row.polytope_dim)
+      .number("volume", row.polytope_volume_m3s3)
+      .number("area", row.polytope_area_m2s2)
+      .close();
 
   // The drawing: joint frame origins, and each cylinder's ends.
   dynamics::JointVector q(n);

@@ -19,6 +19,8 @@ const probe = {
   rate_hz: 0,         // frames per second received, over the last second
   latency_ms: [],     // stick move -> first drawn frame whose command moved
   sent: 0,            // stick states sent
+  shown: null,        // the frame the gauges show
+  avail_arrow: null,  // the available-speed arrow: { length, dir } (null: hidden)
 };
 window.craneassist = probe;
 
@@ -70,7 +72,18 @@ const trailLine = new THREE.Line(trailGeometry, new THREE.LineBasicMaterial({ co
 scene.add(trailLine);
 const cmdArrow = new THREE.ArrowHelper(new THREE.Vector3(1, 0, 0), new THREE.Vector3(), 0.01, 0x4caf7a);
 const refArrow = new THREE.ArrowHelper(new THREE.Vector3(1, 0, 0), new THREE.Vector3(), 0.01, 0xe0a030);
-scene.add(cmdArrow, refArrow);
+// The speed the hydraulics allow along the stick (the flow polytope's reach), on the same scale
+// as the command: drawn first and without depth, so the command's arrow shows over it.
+const availArrow = new THREE.ArrowHelper(new THREE.Vector3(1, 0, 0), new THREE.Vector3(), 0.01, 0xb8c2cc);
+for (const part of [availArrow.line, availArrow.cone]) {
+  part.material.depthWrite = false;
+  part.renderOrder = -1;
+}
+scene.add(cmdArrow, refArrow, availArrow);
+const arrowLength = (speed) => 0.3 + 2 * speed;  // 0.5 m/s: 1.3 m
+// The last stick direction, along which the available speed is (before any: forward, as the
+// controller takes it).
+const stickDir = new THREE.Vector3(1, 0, 0);
 const tipMarker = new THREE.Mesh(new THREE.SphereGeometry(0.07, 16, 12), dark);
 scene.add(tipMarker);
 
@@ -128,8 +141,17 @@ function drawCrane(frame) {
     if (arrow.visible) {
       arrow.position.copy(tip);
       arrow.setDirection(d.divideScalar(speed));
-      arrow.setLength(0.3 + 2 * speed, 0.15, 0.08);  // 0.5 m/s: 1.3 m
+      arrow.setLength(arrowLength(speed), 0.15, 0.08);
     }
+  }
+  if (frame.cmd.every((x) => x !== null) && norm(frame.cmd) > 1e-3) stickDir.copy(vec(frame.cmd)).normalize();
+  availArrow.visible = frame.avail > 1e-3;
+  probe.avail_arrow = null;
+  if (availArrow.visible) {
+    availArrow.position.copy(tip);
+    availArrow.setDirection(stickDir);
+    availArrow.setLength(arrowLength(frame.avail), 0.15, 0.08);
+    probe.avail_arrow = { length: arrowLength(frame.avail), dir: stickDir.toArray() };
   }
 }
 
@@ -167,6 +189,14 @@ function cylinderGauges() {
 
 const norm = (v) => Math.hypot(v[0], v[1], v[2]);
 const fmt = (v, d = 2) => (v === null || v === undefined ? '-' : v.toFixed(d));
+// The flow polytope's measure in its dimension's unit: a solid's volume, a flat one's area (a
+// planar arm, a singular pose).
+function polytopeText(p) {
+  const sig = (v) => (v === null ? '-' : String(Number(v.toPrecision(4))));
+  if (p.dim === 3) return `volume ${sig(p.volume)} m³/s³`;
+  if (p.dim === 2) return `area ${sig(p.area)} m²/s² (flat)`;
+  return `dimension ${p.dim}: no motion across it`;
+}
 
 function showFrame(f) {
   $('t').textContent = fmt(f.t, 1);
@@ -191,6 +221,12 @@ function showFrame(f) {
   lim.className = 'pill' + (f.limit && f.limit !== 'none' ? ' warn' : '');
   $('scale').textContent = fmt(f.scale);
   $('sdot').textContent = `${fmt(f.sdot)} m/s`;
+  // The stick's speed against what the hydraulics allow along it (null: no valid input).
+  const stick = f.cmd.every((x) => x !== null) ? norm(f.cmd) : null;
+  gauge('avail', stick, f.avail, `${fmt(stick)} / ${fmt(f.avail)} m/s`);
+  $('avail-resolved').textContent = `${fmt(f.avail_resolved)} m/s`;
+  $('polytope').textContent = polytopeText(f.polytope);
+  probe.shown = f;
   plotSpeed.push(f.t, [norm(f.tip_v), norm(f.cmd), f.scale]);
 }
 

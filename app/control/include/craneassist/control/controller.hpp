@@ -83,11 +83,17 @@ struct ControllerOutput {
   //                             scaling's flow and cylinder-speed bound (full scaling: along the
   //                             path direction u; flow-only and none: along the command; 0 with
   //                             no command);
-  //   polytope_volume_m3_s3     the volume of the tip polytope (0 for a planar arm, whose
-  //                             polytope is flat).
+  //   polytope_dim              the dimension of the tip polytope: 3 (a solid), 2 (flat: a
+  //                             planar arm, or a singular pose of a spatial one), 1 or 0 (a
+  //                             segment or a point: no motion left across it);
+  //   polytope_volume_m3_s3     its volume (0 unless polytope_dim is 3);
+  //   polytope_area_m2_s2       its area in its plane when flat (polytope_dim 2; else 0): a
+  //                             planar arm's measure.
   double avail_speed_m_s = 0.0;
   double avail_speed_resolved_m_s = 0.0;
+  int polytope_dim = 0;
   double polytope_volume_m3_s3 = 0.0;
+  double polytope_area_m2_s2 = 0.0;
 };
 
 // The controller's status is the cycle status of the loop (control_loop.hpp).

@@ -37,6 +37,9 @@ struct LogRow {
   // Live-loop fields (the live loop and telemetry fill them; the CSV writer does not write them):
   // joint rates, cylinder positions and velocities, loop and input status. Static strings only.
   std::array<double, kMaxJoints> qdot{}, cylinder_pos{}, cylinder_vel{};
+  // The polytope's dimension and, when flat (a planar arm), its area (ControllerOutput).
+  int polytope_dim = 0;
+  double polytope_area_m2s2 = 0.0;
   const char* status = "";       // "running", "stopping", "stopped"
   const char* stop_reason = "";  // why the loop stops or holds ("" while running)
   const char* input_source = "";

@@ -35,6 +35,12 @@ struct TelemetryFrame {
   // Cycle timing: the worst start latency so far, the last compute time, overruns so far.
   double loop_latency_max_s = 0.0, loop_compute_s = 0.0;
   std::uint64_t loop_overruns = 0;
+  // The flow manipulability polytope at the reference pose (ControllerOutput): the fastest tip
+  // speed along the stick's direction (LP) and along the controller's joint motion, the
+  // polytope's dimension, its volume (dimension 3) and its area when flat (dimension 2).
+  double avail_speed_m_s = 0.0, avail_speed_resolved_m_s = 0.0;
+  int polytope_dim = 0;
+  double polytope_volume_m3_s3 = 0.0, polytope_area_m2_s2 = 0.0;
 };
 static_assert(std::is_trivially_copyable_v<TelemetryFrame>);
 
