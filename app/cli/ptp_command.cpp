@@ -10,8 +10,10 @@
 
 #include "crane_options.hpp"
 #include "craneassist/input/joint_trajectory.hpp"
+#include "craneassist/offline/ptp_simulation.hpp"
 #include "craneassist/planner/ptp_planner.hpp"
 #include "exit_codes.hpp"
+#include "goal_planning.hpp"
 #include "option_checks.hpp"
 
 namespace craneassist::cli {
@@ -41,6 +43,68 @@ std::string point_text(const Eigen::Vector2d& p) {
   char text[64];
   std::snprintf(text, sizeof text, "(%.3f, %.3f) m", p.x(), p.y());
   return text;
+}
+
+// --simulate: the plan (and the goal changes' plans) on the MHSB simulator.
+int simulate(planner::PtpPlanner& ptp, const Eigen::Vector2d& from, const Eigen::Vector2d& to,
+             const planner::PtpWeights& weights, const std::vector<offline::PtpGoalChange>& changes,
+             const std::string& log_file, const planner::PtpPlan& plan) {
+  std::ofstream log;
+  if (!log_file.empty()) {
+    log.open(log_file);
+    if (!log) {
+      spdlog::error("--sim-log: {}: cannot open for writing", log_file);
+      return kExitRuntime;
+    }
+  }
+  offline::PtpSimulation run;
+  try {
+    run = offline::simulate_ptp(ptp, from, to, weights, changes, 0.0,
+                                log_file.empty() ? nullptr : &log);
+  } catch (const std::exception& e) {
+    spdlog::error("--simulate: {}", e.what());
+    return kExitRuntime;
+  }
+  const auto& model = ptp.arm().model();
+  const auto& m = run.measured;
+  std::printf("  simulated (MHSB simulator, cascade controller, %.0f Hz): %.2f s\n",
+              1.0 / sim_backend::MhsbControllerSettings{}.period_s, run.duration_s);
+  for (std::size_t i = 1; i < run.segments.size(); ++i) {
+    const auto& s = run.segments[i];
+    std::printf(
+        "    goal changed at %.2f s to %s: replanned from %s in %.3f ms, %.2f s, %.0f J, %d "
+        "mode switches\n",
+        s.start_s, point_text(s.to).c_str(), point_text(s.from).c_str(),
+        1000.0 * s.plan.planning_time_s, s.plan.time_s, s.plan.energy_j, s.plan.switches);
+  }
+  std::printf(
+      "    energy measured %.0f J (main pump %.0f, servo-pumps %.0f) against %.0f J planned "
+      "(%+.1f %%)\n",
+      m.energy_j, m.main_energy_j, m.servo_pump_energy_j, run.planned_energy_j,
+      100.0 * (m.energy_j - run.planned_energy_j) / run.planned_energy_j);
+  std::string errors, supply;
+  for (int k = 0; k < ptp.arm().moving(); ++k) {
+    const int j = ptp.arm().joint(k);
+    char part[96];
+    std::snprintf(part, sizeof part, "%s%s %.2f", k ? ", " : "",
+                  model.joints[static_cast<std::size_t>(j)].name.c_str(),
+                  m.max_abs_error[j] * 180.0 / M_PI);
+    errors += part;
+    std::snprintf(part, sizeof part, "%s%s %.1f", k ? ", " : "",
+                  model.joints[static_cast<std::size_t>(j)].name.c_str(),
+                  m.max_p_supply_pa[j] * 1e-6);
+    supply += part;
+  }
+  std::printf("    largest joint error, deg: %s (at the end %.3f deg)\n", errors.c_str(),
+              run.final_error_rad * 180.0 / M_PI);
+  std::printf("    highest supply pressure, MPa: %s\n", supply.c_str());
+  if (m.invalid_references > 0 || m.dynamics_failures > 0) {
+    spdlog::warn("--simulate: {} invalid references, {} failed dynamics steps",
+                 m.invalid_references, m.dynamics_failures);
+  }
+  (void)plan;
+  if (!log_file.empty()) std::printf("    log: %s\n", log_file.c_str());
+  return kExitOk;
 }
 
 }  // namespace
@@ -75,6 +139,14 @@ CLI::App* add_ptp_command(CLI::App& cli, PtpArgs& args) {
   cmd->add_option("--threads", args.threads, "Threads for building the posture table (default 2)")
       ->check(CLI::Range(1, 64));
   cmd->add_option("-o,--out", args.out, "Write the joint trajectory with mode columns to this CSV");
+  cmd->add_flag("--simulate", args.simulate,
+                "Run the plan on the MHSB simulator under the paper's cascade controller and "
+                "compare the measured energy with the planned (docs/mhsb.md)");
+  cmd->add_option("--sim-log", args.simulate_log,
+                  "With --simulate: the simulator's per-period CSV (docs/mhsb-simulator.md)");
+  cmd->add_option("--goal-at", args.goal_at,
+                  "With --simulate: T:X,Z changes the goal at T s, replanned from where the arm "
+                  "is (repeatable; paper 001 section 4.2)");
   return cmd;
 }
 
@@ -85,6 +157,7 @@ int run_ptp_command(const PtpArgs& args) {
   planner::PostureTableSettings table_settings;
   planner::PtpWeights weights;
   Eigen::Vector2d from, to;
+  std::vector<offline::PtpGoalChange> goal_changes;
   try {
     cfg = load_crane(args.config_file);
     try {
@@ -124,6 +197,19 @@ int run_ptp_command(const PtpArgs& args) {
       settings.energy_model = *dynamics::parse_mhsb_energy_model(args.energy_model);
     }
     table_settings.threads = args.threads;
+    if (!args.goal_at.empty() && !args.simulate) {
+      throw CLI::ValidationError("--goal-at", "goal changes need --simulate");
+    }
+    if (!args.simulate_log.empty() && !args.simulate) {
+      throw CLI::ValidationError("--sim-log", "needs --simulate");
+    }
+    if (args.simulate && !cfg.model.mhsb) {
+      throw CLI::ValidationError(
+          "--simulate", cfg.model.name +
+                            " has no MHSB circuit; run its plan on the crane simulator with "
+                            "craneassist replay --trajectory FILE (or sim --input goal)");
+    }
+    for (const GoalAt& g : parse_goals("", args.goal_at)) goal_changes.push_back({g.t_s, g.xz});
   } catch (const CLI::Error&) {
     throw;
   } catch (...) {
@@ -140,7 +226,9 @@ int run_ptp_command(const PtpArgs& args) {
   const bool loaded = table.has_value();
   const auto check_points = [&](const planner::WorkspaceGrid& grid) {
     const double reach = 0.5 * std::sqrt(2.0) * grid.spacing_m + 1e-9;
-    for (const auto& [option, p] : {std::pair{"--from", from}, std::pair{"--to", to}}) {
+    std::vector<std::pair<std::string, Eigen::Vector2d>> points{{"--from", from}, {"--to", to}};
+    for (const auto& g : goal_changes) points.emplace_back("--goal-at", g.xz);
+    for (const auto& [option, p] : points) {
       if (grid.nearest_node(p, reach) < 0) {
         char why[160];
         std::snprintf(why, sizeof why,
@@ -226,6 +314,12 @@ int run_ptp_command(const PtpArgs& args) {
   }
   if (cfg.model.mhsb) std::printf("  S2 modes: %s\n", modes_line.c_str());
 
+  if (args.simulate) {
+    if (const int rc = simulate(ptp, from, to, weights, goal_changes, args.simulate_log, plan);
+        rc != kExitOk) {
+      return rc;
+    }
+  }
   if (!args.out.empty()) {
     const int n = cfg.model.dof();
     input::JointTrajectory traj(n);

@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace craneassist::cli {
 
@@ -21,6 +22,9 @@ struct PtpArgs {
   std::optional<double> heuristic_scale;
   int threads = 2;
   std::string out;  // joint trajectory CSV; empty: none
+  bool simulate = false;               // run the plan on the MHSB simulator
+  std::string simulate_log;            // its per-period CSV; empty: none
+  std::vector<std::string> goal_at;    // "T:X,Z" goal changes (with --simulate)
 };
 
 CLI::App* add_ptp_command(CLI::App& cli, PtpArgs& args);

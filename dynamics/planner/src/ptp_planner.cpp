@@ -16,6 +16,7 @@ namespace {
 using dynamics::MhsbMode;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kRestSpeed = 1e-6;  // m/s: a cylinder slower than this is at rest (S4)
 
 std::size_t at(int i) {
   return static_cast<std::size_t>(i);
@@ -429,7 +430,9 @@ PtpPlan PtpPlanner::plan(const Eigen::Vector2d& from, const Eigen::Vector2d& to,
       const double vc = st.arm[k] * sample.qdot[k];
       sample.mode[at(k)] = MhsbMode::kNormal;
       if (!model.mhsb) continue;
-      const double vv = vc != 0.0 ? vc : 1e-9 * sign(st.force_n[k]);
+      // At rest (the trajectory's ends: rates of rounding size) the need is whether the valve
+      // holds the load from P0, as in S2.
+      const double vv = std::abs(vc) > kRestSpeed ? vc : 1e-9 * sign(st.force_n[k]);
       if (!dynamics::needs_boost(model, arm_->joint(k), st.force_n[k], vv)) continue;
       const MhsbMode planned =
           table_->patterns()[at(steps[std::min(seg + 1, nn - 1)].pattern)].mode[at(k)];
