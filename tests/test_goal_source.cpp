@@ -67,39 +67,59 @@ TEST(GoalSource, RejectsBadPlans) {
   EXPECT_FALSE(input.publish(straight({0, 0, 0}, {1, 0, 0}, 1.0, 4), NAN));
 }
 
-// A tip that moves as commanded follows the plan and stops at the goal.
+// A tip that moves as commanded follows the plan and stops at the goal. Before it moves, the
+// source arms the input monitor: one cycle released, then arming_s held with no motion; the
+// plan's clock starts after that.
 TEST(GoalSource, FollowsThePlanAndStopsAtTheGoal) {
-  GoalSource input(GoalSourceSettings{.capacity = 256, .position_gain_1_s = 2.0});
+  GoalSource input(GoalSourceSettings{.capacity = 256, .position_gain_1_s = 2.0, .arming_s = 0.3});
   const Eigen::Vector3d a(3, 1, 0), b(5, 2, 0);
-  ASSERT_TRUE(input.publish(straight(a, b, 4.0, 101), 1.0));
+  ASSERT_TRUE(input.publish(straight(a, b, 4.0, 101), 0.0));
   Eigen::Vector3d tip = a + Eigen::Vector3d(0.05, 0, 0);  // starts off the plan
   const double dt = 0.01;
-  double worst_late = 0.0, t = 0.0;
+  double worst_late = 0.0, t = 0.0, first_following = -1.0;
+  int arming_held = 0;
   bool reached = false;
   for (int k = 0; k < 1000 && !reached; ++k) {
     t = k * dt;
     const Eigen::Vector3d v = command(input, t, tip);
     if (!v.allFinite()) {
       reached = std::string(input.state()) == "goal reached";
+      if (k == 0) {
+        EXPECT_STREQ(input.state(), "arming");  // released: the deadman's press comes next
+      }
+      continue;
+    }
+    if (std::string(input.state()) == "arming") {
+      EXPECT_EQ(v, Eigen::Vector3d::Zero());
+      ++arming_held;
       continue;
     }
     EXPECT_STREQ(input.state(), "following");
-    if (t > 2.5) worst_late = std::max(worst_late, (input.reference() - tip).norm());
+    if (first_following < 0.0) {
+      first_following = t;
+      EXPECT_LT((input.reference() - a).norm(), 1e-12);  // the plan starts now, at its start
+    }
+    if (t > first_following + 1.5) {
+      worst_late = std::max(worst_late, (input.reference() - tip).norm());
+    }
     tip += v * dt;
   }
+  EXPECT_NEAR(arming_held * dt, 0.3, 0.011);
   ASSERT_TRUE(reached);
   EXPECT_TRUE(input.reached());
-  EXPECT_GE(t, 5.0);  // not before the plan's end
+  EXPECT_GE(t, first_following + 4.0);  // not before the plan's end
   EXPECT_LT((tip - b).norm(), 0.02);
   EXPECT_LT(worst_late, 0.01);  // once the start offset is worked off, on the plan
 }
 
 // The feedback part is capped: a tip far off is pulled back at the cap, plus the plan's speed.
 TEST(GoalSource, FeedbackSpeedIsCapped) {
-  GoalSource input(GoalSourceSettings{.capacity = 16, .feedback_speed_cap_m_s = 0.3});
+  GoalSource input(
+      GoalSourceSettings{.capacity = 16, .feedback_speed_cap_m_s = 0.3, .arming_s = 0.0});
   ASSERT_TRUE(input.publish(straight({0, 0, 0}, {1, 0, 0}, 1.0, 3), 0.0));
-  const Eigen::Vector3d v =
-      command(input, 5.0, Eigen::Vector3d(1, 10, 0));  // after the end, 10 m off
+  EXPECT_FALSE(command(input, 4.99, Eigen::Vector3d(0, 10, 0)).allFinite());  // arming
+  // The plan starts now (no arming hold), at (0, 0, 0) at rest; the tip is 10 m above it.
+  const Eigen::Vector3d v = command(input, 5.0, Eigen::Vector3d(0, 10, 0));
   ASSERT_TRUE(v.allFinite());
   EXPECT_NEAR(v.norm(), 0.3, 1e-12);
   EXPECT_NEAR(v.y(), -0.3, 1e-12);

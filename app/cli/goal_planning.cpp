@@ -72,7 +72,8 @@ std::vector<GoalAt> parse_goals(const std::string& goal, const std::vector<std::
 std::vector<input::TipSample> tip_trajectory(const planner::PlanarArm& arm,
                                              const planner::PtpPlan& plan,
                                              const Eigen::Vector3d& tip_now_m,
-                                             const Eigen::Vector2d& goal_xz) {
+                                             const Eigen::Vector2d& goal_xz,
+                                             const TipLimits& limits) {
   std::vector<input::TipSample> out;
   if (plan.samples.empty()) return out;
   dynamics::KinematicsData data;
@@ -94,16 +95,36 @@ std::vector<input::TipSample> tip_trajectory(const planner::PlanarArm& arm,
     if (duration > 0.0) s.v_m_s += (end_offset - start_offset) * smoothstep_rate(u) / duration;
     s.t_s -= t0;
   }
+  double peak = 0.0, peak_acceleration = 0.0;
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    peak = std::max(peak, out[k].v_m_s.norm());
+    if (k > 0 && out[k].t_s > out[k - 1].t_s) {
+      peak_acceleration = std::max(peak_acceleration, (out[k].v_m_s - out[k - 1].v_m_s).norm() /
+                                                          (out[k].t_s - out[k - 1].t_s));
+    }
+  }
+  double stretch = 1.0;
+  if (limits.speed_m_s > 0.0) stretch = std::max(stretch, peak / limits.speed_m_s);
+  if (limits.acceleration_m_s2 > 0.0) {
+    stretch = std::max(stretch, std::sqrt(peak_acceleration / (0.5 * limits.acceleration_m_s2)));
+  }
+  if (stretch > 1.0) {
+    for (auto& s : out) {
+      s.t_s *= stretch;
+      s.v_m_s /= stretch;
+    }
+  }
   return out;
 }
 
 GoalPlanner::GoalPlanner(planner::PtpPlanner& planner, input::GoalSource& source,
                          std::vector<GoalAt> goals, const planner::PtpWeights& weights,
-                         bool read_stdin)
+                         const TipLimits& limits, bool read_stdin)
     : planner_(planner),
       source_(source),
       goals_(std::move(goals)),
       weights_(weights),
+      limits_(limits),
       read_stdin_(read_stdin) {}
 
 GoalPlanner::~GoalPlanner() {
@@ -131,22 +152,24 @@ void GoalPlanner::plan_to(const Eigen::Vector2d& goal, const Eigen::Vector3d& ti
   const Eigen::Vector2d from = arm.to_plane(tip);
   char head[160];
   std::snprintf(head, sizeof head, "goal (%.2f, %.2f) m %s at %.2f s", goal.x(), goal.y(), origin,
-                now_s);
+                now_s - start_s_.value_or(now_s));
   std::string line = head;
   try {
     const planner::PtpPlan plan = planner_.plan(from, goal, weights_);
     if (!plan.path.found || plan.samples.empty()) {
       line += ": no path (the arm cannot get there from here)";
     } else {
-      const auto samples = tip_trajectory(arm, plan, tip, goal);
+      const auto samples = tip_trajectory(arm, plan, tip, goal, limits_);
       if (!source_.publish(samples, now_s)) {
         line += ": the plan is too long for the goal input (" + std::to_string(samples.size()) +
                 " samples)";
       } else {
         char text[200];
         std::snprintf(text, sizeof text,
-                      ": planned in %.2f ms, %.1f s, %.2f m, %.1f kJ (the plan's estimate)",
-                      plan.planning_time_s * 1e3, plan.time_s, plan.length_m, plan.energy_j * 1e-3);
+                      ": planned in %.2f ms: %.2f m, %.1f kJ at the planner's speeds (%.1f s), "
+                      "followed in %.1f s",
+                      plan.planning_time_s * 1e3, plan.length_m, plan.energy_j * 1e-3, plan.time_s,
+                      samples.back().t_s);
         line += text;
       }
     }
@@ -160,13 +183,12 @@ void GoalPlanner::plan_to(const Eigen::Vector2d& goal, const Eigen::Vector3d& ti
 
 void GoalPlanner::run() {
   std::size_t next = 0;
-  std::optional<double> start_s;
   while (!stop_) {
     Eigen::Vector3d tip;
     double now = 0.0;
     if (source_.last_tip(tip, now)) {
-      if (!start_s) start_s = now;
-      while (next < goals_.size() && now - *start_s >= goals_[next].t_s) {
+      if (!start_s_) start_s_ = now;
+      while (next < goals_.size() && now - *start_s_ >= goals_[next].t_s) {
         plan_to(goals_[next].xz, tip, now,
                 next == 0 && goals_[next].t_s == 0.0 ? "from the start" : "on schedule");
         ++next;

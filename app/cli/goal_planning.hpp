@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <atomic>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -31,18 +32,29 @@ std::vector<GoalAt> parse_goals(const std::string& goal, const std::vector<std::
 
 // The plan as a tip trajectory in the crane frame, blended so that it starts at the measured tip
 // and ends at the goal itself (the planner's path runs from node to node of its grid): the
-// offsets at both ends are faded across the move with a smoothstep, their velocity added.
+// offsets at both ends are faded across the move with a smoothstep, their velocity added. The
+// planner times a move by its cylinders' speed limits (quasi-statically, paper 001's assumption
+// 2); where that asks for more tip speed than max_tip_speed_m_s or more tip acceleration than
+// half of max_tip_acceleration_m_s2 (the controller's path acceleration bound: the other half is
+// left for its corrections), the whole move is slowed uniformly (time stretched by k: speeds
+// divided by k, accelerations by k^2), since the controller's scaling would cut it anyway and the
+// tip would lag and overshoot.
+struct TipLimits {
+  double speed_m_s = 0.5;
+  double acceleration_m_s2 = 1.0;
+};
 std::vector<input::TipSample> tip_trajectory(const planner::PlanarArm& arm,
                                              const planner::PtpPlan& plan,
                                              const Eigen::Vector3d& tip_now_m,
-                                             const Eigen::Vector2d& goal_xz);
+                                             const Eigen::Vector2d& goal_xz,
+                                             const TipLimits& limits);
 
 class GoalPlanner {
  public:
   // planner and source must outlive this object. read_stdin: also take goals typed as "X,Z"
   // lines on standard input.
   GoalPlanner(planner::PtpPlanner& planner, input::GoalSource& source, std::vector<GoalAt> goals,
-              const planner::PtpWeights& weights, bool read_stdin);
+              const planner::PtpWeights& weights, const TipLimits& limits, bool read_stdin);
   ~GoalPlanner();
   GoalPlanner(const GoalPlanner&) = delete;
   GoalPlanner& operator=(const GoalPlanner&) = delete;
@@ -61,12 +73,14 @@ class GoalPlanner {
   input::GoalSource& source_;
   std::vector<GoalAt> goals_;
   planner::PtpWeights weights_;
+  TipLimits limits_;
   bool read_stdin_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
   mutable std::mutex mutex_;
   std::vector<std::string> report_;
   std::string stdin_buffer_;
+  std::optional<double> start_s_;  // the loop clock at the first measured tip
 };
 
 }  // namespace craneassist::cli

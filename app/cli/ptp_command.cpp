@@ -19,26 +19,6 @@
 namespace craneassist::cli {
 namespace {
 
-// "a,b,..." as exactly `count` finite numbers, or a CLI::ValidationError naming the option.
-std::vector<double> parse_numbers(const std::string& option, const std::string& text,
-                                  std::size_t count, const char* what) {
-  std::vector<double> values;
-  std::stringstream in(text);
-  std::string part;
-  bool ok = true;
-  while (std::getline(in, part, ',')) {
-    char* end = nullptr;
-    const double v = std::strtod(part.c_str(), &end);
-    while (end != nullptr && *end == ' ') ++end;
-    ok = ok && !part.empty() && end != part.c_str() && *end == '\0' && std::isfinite(v);
-    values.push_back(v);
-  }
-  if (!ok || values.size() != count || (!text.empty() && text.back() == ',')) {
-    throw CLI::ValidationError(option, "'" + text + "': expected " + what);
-  }
-  return values;
-}
-
 std::string point_text(const Eigen::Vector2d& p) {
   char text[64];
   std::snprintf(text, sizeof text, "(%.3f, %.3f) m", p.x(), p.y());
@@ -108,6 +88,67 @@ int simulate(planner::PtpPlanner& ptp, const Eigen::Vector2d& from, const Eigen:
 }
 
 }  // namespace
+
+// "a,b,..." as exactly `count` finite numbers, or a CLI::ValidationError naming the option.
+std::vector<double> parse_numbers(const std::string& option, const std::string& text,
+                                  std::size_t count, const char* what) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string part;
+  bool ok = true;
+  while (std::getline(in, part, ',')) {
+    char* end = nullptr;
+    const double v = std::strtod(part.c_str(), &end);
+    while (end != nullptr && *end == ' ') ++end;
+    ok = ok && !part.empty() && end != part.c_str() && *end == '\0' && std::isfinite(v);
+    values.push_back(v);
+  }
+  if (!ok || values.size() != count || (!text.empty() && text.back() == ',')) {
+    throw CLI::ValidationError(option, "'" + text + "': expected " + what);
+  }
+  return values;
+}
+
+LoadedTable posture_table_for(const config::CraneConfig& cfg, const planner::PlanarArm& arm,
+                              const planner::PostureTableSettings& settings,
+                              const std::string& table_option,
+                              const std::vector<std::pair<std::string, Eigen::Vector2d>>& points) {
+  LoadedTable out;
+  out.file = table_option.empty() ? planner::default_table_file(arm, settings)
+                                  : std::optional<std::filesystem::path>(table_option);
+  std::optional<planner::PostureTable> table;
+  if (out.file) table = planner::PostureTable::load(*out.file, arm, settings);
+  out.loaded = table.has_value();
+  const auto check_points = [&](const planner::WorkspaceGrid& grid) {
+    const double reach = 0.5 * std::sqrt(2.0) * grid.spacing_m + 1e-9;
+    for (const auto& [option, p] : points) {
+      if (grid.nearest_node(p, reach) < 0) {
+        char why[160];
+        std::snprintf(why, sizeof why,
+                      "%s is outside the workspace of %s (no reachable grid node within %.1f cm)",
+                      point_text(p).c_str(), cfg.model.name.c_str(), 100.0 * reach);
+        throw CLI::ValidationError(option, why);
+      }
+    }
+  };
+  if (out.loaded) {
+    check_points(table->grid());
+  } else {
+    check_points(planner::sample_workspace(arm, settings).grid);
+    std::fprintf(stderr, "craneassist: building the posture table (%d threads)...\n",
+                 settings.threads);
+    table = planner::PostureTable::build(arm, settings);
+    if (out.file) {
+      try {
+        table->save(*out.file);
+      } catch (const std::exception& e) {
+        spdlog::warn("{} (the table is not cached)", e.what());
+      }
+    }
+  }
+  out.table = std::move(*table);
+  return out;
+}
 
 CLI::App* add_ptp_command(CLI::App& cli, PtpArgs& args) {
   auto* cmd = cli.add_subcommand(
@@ -216,43 +257,12 @@ int run_ptp_command(const PtpArgs& args) {
     return input_error_exit("config");
   }
 
-  // The table: from its file when it matches, else built (the points checked first against the
-  // sampled workspace, which is quick) and written.
-  const std::optional<std::filesystem::path> file =
-      args.table.empty() ? planner::default_table_file(*arm, table_settings)
-                         : std::optional<std::filesystem::path>(args.table);
-  std::optional<planner::PostureTable> table;
-  if (file) table = planner::PostureTable::load(*file, *arm, table_settings);
-  const bool loaded = table.has_value();
-  const auto check_points = [&](const planner::WorkspaceGrid& grid) {
-    const double reach = 0.5 * std::sqrt(2.0) * grid.spacing_m + 1e-9;
-    std::vector<std::pair<std::string, Eigen::Vector2d>> points{{"--from", from}, {"--to", to}};
-    for (const auto& g : goal_changes) points.emplace_back("--goal-at", g.xz);
-    for (const auto& [option, p] : points) {
-      if (grid.nearest_node(p, reach) < 0) {
-        char why[160];
-        std::snprintf(why, sizeof why,
-                      "%s is outside the workspace of %s (no reachable grid node within %.1f cm)",
-                      point_text(p).c_str(), cfg.model.name.c_str(), 100.0 * reach);
-        throw CLI::ValidationError(option, why);
-      }
-    }
-  };
-  if (loaded) {
-    check_points(table->grid());
-  } else {
-    check_points(planner::sample_workspace(*arm, table_settings).grid);
-    std::fprintf(stderr, "craneassist ptp: building the posture table (%d threads)...\n",
-                 table_settings.threads);
-    table = planner::PostureTable::build(*arm, table_settings);
-    if (file) {
-      try {
-        table->save(*file);
-      } catch (const std::exception& e) {
-        spdlog::warn("{} (the table is not cached)", e.what());
-      }
-    }
-  }
+  std::vector<std::pair<std::string, Eigen::Vector2d>> points{{"--from", from}, {"--to", to}};
+  for (const auto& g : goal_changes) points.emplace_back("--goal-at", g.xz);
+  LoadedTable loaded_table = posture_table_for(cfg, *arm, table_settings, args.table, points);
+  const std::optional<std::filesystem::path>& file = loaded_table.file;
+  const bool loaded = loaded_table.loaded;
+  std::optional<planner::PostureTable> table = std::move(loaded_table.table);
   planner::PtpPlanner ptp(*arm, *table, settings);
   planner::PtpPlan plan;
   try {

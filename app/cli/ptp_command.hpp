@@ -5,9 +5,15 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <Eigen/Core>
+#include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "craneassist/config/crane_config.hpp"
+#include "craneassist/planner/posture_table.hpp"
 
 namespace craneassist::cli {
 
@@ -21,13 +27,31 @@ struct PtpArgs {
   std::string table;           // posture table file; empty: the default cache
   std::optional<double> heuristic_scale;
   int threads = 2;
-  std::string out;  // joint trajectory CSV; empty: none
-  bool simulate = false;               // run the plan on the MHSB simulator
-  std::string simulate_log;            // its per-period CSV; empty: none
-  std::vector<std::string> goal_at;    // "T:X,Z" goal changes (with --simulate)
+  std::string out;                   // joint trajectory CSV; empty: none
+  bool simulate = false;             // run the plan on the MHSB simulator
+  std::string simulate_log;          // its per-period CSV; empty: none
+  std::vector<std::string> goal_at;  // "T:X,Z" goal changes (with --simulate)
 };
 
 CLI::App* add_ptp_command(CLI::App& cli, PtpArgs& args);
+
+// "a,b,..." as exactly `count` finite numbers, or a CLI::ValidationError naming the option.
+std::vector<double> parse_numbers(const std::string& option, const std::string& text,
+                                  std::size_t count, const char* what);
+
+// The posture table for arm (ptp and sim --input goal): from table_option's file (empty: the
+// default cache) when it matches, else built (a line on stderr) and written there. The points are
+// checked against the workspace first; one outside it is a CLI::ValidationError naming its
+// option.
+struct LoadedTable {
+  planner::PostureTable table;
+  bool loaded = false;  // from the file
+  std::optional<std::filesystem::path> file;
+};
+LoadedTable posture_table_for(const config::CraneConfig& cfg, const planner::PlanarArm& arm,
+                              const planner::PostureTableSettings& settings,
+                              const std::string& table_option,
+                              const std::vector<std::pair<std::string, Eigen::Vector2d>>& points);
 int run_ptp_command(const PtpArgs& args);
 
 }  // namespace craneassist::cli

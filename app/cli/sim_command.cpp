@@ -19,12 +19,15 @@
 #include "craneassist/config/joystick_config.hpp"
 #include "craneassist/control/live_loop.hpp"
 #include "craneassist/input/evdev_source.hpp"
+#include "craneassist/input/goal_source.hpp"
 #include "craneassist/input/keyboard_source.hpp"
 #include "craneassist/input/replay_source.hpp"
 #include "craneassist/input/sdl_source.hpp"
 #include "craneassist/offline/sim_setup.hpp"
 #include "exit_codes.hpp"
+#include "goal_planning.hpp"
 #include "option_checks.hpp"
+#include "ptp_command.hpp"
 #include "remote_input.hpp"
 
 namespace craneassist::cli {
@@ -166,7 +169,7 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
   sim->add_option("--input", args.input,
                   "keyboard (default on a terminal), evdev, sdl, dds (a remote operator, "
                   "docs/remote-commands.md), web (the virtual joystick of --web; its default), "
-                  "or replay FILE")
+                  "goal (move the tip to --goal energy-optimally; docs/mhsb.md) or replay FILE")
       ->expected(1, 2);
   sim->add_option("--joystick", args.joystick_file,
                   "Joystick mapping YAML (docs/joystick.md; default: the embedded "
@@ -190,6 +193,23 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
       ->check(CLI::Range(0, 99));
   sim->add_option("--cpu", args.cpu, "Pin the loop thread to this core")
       ->check(CLI::Range(0, 1023));
+  sim->add_option("--goal", args.goal,
+                  "--input goal: the tip's goal X,Z in m in the arm's vertical plane (X out from "
+                  "the slew axis, Z up), planned at the start");
+  sim->add_option("--goal-at", args.goal_at,
+                  "--input goal: T:X,Z, a new goal T s after the start (repeatable); goals typed "
+                  "as X,Z lines on standard input replan too");
+  sim->add_option("--goal-weights", args.goal_weights,
+                  "--input goal: the planner's weights w1,w2,w3 of energy, time and mode switches "
+                  "(default 1,0,0: energy-optimal)");
+  sim->add_option("--goal-grid", args.goal_grid,
+                  "--input goal: the planner's grid spacing, e.g. \"0.25 m\" (default: reach / "
+                  "40)");
+  sim->add_option("--goal-speed", args.goal_speed_m_s,
+                  "--input goal: the fastest tip speed a planned move asks for, m/s (default 0.5)")
+      ->check(FiniteRange(0.01, 10.0));
+  sim->add_option("--goal-table", args.goal_table,
+                  "--input goal: the posture table file (default: the cache, as ptp)");
   add_payload_option(*sim, args.payload_kg);
   add_initial_option(*sim, args.initial);
   add_resolution_option(*sim, args.resolution, "for the run");
@@ -202,10 +222,20 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
 int run_sim_command(const SimArgs& args) {
   std::string kind = !args.input.empty() ? args.input[0] : args.web.on ? "web" : "keyboard";
   if (kind != "keyboard" && kind != "evdev" && kind != "sdl" && kind != "dds" && kind != "replay" &&
-      kind != "web") {
+      kind != "web" && kind != "goal") {
     spdlog::error(
-        "--input: unknown input '{}' (expected keyboard, evdev, sdl, dds, web or replay FILE)",
+        "--input: unknown input '{}' (expected keyboard, evdev, sdl, dds, web, goal or replay "
+        "FILE)",
         kind);
+    return kExitUsage;
+  }
+  const bool goal_options = !args.goal.empty() || !args.goal_at.empty();
+  if (kind == "goal" && !goal_options) {
+    spdlog::error("--input goal needs --goal X,Z or --goal-at T:X,Z");
+    return kExitUsage;
+  }
+  if (kind != "goal" && goal_options) {
+    spdlog::error("--goal, --goal-at: only with --input goal");
     return kExitUsage;
   }
   const bool web_on = args.web.on || kind == "web";
@@ -257,6 +287,46 @@ int run_sim_command(const SimArgs& args) {
     return kExitUsage;
   }
 
+  // --input goal: the planner, its posture table (cached) and the goals, before anything moves.
+  std::optional<planner::PlanarArm> goal_arm;
+  std::optional<LoadedTable> goal_table;
+  std::optional<planner::PtpPlanner> goal_planner;
+  std::vector<GoalAt> goals;
+  planner::PtpWeights goal_weights;
+  if (kind == "goal") {
+    goals = parse_goals(args.goal, args.goal_at);
+    const auto w = parse_numbers("--goal-weights", args.goal_weights, 3, "three numbers w1,w2,w3");
+    for (const double x : w) {
+      if (x < 0.0)
+        throw CLI::ValidationError("--goal-weights", "'" + args.goal_weights + "': negative");
+    }
+    goal_weights.energy = w[0];
+    goal_weights.time = w[1];
+    goal_weights.switches = w[2];
+    try {
+      goal_arm.emplace(cfg.model, cfg.simulation.q_initial);
+    } catch (const std::invalid_argument& e) {
+      throw CLI::ValidationError("--input goal", cfg.model.name + ": " + e.what());
+    }
+    planner::PostureTableSettings table_settings;
+    if (!args.goal_grid.empty()) {
+      table_settings.spacing_m =
+          cli_quantity("--goal-grid", args.goal_grid, config::Dimension::kLength);
+      if (!(table_settings.spacing_m >= 0.005 && table_settings.spacing_m <= 5.0)) {
+        throw CLI::ValidationError("--goal-grid", "must be between 5 mm and 5 m");
+      }
+    }
+    std::vector<std::pair<std::string, Eigen::Vector2d>> points;
+    for (const auto& g : goals)
+      points.emplace_back(g.t_s == 0.0 && !args.goal.empty() ? "--goal" : "--goal-at", g.xz);
+    goal_table.emplace(posture_table_for(cfg, *goal_arm, table_settings, args.goal_table, points));
+    goal_planner.emplace(*goal_arm, goal_table->table, planner::PtpSettings{});
+    spdlog::info(
+        "goal planner: {} nodes, {:.0f} mm grid, posture table {}",
+        goal_table->table.grid().nodes(), 1000.0 * goal_table->table.grid().spacing_m,
+        goal_table->loaded ? "loaded from " + goal_table->file->string() : std::string("built"));
+  }
+
   try {
     Machine machines;
     if (const int rc = machines.open(cfg, args.machine, machine_inputs); rc != kExitOk) return rc;
@@ -264,6 +334,7 @@ int run_sim_command(const SimArgs& args) {
     g_stop.store(false);
     std::unique_ptr<input::CommandSource> source;
     input::KeyboardSource* keyboard = nullptr;
+    input::GoalSource* goal_source = nullptr;
     RemoteInput remote;
     if (kind == "dds") {
       remote = open_remote_input(tcfg, jcfg.monitor.stale_timeout_s);
@@ -285,6 +356,11 @@ int run_sim_command(const SimArgs& args) {
       source = std::make_unique<input::SdlSource>(jcfg.mapping, input::SdlSource::Options{});
     } else if (kind == "replay") {
       source = std::make_unique<input::ReplaySource>(*replay);
+    } else if (kind == "goal") {
+      auto goal = std::make_unique<input::GoalSource>(
+          input::GoalSourceSettings{.arming_s = jcfg.monitor.deadman_hold_s});
+      goal_source = goal.get();
+      source = std::move(goal);
     }  // web: the page's joystick, once the server runs (below)
     std::set_terminate([] {
       input::KeyboardSource::restore_terminal();
@@ -335,6 +411,13 @@ int run_sim_command(const SimArgs& args) {
                  options.realtime ? ", real time" : ", as fast as possible");
     if (keyboard != nullptr) print_keys();
 
+    std::optional<GoalPlanner> goal_thread;
+    if (goal_source != nullptr) {
+      // Goals typed on standard input replan too (a terminal in line mode, or a pipe).
+      goal_thread.emplace(*goal_planner, *goal_source, goals, goal_weights,
+                          TipLimits{args.goal_speed_m_s, cfg.scaling.acceleration_max_m_s2}, true);
+      goal_thread->start();
+    }
     std::atomic<bool> done{false};
     StatusReporter reporter(board, keyboard, remote);
     std::thread ui([&] { reporter.run(done); });
@@ -344,8 +427,10 @@ int run_sim_command(const SimArgs& args) {
     } catch (...) {
       done.store(true);
       ui.join();
+      if (goal_thread) goal_thread->stop();
       throw;
     }
+    if (goal_thread) goal_thread->stop();
     // Every valve to its safe state at once (Machine::finish() below deactivates and reports).
     machine.safe_stop();
     done.store(true);
@@ -383,6 +468,10 @@ int run_sim_command(const SimArgs& args) {
       if (!r.refused.empty()) spdlog::warn("real time: {}", r.refused);
     }
     std::printf("  input device: %d disconnects, %d re-attaches\n", s.disconnects, s.reconnects);
+    if (goal_thread) {
+      for (const std::string& line : goal_thread->report()) std::printf("  %s\n", line.c_str());
+      std::printf("  goal input at the end: %s\n", goal_source->state());
+    }
     if (!remote_report.empty()) std::printf("%s\n", remote_report.c_str());
     if (const std::string r = web.report(); !r.empty()) std::printf("%s\n", r.c_str());
     if (log) std::printf("  log: %s (%zu rows)\n", log->path().c_str(), log->rows_written());

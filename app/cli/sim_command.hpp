@@ -34,6 +34,14 @@ struct SimArgs {
   BackendArgs machine;     // empty values: the config's backend: and can:
   TelemetryArgs telemetry;
   WebArgs web;
+  // --input goal (docs/mhsb.md#the-k70m-a-goal-for-sim): the first goal, later ones, the
+  // planner's weights, grid and posture table file.
+  std::string goal;
+  std::vector<std::string> goal_at;
+  std::string goal_weights = "1,0,0";
+  std::string goal_grid;
+  std::string goal_table;
+  double goal_speed_m_s = 0.5;
 };
 
 CLI::App* add_sim_command(CLI::App& cli, SimArgs& args);

@@ -101,10 +101,13 @@ SourceState GoalSource::poll(OperatorCommand& out) noexcept {
     front_ = &plans_[static_cast<std::size_t>(front_index_)];
     cursor_ = 0;
     reached_ = false;
+    // A plan taken while the tip is not being commanded starts once the monitor has armed.
+    waiting_ = !primed_;
     taken_.fetch_add(1, std::memory_order_acq_rel);
   }
   if (!has_plan()) {
     state_ = "no goal";
+    primed_ = false;
     return SourceState::kNoData;
   }
   out.stamp_s = now_s_;
@@ -115,16 +118,39 @@ SourceState GoalSource::poll(OperatorCommand& out) noexcept {
   sample(tau, reference_, v_ref);
   if (!tip_m_.allFinite()) {
     state_ = "no tip measurement";
+    primed_ = false;
     return SourceState::kOk;
   }
   const Eigen::Vector3d error = reference_ - tip_m_;
-  const bool ended = tau >= front_->samples[front_->count - 1].t_s;
+  const bool ended = !waiting_ && tau >= front_->samples[front_->count - 1].t_s;
   if (ended && (reached_ || error.norm() <= settings_.goal_tolerance_m)) {
     reached_ = true;
     state_ = "goal reached";
+    primed_ = false;
     return SourceState::kOk;
   }
-  Eigen::Vector3d feedback = settings_.position_gain_1_s * error;
+  // The input monitor arms on a press of the deadman: a cycle released before the first command,
+  // then the deadman held still for arming_s; the plan's clock starts after that, so the tip does
+  // not begin behind it.
+  if (!primed_) {
+    primed_ = true;
+    primed_at_s_ = now_s_;
+    waiting_ = true;
+    state_ = "arming";
+    return SourceState::kOk;
+  }
+  if (waiting_) {
+    out.deadman = true;
+    if (now_s_ - primed_at_s_ < settings_.arming_s) {
+      state_ = "arming";
+      return SourceState::kOk;
+    }
+    waiting_ = false;
+    front_->start_t_s = now_s_;
+    cursor_ = 0;
+    sample(0.0, reference_, v_ref);
+  }
+  Eigen::Vector3d feedback = settings_.position_gain_1_s * (reference_ - tip_m_);
   const double norm = feedback.norm();
   if (norm > settings_.feedback_speed_cap_m_s) {
     feedback *= settings_.feedback_speed_cap_m_s / norm;

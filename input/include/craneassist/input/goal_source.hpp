@@ -38,6 +38,9 @@ struct GoalSourceSettings {
   double position_gain_1_s = 2.0;       // k
   double feedback_speed_cap_m_s = 0.3;  // |k e| at most this
   double goal_tolerance_m = 0.02;       // within this of the goal at the plan's end: reached
+  // How long the input monitor needs the deadman held before a command passes
+  // (InputMonitorSettings::deadman_hold_s): a plan that starts from rest starts after it.
+  double arming_s = 0.3;
 };
 
 class GoalSource final : public CommandSource {
@@ -60,7 +63,9 @@ class GoalSource final : public CommandSource {
   // Control thread (or after the run): the plan in use and where on it the last cycle was.
   bool has_plan() const noexcept { return front_ != nullptr && front_->count > 0; }
   bool reached() const noexcept { return reached_; }
-  // "no goal", "following", "goal reached", "no tip measurement".
+  // "no goal", "arming" (before a move from rest: one cycle with the deadman released, as the input
+  // monitor arms on a press, then arming_s with it held and no motion), "following", "goal
+  // reached", "no tip measurement".
   const char* state() const noexcept { return state_; }
   const Eigen::Vector3d& reference() const noexcept { return reference_; }
 
@@ -76,6 +81,9 @@ class GoalSource final : public CommandSource {
   double now_s_ = 0.0;
   Eigen::Vector3d tip_m_ = Eigen::Vector3d::Zero();
   const char* state_ = "no goal";
+  bool primed_ = false;  // the deadman was reported released since the last stop
+  double primed_at_s_ = 0.0;
+  bool waiting_ = false;  // the plan's clock waits for the arming to end
   std::array<Plan, 3> plans_;
   // Triple buffer: the producer owns back_, the consumer front_; middle_ holds the third plan's
   // index with bit 2 set when it is newer than the consumer's.
