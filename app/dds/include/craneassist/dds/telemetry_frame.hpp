@@ -35,6 +35,15 @@ struct TelemetryFrame {
   // Cycle timing: the worst start latency so far, the last compute time, overruns so far.
   double loop_latency_max_s = 0.0, loop_compute_s = 0.0;
   std::uint64_t loop_overruns = 0;
+  // The wheeled base under the crane (sim --drive; topic craneassist/base): pose in the world
+  // (x, y, heading), motion and drive command (forward speed, yaw rate), hub-motor flows (fl, fr,
+  // rl, rr), their sum and the drive pump's Q_max. base_present false: a fixed base.
+  bool base_present = false;
+  bool base_shared_pump = false;
+  std::array<double, 3> base_pose{};
+  std::array<double, 2> base_velocity{}, base_command{};
+  std::array<double, 4> base_motor_flow_m3_s{};
+  double base_flow_sum_m3_s = 0.0, base_flow_max_m3_s = 0.0;
 };
 static_assert(std::is_trivially_copyable_v<TelemetryFrame>);
 
