@@ -250,3 +250,35 @@ TEST(InputMonitor, ZeroHoldAndLatchArmAtThePress) {
   ASSERT_TRUE(h.release_and_press().enabled);
   EXPECT_TRUE(h.release_and_press().enabled);
 }
+
+TEST(InputMonitor, DriveStickPassesWithTheCommandAndIsCheckedLikeIt) {
+  Harness h;
+  h.step(kMove, false);
+  OperatorCommand c;
+  c.v_m_s = kMove;
+  c.deadman = true;
+  c.drive = Eigen::Vector2d(0.5, -0.25);
+  h.now += 0.01;
+  c.stamp_s = h.now;
+  h.monitor.update(SourceState::kOk, c, h.now, h.out);
+  EXPECT_TRUE(h.out.enabled);
+  EXPECT_EQ(h.out.drive, c.drive);
+  // Released deadman: no drive either.
+  c.deadman = false;
+  h.now += 0.01;
+  c.stamp_s = h.now;
+  h.monitor.update(SourceState::kOk, c, h.now, h.out);
+  EXPECT_TRUE(h.out.drive.isZero());
+  // A drive outside the stick's travel, or not finite, is a fault like the tip command's.
+  for (const double bad : {1.5, std::nan("")}) {
+    h.release_and_press();
+    c.deadman = true;
+    c.drive = Eigen::Vector2d(bad, 0.0);
+    h.now += 0.01;
+    c.stamp_s = h.now;
+    h.monitor.update(SourceState::kOk, c, h.now, h.out);
+    EXPECT_FALSE(h.out.enabled) << bad;
+    EXPECT_EQ(h.out.fault, std::isnan(bad) ? InputFault::kNotFinite : InputFault::kOutOfRange);
+    EXPECT_TRUE(h.out.drive.isZero());
+  }
+}

@@ -136,6 +136,46 @@ TEST(JoystickConfig, ErrorsNameFileLineAndField) {
   EXPECT_NE(e.reason().find("angular velocity"), std::string::npos) << e.what();
 }
 
+TEST(JoystickConfig, DriveStick) {
+  // The shipped drive-mode mapping: the right stick drives, the left moves the tip.
+  const auto c = config::load_joystick_config(std::string(CRANEASSIST_SOURCE_DIR) +
+                                              "/config/joysticks/gamepad_drive.yaml");
+  const auto& speed = c.mapping.drive[static_cast<std::size_t>(input::DriveAxis::kSpeed)];
+  const auto& curv = c.mapping.drive[static_cast<std::size_t>(input::DriveAxis::kCurvature)];
+  EXPECT_TRUE(speed.enabled);
+  EXPECT_EQ(speed.axis, input::GamepadAxis::kRightY);
+  EXPECT_TRUE(speed.invert);
+  EXPECT_DOUBLE_EQ(speed.max, 1.0);
+  EXPECT_EQ(curv.axis, input::GamepadAxis::kRightX);
+  input::JoystickMapper mapper(c.mapping);
+  input::GamepadState pad;
+  pad.axes[static_cast<std::size_t>(input::GamepadAxis::kRightY)] = -1.0;  // forward
+  pad.axes[static_cast<std::size_t>(input::GamepadAxis::kRightX)] = 1.0;   // right
+  const Eigen::Vector2d d = mapper.drive(pad);
+  EXPECT_DOUBLE_EQ(d[0], 1.0);
+  EXPECT_DOUBLE_EQ(d[1], -1.0);
+  // The default mapping has no drive stick.
+  EXPECT_TRUE(input::JoystickMapper(config::default_joystick_config().mapping).drive(pad).isZero());
+
+  // A drive axis that a tip axis uses already, and one axis for both drive axes: errors.
+  std::string text = default_text();
+  const std::string drive =
+      "  drive:\n    speed:\n      axis: right_y\n      deadband: 0.1\n      expo: 0\n"
+      "    curvature:\n      axis: right_x\n      deadband: 0.1\n      expo: 0\n";
+  const auto pos = text.find("\nkeyboard:");
+  text.insert(pos + 1, drive);
+  const auto e = test::thrown_error<config::ConfigError>(
+      [&] { config::parse_joystick_config(text, "pad.yaml"); }, "no error");
+  EXPECT_EQ(e.field(), "joystick.drive.speed.axis");
+  EXPECT_NE(e.reason().find("joystick.axes.vertical"), std::string::npos) << e.what();
+  std::string both = text;
+  both.replace(both.find("axis: right_y\n      deadband: 0.1"), 13, "axis: left_trigger");
+  both.replace(both.find("axis: right_x\n      deadband: 0.1"), 13, "axis: left_trigger");
+  const auto e2 = test::thrown_error<config::ConfigError>(
+      [&] { config::parse_joystick_config(both, "pad.yaml"); }, "no error");
+  EXPECT_EQ(e2.field(), "joystick.drive.curvature.axis");
+}
+
 TEST(JoystickConfig, MissingFileAndYamlSyntax) {
   try {
     config::load_joystick_config("/nonexistent/pad.yaml");

@@ -101,3 +101,21 @@ TEST(KeyboardState, SpeedStepsDeadmanToggleLatchAndQuit) {
   EXPECT_TRUE(k.quit());
   EXPECT_TRUE(k.axes(5.0).isZero());
 }
+
+TEST(KeyboardState, DriveKeysHoldTheDriveAxesApartFromTheTip) {
+  EXPECT_EQ(decode("ikuo"), (std::vector<Key>{Key::kDriveForward, Key::kDriveBack, Key::kSteerLeft,
+                                              Key::kSteerRight}));
+  KeyboardState k({0.5, 0.15});
+  const double step = 2.0 / KeyboardState::kSteps;
+  k.on_key(Key::kDriveForward, 0.0);
+  k.on_key(Key::kSteerLeft, 0.0);
+  EXPECT_DOUBLE_EQ(k.drive(0.1)[0], step);
+  EXPECT_DOUBLE_EQ(k.drive(0.1)[1], step);  // left is positive curvature
+  EXPECT_TRUE(k.axes(0.1).isZero());        // the tip does not move
+  k.on_key(Key::kSteerRight, 0.2);
+  EXPECT_DOUBLE_EQ(k.drive(0.3)[1], -step);
+  EXPECT_DOUBLE_EQ(k.drive(0.6)[0], 0.0);  // released: no repeat came
+  k.on_key(Key::kDriveBack, 1.0);
+  k.on_key(Key::kStopAll, 1.1);
+  EXPECT_TRUE(k.drive(1.2).isZero());
+}

@@ -16,11 +16,13 @@
 #include <vector>
 
 #include "allocation_counter.hpp"
+#include "craneassist/config/base_config.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/control/live_loop.hpp"
 #include "craneassist/control/replay_runner.hpp"
 #include "craneassist/input/replay.hpp"
 #include "craneassist/offline/sim_setup.hpp"
+#include "craneassist/sim_backend/mobile_crane_backend.hpp"
 #include "csv_cells.hpp"
 
 using namespace craneassist;
@@ -33,6 +35,7 @@ struct Script {
   Eigen::Vector3d v = Eigen::Vector3d::Zero();
   bool deadman = true;
   bool fresh = true;  // false: the sample keeps its old stamp (a frozen device)
+  Eigen::Vector2d drive = Eigen::Vector2d::Zero();  // the drive stick (sim --drive)
 };
 
 class ScriptedSource : public input::CommandSource {
@@ -46,6 +49,7 @@ class ScriptedSource : public input::CommandSource {
       out.stamp_s = now_;
       out.v_m_s = s.v;
       out.deadman = s.deadman;
+      out.drive = s.drive;
     }
     return s.state;
   }
@@ -413,4 +417,72 @@ TEST(LiveLoop, CyclesAllocateNothing) {
   EXPECT_GT(std::abs(r.qdot[1]) + std::abs(r.qdot[2]) + std::abs(r.qdot[3]), 0.0);
   EXPECT_GT(r.cylinder_pos[1], 0.0);
   EXPECT_NE(r.cylinder_vel[1], 0.0);
+}
+
+// The drive mode (sim --drive): one stick drives the base, flow-bounded, while the tip moves; a
+// released deadman stops both. With one pump for the drive and the crane, the motors and the
+// crane together never draw more than Q_max.
+TEST(LiveLoop, DriveModeMovesTheBaseWithinTheFlowBoundAndStopsWithTheDeadman) {
+  const auto cfg = config::default_crane_config();
+  config::BaseConfig base = config::default_base_config();
+  for (const bool shared : {false, true}) {
+    SCOPED_TRACE(shared ? "shared pump" : "separate pumps");
+    sim_backend::MobileCraneBackend machine(cfg.model, offline::sim_settings(cfg), base.model,
+                                            dynamics::BasePose{}, shared);
+    // Full stick ahead and a quarter of the steering to the left while the tip moves out, for
+    // 8 s; then the deadman released.
+    ScriptedSource source([](double t) {
+      Script s;
+      s.v = kOut;
+      s.deadman = t >= 0.1 && t < 8.0;
+      s.drive = Eigen::Vector2d(1.0, 0.25);
+      return s;
+    });
+    Probe probe(1200);
+    control::LiveOptions o = scripted_options(11.0, &probe);
+    o.base = &base.model;
+    control::run_live(cfg, source, machine, o, nullptr);
+    ASSERT_FALSE(probe.rows.empty());
+    const double q_max = base.model.pump_max_flow_m3_s;
+    const double kappa = 0.25 * dynamics::max_curvature_1_m(base.model);
+    const double v_max = q_max / dynamics::flow_per_speed_m2(base.model, kappa);
+    double peak_v = 0.0;
+    for (const auto& r : probe.rows) {
+      ASSERT_TRUE(r.base_present);
+      EXPECT_EQ(r.base_shared_pump, shared);
+      ASSERT_LE(r.base_flow_sum_m3s, q_max * (1 + 1e-9)) << "t = " << r.t;
+      if (shared) ASSERT_LE(r.base_flow_sum_m3s + r.pump_flow_m3s, q_max * (1 + 1e-9)) << r.t;
+      ASSERT_LE(r.base_command[0], v_max * (1 + 1e-9));
+      if (r.base_command[0] > 0.0) {
+        EXPECT_NEAR(r.base_command[1] / r.base_command[0], kappa, 1e-9);  // the curvature
+      }
+      peak_v = std::max(peak_v, r.base_velocity[0]);
+    }
+    // The base reached the flow bound's speed (the lag's time constant is 0.3 s) and turned
+    // left; the deadman's release stopped the command at once and the base within its lag.
+    EXPECT_NEAR(peak_v, v_max, 0.01 * v_max);
+    const control::LogRow& at_release = probe.rows[static_cast<std::size_t>(8.0 / 0.01) + 1];
+    EXPECT_EQ(at_release.base_command[0], 0.0);
+    const control::LogRow& last = probe.rows.back();
+    EXPECT_LT(std::abs(last.base_velocity[0]), 0.01 * v_max);
+    EXPECT_GT(last.base_pose[0], 1.0);
+    EXPECT_GT(last.base_pose[1], 0.0);
+    EXPECT_GT(last.base_pose[2], 0.0);
+  }
+}
+
+TEST(LiveLoop, FixedBaseIgnoresTheDriveStick) {
+  const auto cfg = config::default_crane_config();
+  sim_backend::SimBackend machine(cfg.model, offline::sim_settings(cfg));
+  ScriptedSource source([](double t) {
+    Script s = moving(t);
+    s.drive = Eigen::Vector2d(1.0, 0.0);
+    return s;
+  });
+  Probe probe(200);
+  control::run_live(cfg, source, machine, scripted_options(1.0, &probe), nullptr);
+  for (const auto& r : probe.rows) {
+    EXPECT_FALSE(r.base_present);
+    EXPECT_EQ(r.base_command[0], 0.0);
+  }
 }

@@ -2,6 +2,8 @@
 // and the ODE crane under valve control.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
@@ -84,6 +86,34 @@ TEST(LsPump, FlowSaturationAtLowPressureIsFlowLimited) {
   EXPECT_EQ(r.limit, valves::PumpLimit::kMaxFlow);
   EXPECT_NEAR(r.flow_m3_s, 5e-3, 1e-9);
   EXPECT_GT(r.delivered_fraction[0], r.delivered_fraction[1]);
+}
+
+TEST(LsPump, FlowLimitCapsTheDeliveryAndIsRestored) {
+  // A pump shared with another consumer (a wheeled base's hub motors): what it may deliver is cut
+  // per step; sections starve by load as at the pump's own limit, and the cut is undone.
+  sim_backend::PumpModel pump(test_pump());
+  sim_backend::PumpResult r;
+  pump.set_flow_limit(1e-3);
+  EXPECT_DOUBLE_EQ(pump.flow_limit(), 1e-3);
+  pump.solve(vec({1e-3, 1e-3}), vec({1e6, 2e6}), r);
+  EXPECT_EQ(r.limit, valves::PumpLimit::kMaxFlow);
+  EXPECT_NEAR(r.flow_m3_s, 1e-3, 1e-9);
+  EXPECT_GT(r.delivered_fraction[0], r.delivered_fraction[1]);
+  // Over-running sections take flow at zero pressure, but not more than the pump gives.
+  pump.set_flow_limit(0.2e-3);
+  pump.solve(vec({1e-3, 1e-3}), vec({-8e6, -6e6}), r);
+  EXPECT_LE(r.flow_m3_s, 0.2e-3 * (1 + 1e-12));
+  EXPECT_GT(r.flow_m3_s, 0.0);
+  pump.set_flow_limit(0.0);
+  pump.solve(vec({1e-3, 1e-3}), vec({-8e6, 1e6}), r);
+  EXPECT_EQ(r.flow_m3_s, 0.0);
+  pump.set_flow_limit(std::nan(""));  // not finite: nothing
+  EXPECT_EQ(pump.flow_limit(), 0.0);
+  pump.set_flow_limit(1.0);  // above the pump's own: its own
+  EXPECT_DOUBLE_EQ(pump.flow_limit(), 5e-3);
+  pump.solve(vec({1e-3, 1e-3}), vec({1e6, 2e6}), r);
+  EXPECT_EQ(r.limit, valves::PumpLimit::kNone);
+  EXPECT_DOUBLE_EQ(r.flow_m3_s, 2e-3);
 }
 
 TEST(LsPump, OverrunningLoadDoesNotSetThePressure) {

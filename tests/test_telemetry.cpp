@@ -323,6 +323,50 @@ TEST(Telemetry, EveryTopicRoundTripsEveryField) {
   EXPECT_EQ(pub.stats().frames_dropped, 0u);
 }
 
+// The wheeled base (sim --drive): craneassist/base carries its pose, motion, drive command and
+// hub-motor flows, and only frames that have a base are published on it.
+TEST(Telemetry, TheBaseTopicCarriesTheBaseOnlyWhenThereIsOne) {
+  Subscriber sub(108);
+  Collector<craneassist::msg::BaseState> base;
+  sub.add(cdds::Topic::kBase, &base);
+  cdds::TelemetryPublisher pub(settings(108), info());
+  ASSERT_TRUE(discovered(sub, pub, 5.0));
+  for (std::uint64_t k = 0; k < 20; ++k) {  // no base
+    ASSERT_TRUE(pub.push(frame(k)));
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_TRUE(sub.hydraulics.wait_for(1, 3.0));
+  EXPECT_EQ(pub.stats().samples_written[4], 0u);
+  // With a base: the writer comes with the first such frame; pushed until the reader has one.
+  for (std::uint64_t k = 20; k < 1000 && base.samples().empty(); ++k) {
+    cdds::TelemetryFrame f = frame(k);
+    f.base_present = true;
+    f.base_shared_pump = true;
+    f.base_pose = {1.5, -2.0, 0.25};
+    f.base_velocity = {0.3, 0.05};
+    f.base_command = {0.32, 0.06};
+    f.base_motor_flow_m3_s = {2e-4, 2.5e-4, 2.1e-4, 2.6e-4};
+    f.base_flow_sum_m3_s = 9.2e-4;
+    f.base_flow_max_m3_s = 1.05e-3;
+    ASSERT_TRUE(pub.push(f));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_FALSE(base.samples().empty());
+  const auto b = base.samples().back();
+  EXPECT_GE(b.header().cycle(), 20u);
+  EXPECT_EQ(b.pose()[0], 1.5);
+  EXPECT_EQ(b.pose()[1], -2.0);
+  EXPECT_EQ(b.pose()[2], 0.25);
+  EXPECT_EQ(b.velocity()[1], 0.05);
+  EXPECT_EQ(b.command()[0], 0.32);
+  EXPECT_EQ(b.motor_flow_m3_s()[3], 2.6e-4);
+  EXPECT_EQ(b.motor_flow_sum_m3_s(), 9.2e-4);
+  EXPECT_EQ(b.drive_max_flow_m3_s(), 1.05e-3);
+  EXPECT_TRUE(b.shared_pump());
+  pub.close();
+  EXPECT_GT(pub.stats().samples_written[4], 0u);
+}
+
 // `craneassist web`'s side: the four topics of a publisher, assembled again into the frame the
 // loop pushed (the last one, which close() publishes on every topic), every field.
 TEST(Telemetry, TheWatchAssemblesThePublishedFrame) {

@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "../app/web/src/pad_message.hpp"
+#include "craneassist/config/base_config.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/config/joystick_config.hpp"
 #include "craneassist/web/web_server.hpp"
@@ -136,6 +137,58 @@ TEST(WebServer, StreamsTheCyclesWithTheCraneDrawnAsPoints) {
   EXPECT_EQ(frame["polytope"]["dim"], 3);
   EXPECT_EQ(frame["polytope"]["volume"], 51.51);
   EXPECT_EQ(frame["polytope"]["area"], 0.0);
+}
+
+// The crane on the wheeled base (sim --drive): the frame carries the base and places the crane's
+// frame on it; without a base there is no base member.
+TEST(WebServer, StreamsTheBaseAndTheCranesPlaceOnIt) {
+  const config::CraneConfig cfg = config::default_crane_config();
+  const config::BaseConfig base = config::default_base_config();
+  web::WebOptions o;
+  o.port = 0;
+  o.token = "secret";
+  o.base = &base.model;
+  web::WebServer server(o, cfg);
+  Page page(server.port(), "secret");
+  EXPECT_EQ(page.read("hello")["command"], "available");
+  control::LogRow row;
+  row.t = 2.0;
+  row.q = {0.2, 0.5, -1.5, 1.0};
+  row.status = "running";
+  row.base_present = true;
+  row.base_pose = {3.0, 1.0, 0.5};
+  row.base_velocity = {0.2, 0.05};
+  row.base_flow_sum_m3s = 5e-4;
+  row.base_flow_max_m3s = base.model.pump_max_flow_m3_s;
+  server.publish(row);
+  const json frame = page.read("frame");
+  ASSERT_TRUE(frame.contains("base"));
+  const json& b = frame["base"];
+  EXPECT_DOUBLE_EQ(b["pose"][0].get<double>(), 3.0);
+  EXPECT_DOUBLE_EQ(b["flow_sum"].get<double>(), 5e-4);
+  // The crane's root: the mount point carried by the pose, in the view's frame (y up).
+  const Eigen::Matrix3d& t = cfg.model.task_from_base;
+  const Eigen::Vector3d mount =
+      t * dynamics::world_from_crane_base(base.model, {3.0, 1.0, 0.5}, Eigen::Vector3d::Zero());
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(b["root_p"][i].get<double>(), mount[i], 1e-3);
+  // A point in the crane's frame through root_r, root_p lands where the world mapping puts it.
+  Eigen::Matrix3d r;
+  for (int i = 0; i < 9; ++i) r(i / 3, i % 3) = b["root_r"][i].get<double>();
+  const Eigen::Vector3d p_task(4.0, 1.0, -0.5);
+  const Eigen::Vector3d expected =
+      t * dynamics::world_from_crane_base(base.model, {3.0, 1.0, 0.5}, t.transpose() * p_task);
+  const Eigen::Vector3d drawn = r * p_task + mount;
+  EXPECT_NEAR((drawn - expected).norm(), 0.0, 1e-3);  // the JSON has 5 significant digits
+  ASSERT_EQ(b["boxes"].size(), 5u);                   // the chassis and four wheels
+  EXPECT_EQ(b["boxes"][0]["kind"], "chassis");
+  EXPECT_EQ(b["boxes"][1]["kind"], "wheel");
+
+  row.base_present = false;
+  row.t = 2.1;
+  server.publish(row);
+  json next = page.read("frame");
+  for (int i = 0; i < 20 && next["t"].get<double>() < 2.05; ++i) next = page.read("frame");
+  EXPECT_FALSE(next.contains("base"));
 }
 
 TEST(WebServer, ThePageIsAGamepadThatStopsWhenItLeaves) {

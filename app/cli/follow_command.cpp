@@ -43,6 +43,11 @@ CLI::App* add_follow_command(CLI::App& cli, FollowArgs& args) {
   cmd->add_flag("--no-error-scaling", args.no_error_scaling,
                 "Case 1 of the paper: the flow bound only, the platform not slowed by the tool "
                 "error");
+  cmd->add_option("--pump", args.pump,
+                  "shared: one pump of the drive's pump_max_flow feeds the hub motors and the "
+                  "crane, the crane getting what the motors leave; separate: the crane has its "
+                  "own (default: the base config's drive.shared_with_crane)")
+      ->check(CLI::IsMember({"shared", "separate"}));
   cmd->add_option("--log", args.log, "CSV log of every cycle (default follow.csv)");
   cmd->add_flag("--no-log", args.no_log, "Write no log");
   cmd->add_option("--height-amplitude", args.height_amplitude_m,
@@ -71,6 +76,7 @@ int run_follow_command(const FollowArgs& args) {
   } catch (...) {
     return input_error_exit("tool path");
   }
+  if (!args.pump.empty()) base.shared_with_crane = args.pump == "shared";
   offline::FollowOptions options;
   options.error_scaling = !args.no_error_scaling;
   if (args.height_amplitude_m) options.height_amplitude_m = *args.height_amplitude_m;
@@ -110,9 +116,11 @@ int run_follow_command(const FollowArgs& args) {
     return kExitUsage;
   }
   const offline::FollowSummary& s = result.summary;
-  std::printf("craneassist follow: %s, %s\n", file.source.c_str(),
+  std::printf("craneassist follow: %s, %s, %s\n", file.source.c_str(),
               options.error_scaling ? "flow bound and tool-error scaling (case 2)"
-                                    : "flow bound only (case 1)");
+                                    : "flow bound only (case 1)",
+              base.shared_with_crane ? "one pump for the drive and the crane"
+                                     : "the crane on its own pump");
   std::printf("  tool path: %zu via points, %.2f m; platform %.2f m %s of it, driven %.2f m\n",
               file.via_m.size(), s.path_length_m, std::abs(offset), offset >= 0 ? "right" : "left",
               s.platform_path_length_m);
@@ -120,8 +128,12 @@ int run_follow_command(const FollowArgs& args) {
       "  drive pump: %.1f L/min; peak sum of hub-motor flows %.1f L/min (%.3f of Q_max; "
       "commanded %.3f)\n",
       base.model.pump_max_flow_m3_s / kLpm,
-      s.peak_flow_ratio * base.model.pump_max_flow_m3_s / kLpm, s.peak_flow_ratio,
+      s.peak_motor_flow_ratio * base.model.pump_max_flow_m3_s / kLpm, s.peak_motor_flow_ratio,
       s.peak_commanded_flow_ratio);
+  if (base.shared_with_crane) {
+    std::printf("  shared with the crane: peak motors + crane %.1f L/min (%.3f of Q_max)\n",
+                s.peak_flow_ratio * base.model.pump_max_flow_m3_s / kLpm, s.peak_flow_ratio);
+  }
   if (s.completion_time_s >= 0) {
     std::printf("  completion time: %.2f s\n", s.completion_time_s);
   } else {
@@ -142,7 +154,8 @@ int run_follow_command(const FollowArgs& args) {
     std::ofstream out(args.log);
     std::ostringstream comment;
     comment << "craneassist follow " << file.source
-            << (options.error_scaling ? "" : " --no-error-scaling") << "\n"
+            << (options.error_scaling ? "" : " --no-error-scaling")
+            << (base.shared_with_crane ? " --pump shared" : "") << "\n"
             << "pump_max_flow_m3_s: " << base.model.pump_max_flow_m3_s << "\n"
             << "completion_time_s: " << s.completion_time_s;
     offline::write_follow_csv(out, result, comment.str());

@@ -15,6 +15,7 @@ struct FollowArgs {
   std::string config_file;  // crane; empty: the embedded K70M
   std::string base_file;    // base; empty: the embedded config/machines/mobile_base.yaml
   bool no_error_scaling = false;
+  std::string pump;  // "shared", "separate"; empty: the base config's drive.shared_with_crane
   std::string log = "follow.csv";
   bool no_log = false;
   std::optional<double> height_amplitude_m;

@@ -56,7 +56,17 @@ MachineInputs load_machine_inputs(const config::CraneConfig& cfg, const BackendA
 }
 
 int Machine::open(const config::CraneConfig& cfg, const BackendArgs& args,
-                  const MachineInputs& inputs) {
+                  const MachineInputs& inputs, const config::BaseConfig* base) {
+  if (base != nullptr) {
+    if (uses_can_backend(args, cfg)) {
+      spdlog::error("--drive: the wheeled base is simulated; it runs on the sim backend only");
+      return kExitUsage;
+    }
+    mobile_.emplace(cfg.model, offline::sim_settings(cfg), base->model, dynamics::BasePose{},
+                    base->shared_with_crane);
+    machine_ = &*mobile_;
+    return machine_->activate(0.0, nullptr) ? kExitOk : kExitRuntime;
+  }
   if (!uses_can_backend(args, cfg)) {
     sim_.emplace(cfg.model, offline::sim_settings(cfg));
     machine_ = &*sim_;

@@ -8,7 +8,9 @@
 #include <string>
 
 #include "can_commands.hpp"
+#include "craneassist/config/base_config.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/sim_backend/mobile_crane_backend.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
 #include "craneassist/valves/machine_interface.hpp"
 
@@ -51,13 +53,17 @@ class Machine {
   // says so, and waits up to 2 s for every joint's feedback) from the inputs
   // load_machine_inputs read. Returns kExitOk, or logs why not (with the bus report after a
   // fault, e.g. the address lost) and returns the exit code.
-  int open(const config::CraneConfig& cfg, const BackendArgs& args, const MachineInputs& inputs);
+  // base: the simulated crane stands on this wheeled base (sim --drive; the sim backend only),
+  // at the origin facing x, driven through ValveCommand::drive_*.
+  int open(const config::CraneConfig& cfg, const BackendArgs& args, const MachineInputs& inputs,
+           const config::BaseConfig* base = nullptr);
   // The normal end of a run: the machine deactivated (every valve to its safe state, its
   // threads ended) and the bus report printed. Returns kExitRuntime after a latched fault.
   int finish();
 
  private:
   std::optional<sim_backend::SimBackend> sim_;
+  std::optional<sim_backend::MobileCraneBackend> mobile_;
   std::optional<CanMachine> can_;
   valves::MachineInterface* machine_ = nullptr;
 };

@@ -131,11 +131,17 @@ class StatusReporter {
     if (s.fault == input::InputFault::kStale) {
       std::snprintf(age, sizeof age, " %.0f ms", s.input_age_s * 1e3);
     }
+    char base[96] = "";
+    if (s.base.present) {  // the wheeled base (sim --drive): pose, speed, share of Q_max
+      std::snprintf(base, sizeof base, " | base x %6.2f y %6.2f %4.0f deg %5.2f m/s Q %3.0f%%",
+                    s.base.x_m, s.base.y_m, s.base.phi_rad * 180.0 / 3.14159265358979, s.base.v_m_s,
+                    100.0 * s.base.motor_flow_sum_m3_s / s.base.drive_max_flow_m3_s);
+    }
     std::printf(
-        "\r\033[Kt %6.1f s | %-8s | deadman %s%s%s | tip x %5.2f y %5.2f z %5.2f m | %.2f m/s | "
+        "\r\033[Kt %6.1f s | %-8s | deadman %s%s%s | tip x %5.2f y %5.2f z %5.2f m | %.2f m/s%s | "
         "%s%s",
         s.t, s.status, s.deadman ? "ON " : "off", speed_step, sender, s.tip.x(), s.tip.y(),
-        s.tip.z(), s.tip_v.norm(), s.stop_reason, age);
+        s.tip.z(), s.tip_v.norm(), base, s.stop_reason, age);
     std::fflush(stdout);
   }
 
@@ -151,10 +157,11 @@ class StatusReporter {
   input::InputFault fault_ = input::InputFault::kNone;
 };
 
-void print_keys() {
+void print_keys(bool drive) {
   std::printf(
       "keys: space deadman on/off | w/s or up/down reach | a/d or left/right slew | r/f or "
       "PgUp/PgDn height | +/- speed | l latch | x stop axes | q quit\n");
+  if (drive) std::printf("drive: i/k forward/back | u/o steer left/right\n");
 }
 
 }  // namespace
@@ -214,6 +221,17 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
   add_initial_option(*sim, args.initial);
   add_resolution_option(*sim, args.resolution, "for the run");
   add_backend_options(*sim, args.machine);
+  sim->add_flag("--drive", args.drive,
+                "Drive mode: the crane on the simulated wheeled base of docs/mobile.md, one stick "
+                "(or the keys i/k u/o) driving it, flow-bounded, while the other moves the tip");
+  sim->add_option("--base", args.base_file,
+                  "Base config YAML for --drive (implies it; default: the embedded "
+                  "config/machines/mobile_base.yaml)")
+      ->check(CLI::ExistingFile);
+  sim->add_option("--pump", args.pump,
+                  "--drive: shared (one pump of the drive's Q_max for the motors and the crane, "
+                  "the drive first) or separate (default: the base config's)")
+      ->check(CLI::IsMember({"shared", "separate"}));
   add_telemetry_options(*sim, args.telemetry, true);
   add_web_options(*sim, args.web);
   return sim;
@@ -261,6 +279,12 @@ int run_sim_command(const SimArgs& args) {
         "--input keyboard needs a terminal on stdin (give --input evdev, sdl or replay FILE)");
     return kExitUsage;
   }
+  const bool drive = args.drive || !args.base_file.empty();
+  if (!args.pump.empty() && !drive) {
+    spdlog::error("--pump: only with --drive (the wheeled base)");
+    return kExitUsage;
+  }
+  std::optional<config::BaseConfig> base;
   config::CraneConfig cfg;
   config::JoystickConfig jcfg;
   config::TelemetryConfig tcfg;
@@ -278,6 +302,10 @@ int run_sim_command(const SimArgs& args) {
     if (kind == "dds") check_remote_input_settings(tcfg);
     apply_backend_options(cfg, args.machine);
     machine_inputs = load_machine_inputs(cfg, args.machine);
+    if (drive) {
+      base = config::load_base_or_default(args.base_file);
+      if (!args.pump.empty()) base->shared_with_crane = args.pump == "shared";
+    }
   } catch (...) {
     return input_error_exit("replay");
   }
@@ -329,7 +357,10 @@ int run_sim_command(const SimArgs& args) {
 
   try {
     Machine machines;
-    if (const int rc = machines.open(cfg, args.machine, machine_inputs); rc != kExitOk) return rc;
+    if (const int rc = machines.open(cfg, args.machine, machine_inputs, base ? &*base : nullptr);
+        rc != kExitOk) {
+      return rc;
+    }
     valves::MachineInterface& machine = machines.get();
     g_stop.store(false);
     std::unique_ptr<input::CommandSource> source;
@@ -373,7 +404,10 @@ int run_sim_command(const SimArgs& args) {
 
     WebView web;
     if (web_on) {
-      if (const int rc = web.open(args.web, cfg); rc != kExitOk) return rc;
+      if (const int rc = web.open(args.web, cfg, true, base ? &base->model : nullptr);
+          rc != kExitOk) {
+        return rc;
+      }
       if (kind == "web") source = web.pad_source(jcfg.mapping);
     }
     Telemetry telemetry;
@@ -387,6 +421,7 @@ int run_sim_command(const SimArgs& args) {
     control::LiveStatusBoard board;
     control::LiveOptions options;
     options.monitor = jcfg.monitor;
+    if (base) options.base = &base->model;
     options.realtime = !args.no_realtime;  // always on the can backend (checked above)
     options.duration_s = args.duration_s > 0.0 ? args.duration_s
                          : replay              ? replay->end_time_s() + 1.0
@@ -409,7 +444,20 @@ int run_sim_command(const SimArgs& args) {
                  jcfg.source_name, cfg.model.name, machine.name(),
                  config::resolution_description(cfg),
                  options.realtime ? ", real time" : ", as fast as possible");
-    if (keyboard != nullptr) print_keys();
+    if (keyboard != nullptr) print_keys(drive);
+    if (base) {
+      const bool pad = kind == "evdev" || kind == "sdl";
+      if (pad && !(jcfg.mapping.drive[0].enabled || jcfg.mapping.drive[1].enabled)) {
+        spdlog::warn(
+            "--drive: the joystick mapping ({}) has no drive stick (joystick.drive); "
+            "config/joysticks/gamepad_drive.yaml has one",
+            jcfg.source_name);
+      }
+      spdlog::info("drive: {} ({}), {}; the crane's tip in the world includes the base's pose",
+                   base->model.name.empty() ? "wheeled base" : base->model.name, base->source_name,
+                   base->shared_with_crane ? "one pump for the drive and the crane"
+                                           : "the crane on its own pump");
+    }
 
     std::optional<GoalPlanner> goal_thread;
     if (goal_source != nullptr) {
@@ -471,6 +519,12 @@ int run_sim_command(const SimArgs& args) {
     if (goal_thread) {
       for (const std::string& line : goal_thread->report()) std::printf("  %s\n", line.c_str());
       std::printf("  goal input at the end: %s\n", goal_source->state());
+    }
+    if (base) {
+      const valves::BaseMeasurement b = board.read().base;
+      std::printf("  base: at x %.2f m, y %.2f m, heading %.1f deg; %s\n", b.x_m, b.y_m,
+                  b.phi_rad * 180.0 / 3.14159265358979,
+                  b.shared_pump ? "one pump for the drive and the crane" : "separate pumps");
     }
     if (!remote_report.empty()) std::printf("%s\n", remote_report.c_str());
     if (const std::string r = web.report(); !r.empty()) std::printf("%s\n", r.c_str());

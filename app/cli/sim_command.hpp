@@ -32,6 +32,9 @@ struct SimArgs {
   std::string resolution;  // empty: the config's
   std::string initial;     // start pose "NAME=VALUE UNIT, ..." (sim backend); empty: the config's
   BackendArgs machine;     // empty values: the config's backend: and can:
+  bool drive = false;      // --drive: the crane on the simulated wheeled base
+  std::string base_file;   // --base FILE (implies --drive); empty: the embedded base
+  std::string pump;        // --pump shared|separate; empty: the base config's
   TelemetryArgs telemetry;
   WebArgs web;
   // --input goal (docs/mhsb.md#the-k70m-a-goal-for-sim): the first goal, later ones, the

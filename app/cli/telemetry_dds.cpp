@@ -71,6 +71,10 @@ void Telemetry::finish() {
       static_cast<unsigned long long>(s.samples_written[3]),
       static_cast<unsigned long long>(s.frames_dropped),
       static_cast<unsigned long long>(s.write_errors));
+  if (s.samples_written[4] > 0) {  // a run with a wheeled base (sim --drive)
+    std::printf("  telemetry base: %llu samples on craneassist/base\n",
+                static_cast<unsigned long long>(s.samples_written[4]));
+  }
   if (publishing_->ros2) {
     std::printf(
         "  telemetry ros2: samples joint_states %llu, tip_velocity/command %llu, "

@@ -54,6 +54,14 @@ void each_field(Row& row, Frame& f, int n, Copy copy) {
   copy(row.polytope_dim, f.polytope_dim);
   copy(row.polytope_volume_m3s3, f.polytope_volume_m3_s3);
   copy(row.polytope_area_m2s2, f.polytope_area_m2_s2);
+  copy(row.base_present, f.base_present);
+  copy(row.base_shared_pump, f.base_shared_pump);
+  copy(row.base_pose, f.base_pose);
+  copy(row.base_velocity, f.base_velocity);
+  copy(row.base_command, f.base_command);
+  copy(row.base_motor_flow, f.base_motor_flow_m3_s);
+  copy(row.base_flow_sum_m3s, f.base_flow_sum_m3_s);
+  copy(row.base_flow_max_m3s, f.base_flow_max_m3_s);
 }
 
 }  // namespace

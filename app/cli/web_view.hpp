@@ -9,6 +9,7 @@
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/control/control_loop.hpp"
+#include "craneassist/dynamics/mobile_base.hpp"
 #include "craneassist/input/command_source.hpp"
 #include "craneassist/input/joystick_mapping.hpp"
 
@@ -33,7 +34,9 @@ class WebView {
   // Starts the server and prints the page's address; returns kExitOk, kExitUsage (a bad
   // --web-listen, or a build without the web view) or kExitRuntime (cannot listen), logged.
   // commands false: the page is a view only.
-  int open(const WebArgs& args, const config::CraneConfig& crane, bool commands = true);
+  // base: the wheeled base the crane stands on (sim --drive; kept by reference), or nullptr.
+  int open(const WebArgs& args, const config::CraneConfig& crane, bool commands = true,
+           const dynamics::MobileBaseModel* base = nullptr);
   control::CycleObserver* observer();
   // A row from elsewhere (after open()): WebServer::publish.
   void publish(const control::LogRow& row) noexcept;

@@ -17,7 +17,8 @@ void add_web_options(CLI::App& command, WebArgs& args) {
   command.add_option("--web-rate", args.frame_rate_hz, "(not in this build)");
 }
 
-int WebView::open(const WebArgs&, const config::CraneConfig&, bool) {
+int WebView::open(const WebArgs&, const config::CraneConfig&, bool,
+                  const dynamics::MobileBaseModel*) {
   spdlog::error("web view: this craneassist was built without the web view (CRANEASSIST_WEB=OFF)");
   return kExitUsage;
 }

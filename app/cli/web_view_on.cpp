@@ -54,7 +54,8 @@ void add_web_options(CLI::App& command, WebArgs& args) {
       ->capture_default_str();
 }
 
-int WebView::open(const WebArgs& args, const config::CraneConfig& crane, bool commands) {
+int WebView::open(const WebArgs& args, const config::CraneConfig& crane, bool commands,
+                  const dynamics::MobileBaseModel* base) {
   web::WebOptions o;
   if (!parse_listen(args.listen, o)) {
     spdlog::error("--web-listen: '{}' is not ADDR:PORT (e.g. 127.0.0.1:8080, :0, [::1]:8080)",
@@ -64,6 +65,7 @@ int WebView::open(const WebArgs& args, const config::CraneConfig& crane, bool co
   o.commands = commands;
   o.remote_commands = args.remote_commands;
   o.frame_rate_hz = args.frame_rate_hz;
+  o.base = base;
   try {
     state_->server = std::make_unique<web::WebServer>(o, crane);
   } catch (const std::exception& e) {

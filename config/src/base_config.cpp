@@ -94,7 +94,7 @@ BaseConfig read_config(const Reader& r, const YAML::Node& root, std::string_view
   const YAML::Node drive = r.child(root, "drive", "");
   r.check_keys(drive, dr,
                {"motor_displacement", "gear_ratio", "pump_max_flow", "motor_max_speed",
-                "time_constant", "arm_shares_pump"});
+                "time_constant", "arm_shares_pump", "shared_with_crane"});
   m.motor_displacement_m3 = r.value(drive, "motor_displacement", dr, Dimension::kVolume, 1e-7, 1e-2,
                                     "between 0.1 cm^3 and 10 L");
   m.gear_ratio = r.value(drive, "gear_ratio", dr, Dimension::kDimensionless, 0.01, 1000.0,
@@ -107,6 +107,7 @@ BaseConfig read_config(const Reader& r, const YAML::Node& root, std::string_view
   m.time_constant_s =
       r.value(drive, "time_constant", dr, Dimension::kTime, 0.0, 10.0, "between 0 s and 10 s");
   c.arm_shares_pump = r.flag(drive, "arm_shares_pump", dr, false);
+  c.shared_with_crane = r.flag(drive, "shared_with_crane", dr, false);
 
   const std::string mo = "crane_mount";
   const YAML::Node mount = r.child(root, "crane_mount", "");

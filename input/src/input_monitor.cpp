@@ -50,9 +50,10 @@ void InputMonitor::update(SourceState state, const OperatorCommand& sample, doub
     fault = InputFault::kNoData;
   } else if (!std::isfinite(sample.stamp_s) || !(out.input_age_s <= settings_.stale_timeout_s)) {
     fault = InputFault::kStale;
-  } else if (!sample.v_m_s.allFinite()) {
+  } else if (!sample.v_m_s.allFinite() || !sample.drive.allFinite()) {
     fault = InputFault::kNotFinite;
-  } else if (sample.v_m_s.cwiseAbs().maxCoeff() > settings_.max_speed_m_s) {
+  } else if (sample.v_m_s.cwiseAbs().maxCoeff() > settings_.max_speed_m_s ||
+             sample.drive.cwiseAbs().maxCoeff() > 1.0) {
     fault = InputFault::kOutOfRange;
   } else if (!sample.deadman) {
     fault = InputFault::kDeadmanReleased;
@@ -94,8 +95,10 @@ void InputMonitor::update(SourceState state, const OperatorCommand& sample, doub
   ever_enabled_ = ever_enabled_ || out.enabled;
   if (out.enabled) {
     out.v_m_s = sample.v_m_s;
+    out.drive = sample.drive;
   } else {
     out.v_m_s.setZero();
+    out.drive.setZero();
   }
 }
 

@@ -84,4 +84,13 @@ Eigen::Vector3d JoystickMapper::map(const GamepadState& pad, const Eigen::Vector
   return frame_.to_crane(op, tip_m);
 }
 
+Eigen::Vector2d JoystickMapper::drive(const GamepadState& pad) const noexcept {
+  Eigen::Vector2d d;
+  for (std::size_t i = 0; i < kDriveAxisCount; ++i) {
+    const AxisShape& s = mapping_.drive[i];
+    d[static_cast<Eigen::Index>(i)] = shape_axis(s, pad.axis(s.axis));
+  }
+  return d;
+}
+
 }  // namespace craneassist::input

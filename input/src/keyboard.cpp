@@ -20,6 +20,14 @@ const char* to_string(Key key) {
       return "up";
     case Key::kDown:
       return "down";
+    case Key::kDriveForward:
+      return "drive_forward";
+    case Key::kDriveBack:
+      return "drive_back";
+    case Key::kSteerLeft:
+      return "steer_left";
+    case Key::kSteerRight:
+      return "steer_right";
     case Key::kDeadman:
       return "deadman";
     case Key::kFaster:
@@ -60,6 +68,18 @@ Key KeyDecoder::feed(std::uint8_t byte) noexcept {
       case 'f':
       case 'F':
         return Key::kDown;
+      case 'i':
+      case 'I':
+        return Key::kDriveForward;
+      case 'k':
+      case 'K':
+        return Key::kDriveBack;
+      case 'u':
+      case 'U':
+        return Key::kSteerLeft;
+      case 'o':
+      case 'O':
+        return Key::kSteerRight;
       case ' ':
         return Key::kDeadman;
       case '+':
@@ -157,6 +177,18 @@ void KeyboardState::on_key(Key key, double now_s) noexcept {
     case Key::kDown:
       press(2, -1, now_s);
       break;
+    case Key::kDriveForward:
+      press(3, 1, now_s);
+      break;
+    case Key::kDriveBack:
+      press(3, -1, now_s);
+      break;
+    case Key::kSteerLeft:
+      press(4, 1, now_s);
+      break;
+    case Key::kSteerRight:
+      press(4, -1, now_s);
+      break;
     case Key::kDeadman:
       deadman_ = !deadman_;
       break;
@@ -182,15 +214,28 @@ void KeyboardState::on_key(Key key, double now_s) noexcept {
   }
 }
 
+bool KeyboardState::on(const Held& h, double now_s) const noexcept {
+  return latched_ ? h.direction != 0 : now_s <= h.until_s;
+}
+
 Eigen::Vector3d KeyboardState::axes(double now_s) const noexcept {
   Eigen::Vector3d v;
   const double scale = static_cast<double>(step_) / kSteps;
-  for (std::size_t i = 0; i < held_.size(); ++i) {
+  for (std::size_t i = 0; i < 3; ++i) {
     const Held& h = held_[i];
-    const bool on = latched_ ? h.direction != 0 : now_s <= h.until_s;
-    v[static_cast<Eigen::Index>(i)] = on ? h.direction * scale : 0.0;
+    v[static_cast<Eigen::Index>(i)] = on(h, now_s) ? h.direction * scale : 0.0;
   }
   return v;
+}
+
+Eigen::Vector2d KeyboardState::drive(double now_s) const noexcept {
+  Eigen::Vector2d d;
+  const double scale = static_cast<double>(step_) / kSteps;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const Held& h = held_[3 + i];
+    d[static_cast<Eigen::Index>(i)] = on(h, now_s) ? h.direction * scale : 0.0;
+  }
+  return d;
 }
 
 }  // namespace craneassist::input

@@ -85,6 +85,7 @@ SourceState KeyboardSource::poll(OperatorCommand& out) noexcept {
   }
   out.v_m_s = frame_.to_crane(op, tip_);
   out.deadman = state_.deadman();
+  out.drive = state_.drive(now);
   out.stamp_s = now;
   return SourceState::kOk;
 }

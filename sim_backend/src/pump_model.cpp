@@ -5,9 +5,14 @@
 
 namespace craneassist::sim_backend {
 
+void PumpModel::set_flow_limit(double flow_m3_s) noexcept {
+  // NaN goes to 0: a consumer that cannot say what it leaves leaves nothing.
+  flow_limit_m3_s_ = flow_m3_s > 0.0 ? std::min(flow_m3_s, pump_.max_flow_m3_s) : 0.0;
+}
+
 double PumpModel::deliverable_flow(double p) const {
-  if (p <= 0.0) return pump_.max_flow_m3_s;
-  return std::min(pump_.max_flow_m3_s, pump_.prime_mover_power_w / p);
+  if (p <= 0.0) return flow_limit_m3_s_;
+  return std::min(flow_limit_m3_s_, pump_.prime_mover_power_w / p);
 }
 
 double PumpModel::section_flows(const JointVector& demand, const JointVector& load, double p,
@@ -63,13 +68,23 @@ void PumpModel::solve(const JointVector& demand, const JointVector& load, PumpRe
       }
     }
     p = lo;
-    out.limit = pump_.prime_mover_power_w / std::max(p, 1.0) < pump_.max_flow_m3_s
+    out.limit = pump_.prime_mover_power_w / std::max(p, 1.0) < flow_limit_m3_s_
                     ? valves::PumpLimit::kPower
                     : valves::PumpLimit::kMaxFlow;
   } else if ((constant_pressure ? p_needed : p_ls) > p_ceiling) {
     out.limit = valves::PumpLimit::kRelief;
   }
   out.flow_m3_s = section_flows(demand, load, p, &out.delivered_fraction);
+  // Over-running sections take flow even at zero supply pressure; when that alone is more than
+  // the pump can deliver (a flow limit cut down by another consumer, set_flow_limit) they share
+  // what it delivers in proportion: their inlet chambers cannot fill faster than the pump.
+  const double deliverable = deliverable_flow(p);
+  if (out.flow_m3_s > deliverable) {
+    const double k = out.flow_m3_s > 0.0 ? deliverable / out.flow_m3_s : 0.0;
+    out.delivered_fraction *= k;
+    out.flow_m3_s = deliverable;
+    out.limit = valves::PumpLimit::kMaxFlow;
+  }
   out.supply_pressure_pa = std::max(p, 0.0);
   out.power_w = out.supply_pressure_pa * out.flow_m3_s;
 }

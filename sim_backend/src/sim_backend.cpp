@@ -234,6 +234,14 @@ void SimBackend::advance(double dt_s) {
   for (long k = 0; k < steps; ++k) impl_->step();
 }
 
+void SimBackend::set_pump_flow_limit(double flow_m3_s) noexcept {
+  impl_->pump.set_flow_limit(flow_m3_s);
+}
+
+double SimBackend::pump_flow_limit() const noexcept {
+  return impl_->pump.flow_limit();
+}
+
 double SimBackend::time_s() const {
   return impl_->t_s;
 }

@@ -47,5 +47,10 @@ sed 's/steer_max: 45 deg, paper/steer_max: 45 m, paper/' "$base" > "$work/base_u
 expect base_unit "config: $work/base_unit.yaml:$line: field 'chassis.steer_max': unit 'm' is not a angle unit" \
   follow "$src/examples/paths/mobile_s_curve.csv" --base "$work/base_unit.yaml" --no-log
 expect nan_option "--height-amplitude" follow "$src/examples/paths/mobile_s_curve.csv" --height-amplitude nan --no-log
+expect pump_value "--pump" follow "$src/examples/paths/mobile_s_curve.csv" --pump both --no-log
+line=$(grep -n 'shared_with_crane: false' "$base" | cut -d: -f1)
+sed 's/shared_with_crane: false/shared_with_crane: sometimes/' "$base" > "$work/base_shared.yaml"
+expect base_shared "config: $work/base_shared.yaml:$line: field 'drive.shared_with_crane'" \
+  follow "$src/examples/paths/mobile_s_curve.csv" --base "$work/base_shared.yaml" --no-log
 [ "$failed" -eq 0 ] && echo "follow bad input OK"
 exit $failed

@@ -71,6 +71,7 @@ class StatusObserver final : public CycleObserver {
     status_.input_age_s = input_.last().input_age_s;
     status_.disconnects = input_.monitor().disconnects();
     status_.reconnects = input_.monitor().reconnects();
+    status_.base = c.state.base;
     board_.publish(status_);
   }
 
@@ -86,6 +87,7 @@ LiveSummary run_live(const config::CraneConfig& config, input::CommandSource& so
                      valves::MachineInterface& machine, const LiveOptions& options, CsvLog* log) {
   MonitoredInput input(source, options.monitor);
   TipCommandTask task(config, options.controller, input);
+  task.set_base(options.base);
   const double period = task.period_s();
   RunStatistics statistics(period);
 

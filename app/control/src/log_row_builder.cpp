@@ -66,6 +66,14 @@ void LogRowBuilder::fill(LogRow& row, double t, const Eigen::Vector3d& cmd,
   row.polytope_volume_m3s3 = out.polytope_volume_m3_s3;
   row.polytope_dim = out.polytope_dim;
   row.polytope_area_m2s2 = out.polytope_area_m2_s2;
+  const valves::BaseMeasurement& b = state.base;
+  row.base_present = b.present;
+  row.base_shared_pump = b.shared_pump;
+  row.base_pose = {b.x_m, b.y_m, b.phi_rad};
+  row.base_velocity = {b.v_m_s, b.omega_rad_s};
+  for (std::size_t i = 0; i < 4; ++i) row.base_motor_flow[i] = b.motor_flow_m3_s[i];
+  row.base_flow_sum_m3s = b.motor_flow_sum_m3_s;
+  row.base_flow_max_m3s = b.drive_max_flow_m3_s;
 }
 
 }  // namespace craneassist::control

@@ -15,6 +15,7 @@ void ReplayInput::next(const CycleTime& time, const Eigen::Vector3d&, TipCommand
   const bool finite = out.v_m_s.allFinite();
   out.reason = finite ? "" : "replay stop row";
   out.deadman = finite;
+  out.drive.setZero();
 }
 
 void MonitoredInput::next(const CycleTime& time, const Eigen::Vector3d& tip_m,
@@ -25,6 +26,7 @@ void MonitoredInput::next(const CycleTime& time, const Eigen::Vector3d& tip_m,
   out.v_m_s = mon_.enabled ? mon_.v_m_s : kNoValue;
   out.reason = input::to_string(mon_.fault);
   out.deadman = mon_.deadman;
+  out.drive = mon_.enabled ? mon_.drive : Eigen::Vector2d::Zero();
 }
 
 TipCommandTask::TipCommandTask(const config::CraneConfig& config, const ControllerOptions& options,
@@ -45,6 +47,14 @@ CycleStatus TipCommandTask::step(const CycleTime& time, const valves::MachineSta
   const Eigen::Vector3d& v = stop_cause != nullptr ? kNoValue : command_.v_m_s;
   const CycleStatus status = controller_.update(state, v, out_);
   command.spool = out_.valves.spool;
+  if (base_ != nullptr && stop_cause == nullptr && v.allFinite()) {
+    scaling::flow_bounded_drive(*base_, command_.drive[0], command_.drive[1],
+                                base_->pump_max_flow_m3_s, drive_);
+  } else {
+    drive_ = scaling::BaseDriveOutput{};
+  }
+  command.drive_v_m_s = drive_.v_m_s;
+  command.drive_omega_rad_s = drive_.omega_rad_s;
 
   builder_.fill(row, time.t_s, v, out_, state);
   row.status = status_word(status);
@@ -56,6 +66,7 @@ CycleStatus TipCommandTask::step(const CycleTime& time, const valves::MachineSta
   row.stop_reason = reason;
   row.deadman = command_.deadman;
   row.input_source = input_.name();
+  row.base_command = {command.drive_v_m_s, command.drive_omega_rad_s};
   return status;
 }
 

@@ -59,6 +59,8 @@ bool safe_deserialize_payload(Topic topic, const std::uint8_t* data, std::size_t
         return deserialize_as<msg::CommandPathPubSubType>(data, size);
       case Topic::kOperatorCommand:
         return deserialize_as<msg::OperatorCommandPubSubType>(data, size);
+      case Topic::kBase:
+        return deserialize_as<msg::BaseStatePubSubType>(data, size);
     }
   } catch (...) {  // out of memory for the payload's copy
   }

@@ -91,6 +91,7 @@ class LatestSamples {
         take_into<msg::CommandPath>(reader, &Snapshot::command_path, topic);
         break;
       case Topic::kOperatorCommand:
+      case Topic::kBase:
         break;
     }
   }

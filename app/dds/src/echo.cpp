@@ -135,6 +135,24 @@ void describe(const msg::OperatorCommand& m, FieldVisitor& v) {
   v.flag("deadman", m.deadman());
 }
 
+void describe(const msg::BaseState& m, FieldVisitor& v) {
+  describe_header(m.header(), v);
+  v.number("x_m", m.pose()[0], "m");
+  v.number("y_m", m.pose()[1], "m");
+  v.number("phi_rad", m.pose()[2], "rad");
+  v.number("v_m_s", m.velocity()[0], "m/s");
+  v.number("omega_rad_s", m.velocity()[1], "rad/s");
+  v.number("v_cmd_m_s", m.command()[0], "m/s");
+  v.number("omega_cmd_rad_s", m.command()[1], "rad/s");
+  v.number("motor_flow_fl_m3_s", m.motor_flow_m3_s()[0], "m^3/s");
+  v.number("motor_flow_fr_m3_s", m.motor_flow_m3_s()[1], "m^3/s");
+  v.number("motor_flow_rl_m3_s", m.motor_flow_m3_s()[2], "m^3/s");
+  v.number("motor_flow_rr_m3_s", m.motor_flow_m3_s()[3], "m^3/s");
+  v.number("motor_flow_sum_m3_s", m.motor_flow_sum_m3_s(), "m^3/s");
+  v.number("drive_max_flow_m3_s", m.drive_max_flow_m3_s(), "m^3/s");
+  v.flag("shared_pump", m.shared_pump());
+}
+
 const char* qos_policy_name(std::uint32_t id) {
   switch (id) {
     case fdds::DURABILITY_QOS_POLICY_ID:
@@ -467,6 +485,9 @@ void echo_sample(const msg::CommandPath& sample, EchoFormat format, std::FILE* o
 void echo_sample(const msg::OperatorCommand& sample, EchoFormat format, std::FILE* out) {
   echo_one(sample, format, out);
 }
+void echo_sample(const msg::BaseState& sample, EchoFormat format, std::FILE* out) {
+  echo_one(sample, format, out);
+}
 
 int run_echo(const EchoOptions& o) {
   const TopicInfo* topic = find_topic(o.topic);
@@ -490,6 +511,8 @@ int run_echo(const EchoOptions& o) {
       return echo_topic<msg::CommandPath>(*topic, o);
     case Topic::kOperatorCommand:
       return echo_topic<msg::OperatorCommand>(*topic, o);
+    case Topic::kBase:
+      return echo_topic<msg::BaseState>(*topic, o);
   }
   return kToolUsage;
 }

@@ -107,6 +107,7 @@ ParticipantPtr make_participant(const ParticipantOptions& options) {
   register_type_support<CheckedPubSubType<craneassist::msg::HydraulicsPubSubType>>(*p, types);
   register_type_support<CheckedPubSubType<craneassist::msg::CommandPathPubSubType>>(*p, types);
   register_type_support<CheckedPubSubType<craneassist::msg::OperatorCommandPubSubType>>(*p, types);
+  register_type_support<CheckedPubSubType<craneassist::msg::BaseStatePubSubType>>(*p, types);
   return p;
 }
 

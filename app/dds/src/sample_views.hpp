@@ -19,6 +19,7 @@ void echo_sample(const msg::JointState& sample, EchoFormat format, std::FILE* ou
 void echo_sample(const msg::Hydraulics& sample, EchoFormat format, std::FILE* out);
 void echo_sample(const msg::CommandPath& sample, EchoFormat format, std::FILE* out);
 void echo_sample(const msg::OperatorCommand& sample, EchoFormat format, std::FILE* out);
+void echo_sample(const msg::BaseState& sample, EchoFormat format, std::FILE* out);
 
 // The dashboard's plain view (as --once prints it) of the latest sample of each telemetry topic;
 // nullptr: none received yet.

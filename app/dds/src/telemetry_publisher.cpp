@@ -32,7 +32,9 @@ std::int64_t monotonic_ns() noexcept {
 
 namespace {
 
-constexpr int kTelemetryTopics = 4;  // status, joints, hydraulics, command_path
+// status, joints, hydraulics, command_path, base (a run with a wheeled base only)
+constexpr int kTelemetryTopics = 5;
+constexpr int kBaseTopic = 4;
 
 template <typename Header>
 void fill_header(Header& h, const TelemetryFrame& f) {
@@ -50,17 +52,20 @@ std::vector<double> first(const std::array<double, N>& a, int n) {
 
 struct TelemetryPublisher::Impl {
   Impl(const config::TelemetryConfig& config, TelemetryInfo run_info, std::size_t capacity)
-      : info(std::move(run_info)), ring(capacity + 1) {
+      : info(std::move(run_info)), base_settings(config.hydraulics), ring(capacity + 1) {
     const config::TopicSettings* settings[kTelemetryTopics] = {
-        &config.status, &config.joints, &config.hydraulics, &config.command_path};
+        &config.status, &config.joints, &config.hydraulics, &config.command_path,
+        &config.hydraulics};  // the base at the hydraulics topic's rate and QoS
     for (int i = 0; i < kTelemetryTopics; ++i) pacers[i] = TopicPacer(settings[i]->rate_hz);
     participant = make_participant(participant_options(config));
     if (config.ros2.enabled) register_ros2_types(*participant, config.type_propagation);
     publisher = participant->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
     if (publisher == nullptr) throw std::runtime_error("DDS: cannot create the publisher");
     const Topic topics[kTelemetryTopics] = {Topic::kStatus, Topic::kJoints, Topic::kHydraulics,
-                                            Topic::kCommandPath};
-    for (int i = 0; i < kTelemetryTopics; ++i) {
+                                            Topic::kCommandPath, Topic::kBase};
+    // The base's writer comes with the first frame that has a base (publish(), on the publisher
+    // thread): a run without one offers no craneassist/base.
+    for (int i = 0; i < kBaseTopic; ++i) {
       writers[i] = publisher->create_datawriter(get_topic(*participant, topics[i]),
                                                 writer_qos(*settings[i]));
       if (writers[i] == nullptr) {
@@ -142,7 +147,16 @@ struct TelemetryPublisher::Impl {
   void publish(const TelemetryFrame& f, bool force) {
     if (ros2 && !ros2->publish(f, force)) write_errors.fetch_add(1, std::memory_order_relaxed);
     for (int i = 0; i < kTelemetryTopics; ++i) {
+      if (i == kBaseTopic && !f.base_present) continue;  // no base: nothing on craneassist/base
       if (!pacers[i].due(f, force)) continue;
+      if (i == kBaseTopic && writers[i] == nullptr) {
+        writers[i] = publisher->create_datawriter(get_topic(*participant, Topic::kBase),
+                                                  writer_qos(base_settings));
+        if (writers[i] == nullptr) {
+          write_errors.fetch_add(1, std::memory_order_relaxed);
+          continue;
+        }
+      }
       bool ok = false;
       switch (i) {
         case 0:
@@ -154,8 +168,11 @@ struct TelemetryPublisher::Impl {
         case 2:
           ok = write_hydraulics(f);
           break;
-        default:
+        case 3:
           ok = write_command_path(f);
+          break;
+        default:
+          ok = write_base(f);
           break;
       }
       if (ok) {
@@ -205,6 +222,18 @@ struct TelemetryPublisher::Impl {
     joints.tip_m(f.tip_m);
     joints.tip_v_m_s(f.tip_v_m_s);
     return writers[1]->write(&joints);
+  }
+
+  bool write_base(const TelemetryFrame& f) {
+    fill_header(base.header(), f);
+    base.pose(f.base_pose);
+    base.velocity(f.base_velocity);
+    base.command(f.base_command);
+    base.motor_flow_m3_s(f.base_motor_flow_m3_s);
+    base.motor_flow_sum_m3_s(f.base_flow_sum_m3_s);
+    base.drive_max_flow_m3_s(f.base_flow_max_m3_s);
+    base.shared_pump(f.base_shared_pump);
+    return writers[kBaseTopic]->write(&base);
   }
 
   bool write_hydraulics(const TelemetryFrame& f) {
@@ -270,6 +299,8 @@ struct TelemetryPublisher::Impl {
   craneassist::msg::JointState joints;
   craneassist::msg::Hydraulics hydraulics;
   craneassist::msg::CommandPath command_path;
+  craneassist::msg::BaseState base;
+  config::TopicSettings base_settings;  // the hydraulics topic's rate and QoS
   // The ring (loop thread produces, publisher thread consumes).
   std::vector<TelemetryFrame> ring;
   std::atomic<std::size_t> head{0}, tail{0};

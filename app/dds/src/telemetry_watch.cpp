@@ -68,6 +68,7 @@ struct TelemetryWatch::Impl {
         take_all<msg::CommandPath>(reader, bad);
         break;
       case Topic::kOperatorCommand:
+      case Topic::kBase:
         break;
     }
     if (bad > 0) {

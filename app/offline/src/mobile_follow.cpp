@@ -11,7 +11,7 @@
 #include "craneassist/dynamics/kinematics.hpp"
 #include "craneassist/offline/sim_setup.hpp"
 #include "craneassist/scaling/path_scaler.hpp"
-#include "craneassist/sim_backend/mobile_base_sim.hpp"
+#include "craneassist/sim_backend/mobile_crane_backend.hpp"
 
 namespace craneassist::offline {
 namespace {
@@ -123,11 +123,11 @@ FollowResult run_follow(const config::CraneConfig& crane, const config::BaseConf
   sim_backend::SimSettings settings = sim_settings(crane);
   settings.q_initial = initial_crane_pose(crane, tip0);
 
-  sim_backend::SimBackend arm(crane.model, settings);
-  sim_backend::MobileBaseSim platform(bm, start);
+  // The crane on the base; with a shared pump the crane gets what the motors leave each step.
+  sim_backend::MobileCraneBackend machine(crane.model, settings, bm, start, base.shared_with_crane);
   control::Controller controller(crane, {});
   valves::MachineState state;
-  arm.read(state);
+  machine.read(state);
   controller.reset(state);
 
   FollowResult result;
@@ -149,8 +149,8 @@ FollowResult run_follow(const config::CraneConfig& crane, const config::BaseConf
 
   for (long k = 0; k < max_cycles; ++k) {
     const double t = static_cast<double>(k) * period;
-    arm.read(state);
-    const sim_backend::MobileBaseState& ps = platform.state();
+    machine.read(state);
+    const sim_backend::MobileBaseState& ps = machine.base().state();
     const dynamics::BasePose pose = ps.pose;
 
     // The tool error: the target at the present s against the measured tip, in the platform's
@@ -170,7 +170,6 @@ FollowResult run_follow(const config::CraneConfig& crane, const config::BaseConf
     in.tracking_factor = delta;
     in.arm_flow_m3_s = state.pump.flow_m3_s;
     follower.update(in, fout);
-    platform.command({fout.v_m_s, fout.omega_rad_s});
 
     // The arm: the tool point at the new s, relative to the measured platform, through the
     // crane's controller: its motion plus a P term on the reference tip's error.
@@ -190,7 +189,10 @@ FollowResult run_follow(const config::CraneConfig& crane, const config::BaseConf
         feed_forward +
         (distance > 0.0 ? Eigen::Vector3d(gap * (p_speed / distance)) : Eigen::Vector3d::Zero());
     controller.update(state, command, out);
-    arm.write(out.valves);
+    valves::ValveCommand to_machine = out.valves;
+    to_machine.drive_v_m_s = fout.v_m_s;
+    to_machine.drive_omega_rad_s = fout.omega_rad_s;
+    machine.write(to_machine);
 
     FollowRow row;
     row.t = t;
@@ -228,6 +230,7 @@ FollowResult run_follow(const config::CraneConfig& crane, const config::BaseConf
     for (int i = 0; i < std::min<int>(4, static_cast<int>(state.q.size())); ++i)
       row.q[i] = state.q[i];
     row.arm_flow = state.pump.flow_m3_s;
+    row.arm_flow_max = machine.crane().pump_flow_limit();
     row.limit = scaling::to_string(fout.limit);
     result.rows.push_back(row);
 
@@ -239,7 +242,11 @@ FollowResult run_follow(const config::CraneConfig& crane, const config::BaseConf
       sum_sq_settled += error * error;
       ++settled_cycles;
     }
-    sum.peak_flow_ratio = std::max(sum.peak_flow_ratio, row.flow_sum / bm.pump_max_flow_m3_s);
+    // With a shared pump the crane's flow counts against the same Q_max.
+    const double pump_flow = row.flow_sum + (base.shared_with_crane ? row.arm_flow : 0.0);
+    sum.peak_flow_ratio = std::max(sum.peak_flow_ratio, pump_flow / bm.pump_max_flow_m3_s);
+    sum.peak_motor_flow_ratio =
+        std::max(sum.peak_motor_flow_ratio, row.flow_sum / bm.pump_max_flow_m3_s);
     sum.peak_commanded_flow_ratio =
         std::max(sum.peak_commanded_flow_ratio, fout.wheels.flow_sum_m3_s / bm.pump_max_flow_m3_s);
     sum.peak_slew_rate_rad_s = std::max(sum.peak_slew_rate_rad_s, std::abs(state.qdot[0]));
@@ -253,8 +260,7 @@ FollowResult run_follow(const config::CraneConfig& crane, const config::BaseConf
       sum.completion_time_s = t;
     }
     if (finished_at >= 0.0 && t - finished_at >= options.settle_s) break;
-    arm.advance(period);
-    platform.advance(period);
+    machine.advance(period);
   }
   sum.rms_tool_error_m = std::sqrt(sum_sq / static_cast<double>(std::max<long>(1, sum.cycles)));
   sum.rms_tool_error_settled_m =
@@ -272,7 +278,7 @@ void write_follow_csv(std::ostream& out, const FollowResult& result, const std::
   out << "t,s,sdot,x,y,phi,x_d,y_d,phi_d,e_x,e_y,e_phi,v_cmd,omega_cmd,v,omega,v_max,"
          "flow_fl,flow_fr,flow_rl,flow_rr,flow_sum,flow_max,steer_fl,steer_fr,steer_rl,steer_rr,"
          "tool_x,tool_y,tool_z,tool_x_d,tool_y_d,tool_z_d,tool_error,tool_error_filtered,delta,"
-         "q1,q2,q3,q4,arm_flow,limit\n";
+         "q1,q2,q3,q4,arm_flow,arm_flow_max,limit\n";
   out.precision(9);
   for (const FollowRow& r : result.rows) {
     out << r.t << ',' << r.s << ',' << r.sdot << ',' << r.x << ',' << r.y << ',' << r.phi << ','
@@ -285,7 +291,7 @@ void write_follow_csv(std::ostream& out, const FollowResult& result, const std::
     for (const double p : r.tool_d) out << ',' << p;
     out << ',' << r.tool_error << ',' << r.tool_error_filtered << ',' << r.delta;
     for (const double q : r.q) out << ',' << q;
-    out << ',' << r.arm_flow << ',' << r.limit << '\n';
+    out << ',' << r.arm_flow << ',' << r.arm_flow_max << ',' << r.limit << '\n';
   }
 }
 

@@ -140,7 +140,73 @@ std::string crane_json(const config::CraneConfig& crane, double frame_rate_hz) {
   return out;
 }
 
-SceneBuilder::SceneBuilder(const dynamics::CraneModel& model) : model_(model) {}
+SceneBuilder::SceneBuilder(const dynamics::CraneModel& model, const dynamics::MobileBaseModel* base)
+    : model_(model), base_(base) {}
+
+namespace {
+
+// A 3x3 matrix row by row.
+void matrix(std::string& out, const Eigen::Matrix3d& m) {
+  const double v[9] = {m(0, 0), m(0, 1), m(0, 2), m(1, 0), m(1, 1),
+                       m(1, 2), m(2, 0), m(2, 1), m(2, 2)};
+  numbers(out, v, 9);
+}
+
+Eigen::Matrix3d yaw(double a) {
+  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
+
+}  // namespace
+
+void SceneBuilder::base_json(const control::LogRow& row, std::string& out) const {
+  Object b(out);
+  b.numbers("pose", row.base_pose.data(), 3)
+      .numbers("velocity", row.base_velocity.data(), 2)
+      .numbers("command", row.base_command.data(), 2)
+      .numbers("motor_flow", row.base_motor_flow.data(), 4)
+      .number("flow_sum", row.base_flow_sum_m3s)
+      .number("flow_max", row.base_flow_max_m3s)
+      .flag("shared_pump", row.base_shared_pump);
+  if (base_ == nullptr) {
+    b.close();
+    return;
+  }
+  // The view's frame is the crane frame of a fixed crane (y up): the world (z up) is drawn
+  // through the same turn, task_from_base. The crane's root: its frame in the view's.
+  const Eigen::Matrix3d& t = model_.task_from_base;
+  const dynamics::BasePose pose{row.base_pose[0], row.base_pose[1], row.base_pose[2]};
+  const Eigen::Vector3d mount =
+      dynamics::world_from_crane_base(*base_, pose, Eigen::Vector3d::Zero());
+  matrix(b.nested("root_r"), t * yaw(pose.phi_rad + base_->crane_mount_yaw_rad) * t.transpose());
+  b.vec3("root_p", t * mount);
+  // Boxes in world axes (x along the heading, z up), placed: r maps the box's axes to the
+  // view's, p its centre, size its extent along its axes.
+  std::string& boxes = b.nested("boxes");
+  boxes += '[';
+  auto box = [&](const char* kind, const Eigen::Matrix3d& r_world, const Eigen::Vector3d& p_world,
+                 const Eigen::Vector3d& size) {
+    if (boxes.back() != '[') boxes += ',';
+    Object o(boxes);
+    o.text("kind", kind);
+    matrix(o.nested("r"), t * r_world);
+    o.vec3("p", t * p_world).vec3("size", size).close();
+  };
+  const double r_wheel = base_->wheel_radius_m;
+  const Eigen::Matrix3d r_chassis = yaw(pose.phi_rad);
+  const Eigen::Vector3d xy(pose.x_m, pose.y_m, 0.0);
+  box("chassis", r_chassis, xy + Eigen::Vector3d(0.0, 0.0, r_wheel + 0.15),
+      Eigen::Vector3d(2.0 * base_->half_length_m, 2.0 * (base_->half_width_m - 0.1), 0.3));
+  dynamics::WheelState wheels;
+  dynamics::wheel_inverse_kinematics(*base_, row.base_velocity[1], row.base_velocity[0], wheels);
+  for (int i = 0; i < dynamics::kBaseWheels; ++i) {
+    const double steer = wheels.steer_rad[static_cast<std::size_t>(i)];
+    const Eigen::Vector2d c = dynamics::wheel_centre(*base_, i, steer);
+    box("wheel", yaw(pose.phi_rad + steer), xy + r_chassis * Eigen::Vector3d(c.x(), c.y(), r_wheel),
+        Eigen::Vector3d(2.0 * r_wheel, 0.3, 2.0 * r_wheel));
+  }
+  boxes += ']';
+  b.close();
+}
 
 void SceneBuilder::frame_json(const control::LogRow& row, std::uint64_t seq, std::string& out) {
   const int n = model_.dof();
@@ -179,6 +245,7 @@ void SceneBuilder::frame_json(const control::LogRow& row, std::uint64_t seq, std
       .number("volume", row.polytope_volume_m3s3)
       .number("area", row.polytope_area_m2s2)
       .close();
+  if (row.base_present) base_json(row, f.nested("base"));
 
   // The drawing: joint frame origins, and each cylinder's ends.
   dynamics::JointVector q(n);

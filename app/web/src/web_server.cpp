@@ -99,7 +99,7 @@ struct WebServer::Impl {
   Impl(const WebOptions& o, const config::CraneConfig& crane)
       : options(o),
         crane_text(crane_json(crane, o.frame_rate_hz)),
-        scene(crane.model),
+        scene(crane.model, o.base),
         token(o.token.empty() ? random_token() : o.token),
         acceptor(ioc),
         timer(ioc) {}
@@ -483,6 +483,7 @@ class PadSource : public input::CommandSource {
     if (!taken_.connected) return input::SourceState::kDisconnected;
     out.v_m_s = mapper_.map(taken_.pad, tip_);
     out.deadman = mapper_.deadman(taken_.pad);
+    out.drive = mapper_.drive(taken_.pad);
     out.stamp_s = taken_.stamp_s;
     return input::SourceState::kOk;
   }

@@ -57,6 +57,24 @@ input::AxisShape read_axis(const Reader& r, const YAML::Node& node, const std::s
   return s;
 }
 
+// A drive-stick axis (sim --base): as a tip axis without max (a fraction of the drive's limit).
+input::AxisShape read_drive_axis(const Reader& r, const YAML::Node& node, const std::string& path) {
+  r.check_keys(node, path, {"axis", "deadband", "expo", "invert"});
+  input::AxisShape s;
+  s.enabled = true;
+  const std::string axis = r.text(node, "axis", path);
+  if (!input::parse_gamepad_axis(axis, s.axis)) {
+    r.fail(node["axis"], path + ".axis",
+           "unknown axis '" + axis +
+               "' (expected left_x, left_y, right_x, right_y, left_trigger or right_trigger)");
+  }
+  s.deadband = r.value(node, "deadband", path, Dimension::kDimensionless, 0.0, 0.9, "0 to 0.9");
+  s.expo = r.value(node, "expo", path, Dimension::kDimensionless, 0.0, 1.0, "0 to 1");
+  s.max = 1.0;
+  s.invert = r.flag(node, "invert", path, false);
+  return s;
+}
+
 JoystickConfig read_config(const Reader& r, const YAML::Node& root, std::string_view source) {
   r.check_keys(root, "", {"format", "name", "input", "joystick", "keyboard"});
   const std::string format = r.text(root, "format", "");
@@ -82,7 +100,8 @@ JoystickConfig read_config(const Reader& r, const YAML::Node& root, std::string_
   }
 
   const YAML::Node js = r.child(root, "joystick", "");
-  r.check_keys(js, "joystick", {"frame", "slew", "deadman", "min_radius", "device", "axes"});
+  r.check_keys(js, "joystick",
+               {"frame", "slew", "deadman", "min_radius", "device", "axes", "drive"});
   auto& m = c.mapping;
   const std::string frame = r.text(js, "frame", "joystick");
   if (frame == "cylindrical") {
@@ -126,6 +145,28 @@ JoystickConfig read_config(const Reader& r, const YAML::Node& root, std::string_
     ++mapped;
   }
   if (mapped == 0) r.fail(axes, "joystick.axes", "map at least one of lateral, radial, vertical");
+  if (js["drive"].IsDefined()) {
+    const YAML::Node drive = js["drive"];
+    r.check_keys(drive, "joystick.drive", {"speed", "curvature"});
+    constexpr const char* kDriveKeys[input::kDriveAxisCount] = {"speed", "curvature"};
+    for (std::size_t i = 0; i < input::kDriveAxisCount; ++i) {
+      const std::string path = std::string("joystick.drive.") + kDriveKeys[i];
+      const YAML::Node node = r.child(drive, kDriveKeys[i], "joystick.drive");
+      m.drive[i] = read_drive_axis(r, node, path);
+      // One gamepad axis moves one thing: the drive stick is not a tip axis.
+      for (std::size_t j = 0; j < input::kOperatorAxisCount; ++j) {
+        if (m.axes[j].enabled && m.axes[j].axis == m.drive[i].axis) {
+          r.fail(node["axis"], path + ".axis",
+                 std::string("this gamepad axis is already joystick.axes.") +
+                     input::to_string(static_cast<input::OperatorAxis>(j)));
+        }
+      }
+    }
+    if (m.drive[0].axis == m.drive[1].axis) {
+      r.fail(drive["curvature"]["axis"], "joystick.drive.curvature.axis",
+             "the same gamepad axis as joystick.drive.speed");
+    }
+  }
 
   if (root["keyboard"].IsDefined()) {
     const YAML::Node kb = root["keyboard"];

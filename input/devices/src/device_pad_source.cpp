@@ -23,6 +23,7 @@ SourceState DevicePadSource::poll(OperatorCommand& out) noexcept {
   if (!taken_.has_state) return SourceState::kNoData;
   out.v_m_s = mapper_.map(taken_.pad, tip_);
   out.deadman = mapper_.deadman(taken_.pad);
+  out.drive = mapper_.drive(taken_.pad);
   out.stamp_s = taken_.stamp_s;
   return SourceState::kOk;
 }

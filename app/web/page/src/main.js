@@ -63,6 +63,12 @@ function place(mesh, a, b, width) {
   mesh.scale.set(width, len, width);
 }
 
+// The crane's own frame: the view's on a fixed base; on a wheeled base (sim --drive) placed by
+// the frame's base.root_r, base.root_p (drawBase).
+const craneRoot = new THREE.Group();
+craneRoot.matrixAutoUpdate = false;
+scene.add(craneRoot);
+
 const links = [];        // pillar, booms, telescope
 const cylinders = [];    // hydraulic cylinders, one per drawn cylinder
 const trail = { points: [], max: 900 };
@@ -79,13 +85,13 @@ for (const part of [availArrow.line, availArrow.cone]) {
   part.material.depthWrite = false;
   part.renderOrder = -1;
 }
-scene.add(cmdArrow, refArrow, availArrow);
+craneRoot.add(cmdArrow, refArrow, availArrow);
 const arrowLength = (speed) => 0.3 + 2 * speed;  // 0.5 m/s: 1.3 m
 // The last stick direction, along which the available speed is (before any: forward, as the
 // controller takes it).
 const stickDir = new THREE.Vector3(1, 0, 0);
 const tipMarker = new THREE.Mesh(new THREE.SphereGeometry(0.07, 16, 12), dark);
-scene.add(tipMarker);
+craneRoot.add(tipMarker);
 
 function resize() {
   const w = view.clientWidth, h = view.clientHeight;
@@ -108,7 +114,7 @@ function drawCrane(frame) {
     if (pts[i].distanceTo(pts[i + 1]) < 1e-3) continue;
     if (!links[k]) {
       links[k] = new THREE.Mesh(k === 0 ? unitCylinder : unitBox, k === 0 ? dark : steel);
-      scene.add(links[k]);
+      craneRoot.add(links[k]);
     }
     place(links[k], pts[i], pts[i + 1], k === 0 ? 0.16 : 0.14 - 0.02 * Math.min(k, 3));
     ++k;
@@ -118,7 +124,7 @@ function drawCrane(frame) {
     if (!m) {
       m = cylinders[c.joint] = new THREE.Mesh(unitCylinder,
         new THREE.MeshStandardMaterial({ color: 0x4a9be8, metalness: 0.6, roughness: 0.3 }));
-      scene.add(m);
+      craneRoot.add(m);
     }
     place(m, vec(c.a), vec(c.b), crane ? Math.max(0.03, crane.cylinders[c.joint].bore_m * 0.6) : 0.05);
     const p = frame.p_load ? frame.p_load[c.joint] : 0;
@@ -128,7 +134,7 @@ function drawCrane(frame) {
   }
   const tip = vec(frame.tip);
   tipMarker.position.copy(tip);
-  trail.points.push(tip);
+  trail.points.push(tip.clone().applyMatrix4(craneRoot.matrix));  // the trail on the ground
   if (trail.points.length > trail.max) trail.points.shift();
   const pos = trailGeometry.attributes.position;
   trail.points.forEach((p, i) => pos.setXYZ(i, p.x, p.y, p.z));
@@ -153,6 +159,59 @@ function drawCrane(frame) {
     availArrow.setLength(arrowLength(frame.avail), 0.15, 0.08);
     probe.avail_arrow = { length: arrowLength(frame.avail), dir: stickDir.toArray() };
   }
+}
+
+// The wheeled base (sim --drive, docs/mobile.md#live): the chassis and wheels as boxes the
+// server places, the crane's frame on it. Without a base the crane's frame is the view's.
+const chassisMaterial = new THREE.MeshStandardMaterial({ color: 0x5d7a3a, metalness: 0.2, roughness: 0.7 });
+const baseBoxes = [];
+const baseTrail = { points: [], max: 3000 };
+const baseTrailGeometry = new THREE.BufferGeometry();
+baseTrailGeometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(baseTrail.max * 3), 3));
+scene.add(new THREE.Line(baseTrailGeometry, new THREE.LineBasicMaterial({ color: 0x8fbf5a })));
+
+function drawBase(frame) {
+  const b = frame.base;
+  baseBoxes.forEach((m) => { m.visible = false; });
+  if (!b || !b.root_r) {
+    craneRoot.matrix.identity();
+    return;
+  }
+  const r = b.root_r, p = b.root_p;
+  craneRoot.matrix.set(r[0], r[1], r[2], p[0], r[3], r[4], r[5], p[1], r[6], r[7], r[8], p[2], 0, 0, 0, 1);
+  b.boxes.forEach((box, i) => {
+    let m = baseBoxes[i];
+    if (!m) {
+      m = baseBoxes[i] = new THREE.Mesh(unitBox, box.kind === 'wheel' ? dark : chassisMaterial);
+      m.matrixAutoUpdate = false;
+      scene.add(m);
+    }
+    const q = box.r, c = box.p, s = box.size;
+    m.matrix.set(q[0] * s[0], q[1] * s[1], q[2] * s[2], c[0], q[3] * s[0], q[4] * s[1], q[5] * s[2], c[1],
+      q[6] * s[0], q[7] * s[1], q[8] * s[2], c[2], 0, 0, 0, 1);
+    m.visible = true;
+  });
+  const centre = vec(b.boxes[0].p);
+  const last = baseTrail.points[baseTrail.points.length - 1];
+  if (!last || last.distanceTo(centre) > 0.05) {
+    baseTrail.points.push(centre);
+    if (baseTrail.points.length > baseTrail.max) baseTrail.points.shift();
+    const pos = baseTrailGeometry.attributes.position;
+    baseTrail.points.forEach((v, i) => pos.setXYZ(i, v.x, 0.01, v.z));
+    pos.needsUpdate = true;
+    baseTrailGeometry.setDrawRange(0, baseTrail.points.length);
+  }
+}
+
+function showBase(f) {
+  const b = f.base;
+  $('base-panel').hidden = !b;
+  if (!b) return;
+  const pumpFlow = b.flow_sum + (b.shared_pump ? f.pump.flow : 0);
+  gauge('drive', pumpFlow, b.flow_max,
+    `${fmt(pumpFlow * 6e4, 1)} / ${fmt(b.flow_max * 6e4, 0)} L/min${b.shared_pump ? ' (motors + crane)' : ''}`);
+  $('base-pose').textContent =
+    `x ${fmt(b.pose[0])} y ${fmt(b.pose[1])} m · ${fmt(b.pose[2] * 180 / Math.PI, 0)}° · ${fmt(b.velocity[0])} m/s`;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -337,8 +396,10 @@ setInterval(() => {
 function animate() {
   requestAnimationFrame(animate);
   if (fresh) {
+    drawBase(fresh);
     drawCrane(fresh);
     showFrame(fresh);
+    showBase(fresh);
     probe.drawn += 1;
     if (moveStarted !== null && norm(fresh.cmd) > 1e-3) {
       probe.latency_ms.push(performance.now() - moveStarted);

@@ -30,8 +30,13 @@ struct BaseFollowingConfig {
 struct BaseConfig {
   dynamics::MobileBaseModel model;
   BaseFollowingConfig following;
-  // The crane's pump feeds the hub motors too: its flow counts against the drive pump's.
+  // The platform's planner counts the crane's measured pump flow against the drive pump's
+  // (v_max from Q_max less the arm's flow).
   bool arm_shares_pump = false;
+  // One pump of the drive's pump_max_flow feeds the hub motors and the crane: each simulation
+  // step the crane's pump delivers at most what the motors leave of it (the drive first; the
+  // paper's remark after eq. 15). false: the crane has its own pump (the paper's machine).
+  bool shared_with_crane = false;
   std::string source_name;
 };
 

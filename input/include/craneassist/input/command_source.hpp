@@ -19,6 +19,10 @@ struct OperatorCommand {
   Eigen::Vector3d v_m_s =
       Eigen::Vector3d::Zero();  // tip velocity, crane frame (x fwd, y up, z lat)
   bool deadman = false;         // enable button held
+  // The drive stick of a crane on a wheeled base (sim --base, docs/mobile.md#live): forward
+  // speed and curvature as fractions of their flow-bounded and steering limits, each in
+  // [-1, 1] (curvature positive: turning left). Zero for sources without one.
+  Eigen::Vector2d drive = Eigen::Vector2d::Zero();
 };
 
 enum class SourceState {

@@ -55,6 +55,7 @@ const char* to_string(InputFault fault);
 
 struct MonitorOutput {
   Eigen::Vector3d v_m_s = Eigen::Vector3d::Zero();  // what the controller gets
+  Eigen::Vector2d drive = Eigen::Vector2d::Zero();  // the drive stick, passed with v_m_s
   bool enabled = false;                             // the operator's command passes
   InputFault fault = InputFault::kNoData;
   bool deadman = false;      // as the source reports it (false when there is no sample)

@@ -40,10 +40,17 @@ struct AxisShape {
   bool invert = false;
 };
 
+// The drive stick's axes (sim --base), indices of JoystickMapping::drive.
+enum class DriveAxis { kSpeed, kCurvature };
+inline constexpr std::size_t kDriveAxisCount = 2;
+
 struct JoystickMapping {
   MappingFrame frame = MappingFrame::kCylindrical;
   SlewMode slew = SlewMode::kTangential;
   std::array<AxisShape, kOperatorAxisCount> axes{};
+  // The drive stick: forward speed and curvature as fractions of their limits (max is 1 at
+  // full deflection; curvature positive: left). Disabled: no drive from this device.
+  std::array<AxisShape, kDriveAxisCount> drive{};
   GamepadButton deadman = GamepadButton::kRightShoulder;
   // Below this horizontal radius the radial direction is not defined well: the last direction
   // measured outside it is kept (and an angular slew uses this radius).
@@ -88,6 +95,8 @@ class JoystickMapper {
   Eigen::Vector3d map(const GamepadState& pad, const Eigen::Vector3d& tip_m,
                       double speed_factor = 1.0) noexcept;
   bool deadman(const GamepadState& pad) const noexcept { return pad.button(mapping_.deadman); }
+  // The drive stick (speed, curvature fractions in [-1, 1]); zero where an axis is disabled.
+  Eigen::Vector2d drive(const GamepadState& pad) const noexcept;
   const JoystickMapping& mapping() const noexcept { return mapping_; }
 
  private:

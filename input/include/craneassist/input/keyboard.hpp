@@ -15,18 +15,22 @@ namespace craneassist::input {
 
 enum class Key {
   kNone,
-  kForward,  // w, up arrow: reach out
-  kBack,     // s, down arrow: reach in
-  kLeft,     // a, left arrow: slew left
-  kRight,    // d, right arrow: slew right
-  kUp,       // r, page up: tip up
-  kDown,     // f, page down: tip down
-  kDeadman,  // space: toggle the enable
-  kFaster,   // + or =
-  kSlower,   // - or _
-  kLatch,    // l: latched mode on/off
-  kStopAll,  // x: all axes to zero (latched mode)
-  kQuit,     // q, Q
+  kForward,       // w, up arrow: reach out
+  kBack,          // s, down arrow: reach in
+  kLeft,          // a, left arrow: slew left
+  kRight,         // d, right arrow: slew right
+  kUp,            // r, page up: tip up
+  kDown,          // f, page down: tip down
+  kDriveForward,  // i: drive forward (sim --base)
+  kDriveBack,     // k: drive back
+  kSteerLeft,     // u: steer left
+  kSteerRight,    // o: steer right
+  kDeadman,       // space: toggle the enable
+  kFaster,        // + or =
+  kSlower,        // - or _
+  kLatch,         // l: latched mode on/off
+  kStopAll,       // x: all axes to zero (latched mode)
+  kQuit,          // q, Q
 };
 const char* to_string(Key key);
 
@@ -54,6 +58,8 @@ class KeyboardState {
   void on_key(Key key, double now_s) noexcept;
   // Operator axes (lateral, radial, vertical) in -1..1 times the speed step, at time now_s.
   Eigen::Vector3d axes(double now_s) const noexcept;
+  // The drive keys (speed, curvature; curvature positive: left) in -1..1 times the speed step.
+  Eigen::Vector2d drive(double now_s) const noexcept;
   bool deadman() const noexcept { return deadman_; }
   bool latched() const noexcept { return latched_; }
   bool quit() const noexcept { return quit_; }
@@ -70,7 +76,9 @@ class KeyboardState {
   void press(std::size_t axis, int direction, double now_s) noexcept;
 
   KeyboardSettings settings_;
-  std::array<Held, 3> held_{};
+  bool on(const Held& h, double now_s) const noexcept;
+
+  std::array<Held, 5> held_{};  // lateral, radial, vertical; drive speed, curvature
   bool deadman_ = false;
   bool latched_ = false;
   bool quit_ = false;

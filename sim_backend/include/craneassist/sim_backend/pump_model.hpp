@@ -46,7 +46,14 @@ struct PumpResult {
 
 class PumpModel {
  public:
-  explicit PumpModel(const dynamics::Pump& pump) : pump_(pump) {}
+  explicit PumpModel(const dynamics::Pump& pump)
+      : pump_(pump), flow_limit_m3_s_(pump.max_flow_m3_s) {}
+
+  // The most the pump may deliver from now on: its max_flow, or less when another consumer on
+  // the same pump takes the rest (a crane sharing its pump with a drive, docs/mobile.md). Clamped
+  // to [0, max_flow]; no allocation.
+  void set_flow_limit(double flow_m3_s) noexcept;
+  double flow_limit() const noexcept { return flow_limit_m3_s_; }
 
   // demand_m3_s: flow each section asks for (>= 0); load_pressure_pa: its load pressure
   // (negative for an over-running load). Bounded work (fixed bisection count), no allocation.
@@ -61,6 +68,7 @@ class PumpModel {
                        JointVector* fraction) const;
 
   dynamics::Pump pump_;
+  double flow_limit_m3_s_;
 };
 
 }  // namespace craneassist::sim_backend

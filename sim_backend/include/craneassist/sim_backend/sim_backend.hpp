@@ -46,6 +46,12 @@ class SimBackend final : public valves::MachineInterface {
   bool activate(double timeout_s, std::string* why) override;
   void safe_stop() noexcept override;
 
+  // The most the pump may deliver from the next step on (at most the model's max_flow): what
+  // another consumer on the same pump leaves, set between steps (a crane sharing its pump with
+  // a wheeled base's hub motors, docs/mobile.md). No allocation.
+  void set_pump_flow_limit(double flow_m3_s) noexcept;
+  double pump_flow_limit() const noexcept;
+
   double time_s() const;
   // Cylinder forces of the last step (N, positive pushing the cylinder out).
   const JointVector& cylinder_force_n() const;

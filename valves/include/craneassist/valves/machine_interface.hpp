@@ -23,12 +23,27 @@ struct PumpMeasurement {
   PumpLimit limit = PumpLimit::kNone;
 };
 
+// The wheeled base under the crane, on a machine that has one (docs/mobile.md): its pose in the
+// world (x, y, heading), its motion, and the hub motors' steering angles and flows (front left,
+// front right, rear left, rear right).
+struct BaseMeasurement {
+  bool present = false;  // false: a crane on a fixed base; the rest is zero
+  double x_m = 0.0, y_m = 0.0, phi_rad = 0.0;
+  double v_m_s = 0.0, omega_rad_s = 0.0;
+  double steer_rad[4] = {0.0, 0.0, 0.0, 0.0};
+  double motor_flow_m3_s[4] = {0.0, 0.0, 0.0, 0.0};
+  double motor_flow_sum_m3_s = 0.0;
+  double drive_max_flow_m3_s = 0.0;  // Q_max of the drive pump
+  bool shared_pump = false;          // the crane's pump flow counts against the same Q_max
+};
+
 struct MachineState {
   double t_s = 0.0;
   JointVector q;                 // joint positions, rad or m
   JointVector qdot;              // joint rates
   JointVector load_pressure_pa;  // per cylinder; positive: resistive load (paper 004 sign)
   PumpMeasurement pump;
+  BaseMeasurement base;
   bool valid = false;
 };
 
@@ -36,6 +51,10 @@ struct MachineState {
 // i.e. the valve current scaled to its range.
 struct ValveCommand {
   JointVector spool;
+  // The wheeled base's velocity command (forward speed, yaw rate), on a machine that has one
+  // (sim --base); ignored by a crane on a fixed base. Zero: stand still.
+  double drive_v_m_s = 0.0;
+  double drive_omega_rad_s = 0.0;
 };
 
 enum class BackendStatus { kOk, kNoData, kFault };

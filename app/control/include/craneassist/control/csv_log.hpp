@@ -48,6 +48,16 @@ struct LogRow {
   // run so far (0 when not paced), the previous cycle's compute time, the overruns so far.
   double loop_latency_max_s = 0.0, loop_compute_s = 0.0;
   long loop_overruns = 0;
+  // The wheeled base under the crane (sim --drive; MachineState::base) and the drive command
+  // written with the spools (live and telemetry only, like the fields above). Zero on a fixed
+  // base (base_present false).
+  bool base_present = false;
+  bool base_shared_pump = false;            // the crane's pump flow counts against the same Q_max
+  std::array<double, 3> base_pose{};        // x, y (m), heading (rad), world
+  std::array<double, 2> base_velocity{};    // forward speed (m/s), yaw rate (rad/s)
+  std::array<double, 2> base_command{};     // the drive command, the same units
+  std::array<double, 4> base_motor_flow{};  // hub motors fl, fr, rl, rr, m^3/s
+  double base_flow_sum_m3s = 0.0, base_flow_max_m3s = 0.0;
 
   // The pump columns from a measurement.
   void set_pump(const valves::PumpMeasurement& pump) {

@@ -14,6 +14,7 @@
 #include "craneassist/control/control_loop.hpp"
 #include "craneassist/control/controller.hpp"
 #include "craneassist/control/csv_log.hpp"
+#include "craneassist/dynamics/mobile_base.hpp"
 #include "craneassist/input/command_source.hpp"
 #include "craneassist/input/input_monitor.hpp"
 #include "craneassist/input/replay.hpp"
@@ -34,6 +35,7 @@ struct LiveStatus {
   bool deadman = false;
   double input_age_s = 0.0;
   int disconnects = 0, reconnects = 0;
+  valves::BaseMeasurement base;  // the wheeled base (sim --base); present false without one
 };
 
 class LiveStatusBoard {
@@ -57,6 +59,10 @@ class LiveStatusBoard {
 struct LiveOptions {
   ControllerOptions controller;
   input::InputMonitorSettings monitor;
+  // The crane stands on this wheeled base, driven by the operator's drive stick
+  // (TipCommandTask::set_base; the machine must take the drive command: MobileCraneBackend).
+  // nullptr: a fixed base. Kept by reference.
+  const dynamics::MobileBaseModel* base = nullptr;
   // true: paced at the control rate, the monitor's clock is steady_clock (device sources);
   // false: as fast as possible, the clock is machine time (scripted sources and tests only).
   bool realtime = true;

@@ -13,6 +13,7 @@
 #include "craneassist/input/command_source.hpp"
 #include "craneassist/input/input_monitor.hpp"
 #include "craneassist/input/replay.hpp"
+#include "craneassist/scaling/base_drive.hpp"
 
 namespace craneassist::control {
 
@@ -23,6 +24,9 @@ struct TipCommand {
   Eigen::Vector3d v_m_s = Eigen::Vector3d::Zero();
   const char* reason = "";  // why there is no command ("" when there is one); static
   bool deadman = false;
+  // The drive stick (speed, curvature fractions in [-1, 1]; input::OperatorCommand::drive),
+  // zero when the command does not pass.
+  Eigen::Vector2d drive = Eigen::Vector2d::Zero();
 };
 
 class TipCommandInput {
@@ -78,6 +82,12 @@ class TipCommandTask final : public CycleTask {
   const ControllerOutput* controller_output() const noexcept override { return &out_; }
 
   double period_s() const noexcept { return controller_.period_s(); }
+  // The crane stands on this wheeled base (kept by reference; nullptr: a fixed base): each cycle
+  // the drive stick becomes the base's flow-bounded velocity command (scaling::flow_bounded_drive,
+  // against the drive pump's Q_max), written with the spools (ValveCommand::drive_*); zero
+  // while the command does not pass or the loop stops.
+  void set_base(const dynamics::MobileBaseModel* base) noexcept { base_ = base; }
+  const scaling::BaseDriveOutput& drive() const noexcept { return drive_; }
   // The measured tip of the last step (zero without a valid measurement).
   const Eigen::Vector3d& tip() const noexcept { return builder_.tip(); }
   const Eigen::Vector3d& tip_velocity() const noexcept { return builder_.tip_velocity(); }
@@ -88,6 +98,8 @@ class TipCommandTask final : public CycleTask {
   LogRowBuilder builder_;
   ControllerOutput out_;
   TipCommand command_;
+  const dynamics::MobileBaseModel* base_ = nullptr;
+  scaling::BaseDriveOutput drive_;
 };
 
 }  // namespace craneassist::control

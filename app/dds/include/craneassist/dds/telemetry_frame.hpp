@@ -41,6 +41,15 @@ struct TelemetryFrame {
   double avail_speed_m_s = 0.0, avail_speed_resolved_m_s = 0.0;
   int polytope_dim = 0;
   double polytope_volume_m3_s3 = 0.0, polytope_area_m2_s2 = 0.0;
+  // The wheeled base under the crane (sim --drive; topic craneassist/base): pose in the world
+  // (x, y, heading), motion and drive command (forward speed, yaw rate), hub-motor flows (fl, fr,
+  // rl, rr), their sum and the drive pump's Q_max. base_present false: a fixed base.
+  bool base_present = false;
+  bool base_shared_pump = false;
+  std::array<double, 3> base_pose{};
+  std::array<double, 2> base_velocity{}, base_command{};
+  std::array<double, 4> base_motor_flow_m3_s{};
+  double base_flow_sum_m3_s = 0.0, base_flow_max_m3_s = 0.0;
 };
 static_assert(std::is_trivially_copyable_v<TelemetryFrame>);
 

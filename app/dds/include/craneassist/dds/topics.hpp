@@ -5,7 +5,7 @@
 
 namespace craneassist::dds {
 
-enum class Topic { kStatus, kJoints, kHydraulics, kCommandPath, kOperatorCommand };
+enum class Topic { kStatus, kJoints, kHydraulics, kCommandPath, kOperatorCommand, kBase };
 
 struct TopicInfo {
   Topic topic;
@@ -22,6 +22,7 @@ inline constexpr TopicInfo kTopics[] = {
      "craneassist::msg::CommandPath"},
     {Topic::kOperatorCommand, "operator_command", "craneassist/operator_command",
      "craneassist::msg::OperatorCommand"},
+    {Topic::kBase, "base", "craneassist/base", "craneassist::msg::BaseState"},
 };
 
 // The entry of a short or DDS name; nullptr when there is none.

@@ -50,6 +50,8 @@ struct FollowRow {
   double tool_error = 0, tool_error_filtered = 0, delta = 1;
   double q[4] = {0, 0, 0, 0};
   double arm_flow = 0;
+  double arm_flow_max =
+      0;  // what the crane's pump may deliver (less than its own with a shared pump)
   const char* limit = "";
 };
 
@@ -62,7 +64,10 @@ struct FollowSummary {
   double settled_at_s = -1.0;
   double peak_tool_error_settled_m = 0.0;
   double rms_tool_error_settled_m = 0.0;
-  double peak_flow_ratio = 0.0;  // sum of hub-motor flows over Q_max
+  // The sum of hub-motor flows over Q_max, plus the crane's pump flow when it shares the pump
+  // (BaseConfig::shared_with_crane); the motors alone.
+  double peak_flow_ratio = 0.0;
+  double peak_motor_flow_ratio = 0.0;
   double peak_commanded_flow_ratio = 0.0;
   double peak_slew_rate_rad_s = 0.0;
   double path_length_m = 0.0;

@@ -23,6 +23,7 @@
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/control/control_loop.hpp"
+#include "craneassist/dynamics/mobile_base.hpp"
 #include "craneassist/input/command_source.hpp"
 #include "craneassist/input/joystick_mapping.hpp"
 
@@ -35,6 +36,9 @@ struct WebOptions {
   bool commands = true;               // false: the page is a view only
   bool remote_commands = false;       // accept commands from other hosts (with the token)
   std::string token;                  // the session token; empty: a random one
+  // The wheeled base the crane stands on (sim --drive; kept by reference, it must outlive the
+  // server): the frames then carry the base and the crane's place on it. nullptr: a fixed base.
+  const dynamics::MobileBaseModel* base = nullptr;
 };
 
 struct WebCounters {

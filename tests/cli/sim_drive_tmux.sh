@@ -1,0 +1,50 @@
+#!/bin/sh
+# craneassist sim --drive with the keyboard in a real terminal (docs/mobile.md#live): a detached
+# tmux session, keys sent with send-keys at a terminal's auto-repeat rate. With the deadman on,
+# i (forward) and u (steer left) held drive the base forward and to the left while the tip
+# stays; the summary names where the base ended. One pump for the drive and the crane.
+# Usage: sim_drive_tmux.sh CRANEASSIST
+set -eu
+bin=$1
+command -v tmux >/dev/null || { echo "tmux is not installed (tools/install-deps.sh)"; exit 1; }
+work=$(mktemp -d)
+sock="$work/tmux.sock"
+session=craneassist_drive
+cleanup() { tmux -S "$sock" kill-server 2>/dev/null || true; rm -rf "$work"; }
+trap cleanup EXIT
+
+pane() { tmux -S "$sock" capture-pane -p -t "$session" | grep -v "^ *$"; }
+keys() { tmux -S "$sock" send-keys -t "$session" "$@"; }
+wait_for() {
+  i=0
+  while ! pane | grep -q -- "$1"; do
+    i=$((i + 1))
+    if [ $i -gt $(($2 * 10)) ]; then
+      echo "timed out waiting for '$1'; the pane:"; pane; exit 1
+    fi
+    sleep 0.1
+  done
+}
+
+tmux -S "$sock" new-session -d -s "$session" -x 220 -y 40 sh
+keys "$bin sim --drive --pump shared --no-telemetry; echo DRIVE-\$((40 + 2))" Enter
+wait_for "drive: i/k forward/back" 10
+wait_for "base x" 5
+keys Space
+wait_for "deadman ON" 3
+sleep 0.5
+# i and u held together: each auto-repeats every 60 ms.
+n=0
+while [ $n -lt 50 ]; do keys i; sleep 0.03; keys u; sleep 0.03; n=$((n + 1)); done
+sleep 1.0
+keys q
+wait_for DRIVE-42 10
+pane | tail -8
+line=$(pane | grep "base: at x")
+echo "$line" | grep -q "one pump for the drive and the crane" || { echo "no shared pump"; exit 1; }
+echo "$line" | awk '{
+  x = $4 + 0; y = $7 + 0; h = $10 + 0
+  ok = (x > 0.1) && (y > 0.0) && (h > 1.0)
+  if (!ok) { print "the base did not drive forward and left: " $0; exit 1 }
+}'
+echo "drive session OK"
