@@ -82,6 +82,19 @@ msg::Hydraulics hydraulics_sample(std::uint64_t cycle) {
   return m;
 }
 
+msg::BaseState base_sample(std::uint64_t cycle) {
+  msg::BaseState m;
+  m.header(header_of(cycle));
+  m.pose({1.0, 2.0, 0.1});
+  m.velocity({0.3, 0.01});
+  m.command({0.3, 0.01});
+  m.motor_flow_m3_s({2e-4, 2e-4, 2e-4, 2e-4});
+  m.motor_flow_sum_m3_s(8e-4);
+  m.drive_max_flow_m3_s(1.05e-3);
+  m.shared_pump(false);
+  return m;
+}
+
 msg::CommandPath command_path_sample(std::uint64_t cycle) {
   msg::CommandPath m;
   m.header(header_of(cycle));
@@ -127,6 +140,13 @@ Payload bad_bool(dds::Topic topic) {
       p = serialized<msg::CommandPathPubSubType>(m);
       m.deadman(true);
       q = serialized<msg::CommandPathPubSubType>(m);
+      break;
+    }
+    case dds::Topic::kBase: {
+      msg::BaseState m = base_sample(1);
+      p = serialized<msg::BaseStatePubSubType>(m);
+      m.shared_pump(true);
+      q = serialized<msg::BaseStatePubSubType>(m);
       break;
     }
     case dds::Topic::kHydraulics:
@@ -189,6 +209,8 @@ Payload telemetry_payload(dds::Topic topic, std::uint64_t cycle) {
       return serialized<msg::HydraulicsPubSubType>(hydraulics_sample(cycle));
     case dds::Topic::kCommandPath:
       return serialized<msg::CommandPathPubSubType>(command_path_sample(cycle));
+    case dds::Topic::kBase:
+      return serialized<msg::BaseStatePubSubType>(base_sample(cycle));
     case dds::Topic::kOperatorCommand:
       break;
   }

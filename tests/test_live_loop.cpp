@@ -451,7 +451,9 @@ TEST(LiveLoop, DriveModeMovesTheBaseWithinTheFlowBoundAndStopsWithTheDeadman) {
       ASSERT_TRUE(r.base_present);
       EXPECT_EQ(r.base_shared_pump, shared);
       ASSERT_LE(r.base_flow_sum_m3s, q_max * (1 + 1e-9)) << "t = " << r.t;
-      if (shared) ASSERT_LE(r.base_flow_sum_m3s + r.pump_flow_m3s, q_max * (1 + 1e-9)) << r.t;
+      if (shared) {
+        ASSERT_LE(r.base_flow_sum_m3s + r.pump_flow_m3s, q_max * (1 + 1e-9)) << r.t;
+      }
       ASSERT_LE(r.base_command[0], v_max * (1 + 1e-9));
       if (r.base_command[0] > 0.0) {
         EXPECT_NEAR(r.base_command[1] / r.base_command[0], kappa, 1e-9);  // the curvature
