@@ -53,8 +53,8 @@ struct BaseRun {
 };
 
 BaseRun run(const dynamics::MobileBaseModel& model, const scaling::CompositeBezierPath& path,
-        const scaling::BaseFollowerConfig& fc, const dynamics::BasePose& start,
-        double settle_s = 1e9, double delta = 1.0, double max_s = 1000.0) {
+            const scaling::BaseFollowerConfig& fc, const dynamics::BasePose& start,
+            double settle_s = 1e9, double delta = 1.0, double max_s = 1000.0) {
   scaling::BasePathFollower follower(model, path, fc);
   sim_backend::MobileBaseSim sim(model, start);
   scaling::BaseFollowerOutput out;
