@@ -21,10 +21,13 @@ struct PtpArgs {
   std::string table;           // posture table file; empty: the default cache
   std::optional<double> heuristic_scale;
   int threads = 2;
-  std::string out;  // joint trajectory CSV; empty: none
-  bool simulate = false;               // run the plan on the MHSB simulator
-  std::string simulate_log;            // its per-period CSV; empty: none
-  std::vector<std::string> goal_at;    // "T:X,Z" goal changes (with --simulate)
+  std::string posture = "optimal";   // optimal | fixed-last:ANGLE (paper 001 Case 4)
+  std::string out;                   // joint trajectory CSV; empty: none
+  std::string path_out;              // the S2 path's nodes as CSV; empty: none
+  std::string workspace_out;         // the grid's nodes with their all-N posture; empty: none
+  bool simulate = false;             // run the plan on the MHSB simulator
+  std::string simulate_log;          // its per-period CSV; empty: none
+  std::vector<std::string> goal_at;  // "T:X,Z" goal changes (with --simulate)
 };
 
 CLI::App* add_ptp_command(CLI::App& cli, PtpArgs& args);
