@@ -37,7 +37,7 @@ CASE4_J3_DEG = (70.0, 120.0)
 FIELDS = [
     "case", "group", "description", "from_x_m", "from_z_m", "to_x_m", "to_z_m", "w1", "w2", "w3",
     "options", "s2_nodes", "s2_length_m", "s2_time_s", "s2_energy_j", "s2_switches", "time_s",
-    "energy_j", "length_m", "switches", "peak_speed_ratio", "planning_ms", "s2_modes",
+    "energy_j", "length_m", "switches", "peak_speed_ratio", "s2_mean_area_m2_s2", "planning_ms", "s2_modes",
     "sim_energy_j", "sim_planned_j", "sim_main_j", "sim_servo_pump_j", "sim_max_error_deg",
     "sim_max_p_supply_mpa", "paper_time_s", "paper_energy_j", "paper_s2_energy_j",
     "paper_max_error_deg", "note",
@@ -112,6 +112,12 @@ class Runner:
                    paper_s2_energy_j=paper[2] or "", paper_max_error_deg=paper_error or "",
                    note=note)
         row.update(parse(out.stdout))
+        if files:
+            # The mean flow manipulability polytope area over the S2 path's postures (Case 4).
+            with open(stem + ".path.csv") as f:
+                nodes = list(csv.DictReader(line for line in f if not line.startswith("#")))
+            row["s2_mean_area_m2_s2"] = "%.3f" % (
+                sum(float(n["area_m2_s2"]) for n in nodes) / len(nodes))
         self.rows.append(row)
         print(f"  {case:>14}: S2 {row.get('s2_energy_j')} J {row.get('s2_time_s')} s; S3/S4 "
               f"{row.get('energy_j')} J {row.get('time_s')} s; simulated "

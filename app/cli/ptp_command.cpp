@@ -113,8 +113,8 @@ int write_path(const planner::PlanarArm& arm, const planner::PostureTable& table
   std::ostringstream out;
   out << "# craneassist ptp: the S2 path (docs/mhsb.md); t_s, energy_j: S2's arrival and energy "
          "spent; t_trajectory_s: when the S3/S4 trajectory passes the node; q: the moving "
-         "joints, rad\n";
-  out << "step,x_m,z_m,pattern,t_s,energy_j,t_trajectory_s";
+         "joints, rad; area_m2_s2: the posture's flow manipulability polytope area\n";
+  out << "step,x_m,z_m,pattern,t_s,energy_j,t_trajectory_s,area_m2_s2";
   for (int k = 0; k < arm.moving(); ++k) {
     out << ",q_" << arm.model().joints[static_cast<std::size_t>(arm.joint(k))].name << "_rad";
   }
@@ -125,9 +125,10 @@ int write_path(const planner::PlanarArm& arm, const planner::PostureTable& table
     const Eigen::Vector2d xz = table.grid().node_xz[static_cast<std::size_t>(s.node)];
     char line[200];
     std::snprintf(
-        line, sizeof line, "%zu,%.4f,%.4f,%s,%.4f,%.3f,%.4f", i, xz.x(), xz.y(),
+        line, sizeof line, "%zu,%.4f,%.4f,%s,%.4f,%.3f,%.4f,%.6g", i, xz.x(), xz.y(),
         dynamics::to_string(table.patterns()[static_cast<std::size_t>(s.pattern)]).c_str(), s.t_s,
-        s.energy_j, i < plan.node_times_s.size() ? plan.node_times_s[i] : s.t_s);
+        s.energy_j, i < plan.node_times_s.size() ? plan.node_times_s[i] : s.t_s,
+        table.area(s.node, s.pattern));
     out << line;
     for (int k = 0; k < arm.moving(); ++k) {
       std::snprintf(line, sizeof line, ",%.6f", s.q[k]);
@@ -228,9 +229,10 @@ CLI::App* add_ptp_command(CLI::App& cli, PtpArgs& args) {
                   "last joint held at ANGLE, degrees or with a unit, changed 1 deg at a time "
                   "where the other joints cannot reach a node)");
   cmd->add_option("-o,--out", args.out, "Write the joint trajectory with mode columns to this CSV");
-  cmd->add_option("--path-out", args.path_out,
-                  "Write the S2 path's nodes (X, Z, mode pattern, time, energy, posture) to this "
-                  "CSV");
+  cmd->add_option(
+      "--path-out", args.path_out,
+      "Write the S2 path's nodes (X, Z, mode pattern, time, energy, polytope area, posture) to "
+      "this CSV");
   cmd->add_option("--workspace-out", args.workspace_out,
                   "Write the grid's nodes with the all-N posture of the posture table, its "
                   "polytope area and which joints need a boost to hold the load there, to this "
