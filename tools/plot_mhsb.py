@@ -109,8 +109,8 @@ def plot_paths(work, out):
     panels = [
         ("Case 1: lifting 10 kg", [("1-1", "tab:green", "1-1 energy-optimal"),
                                    ("1-2", "navy", "1-2 shortest time")], "1-1"),
-        ("Cases 2 and 3", [("2-1", "navy", "2-1"), ("2-2", "darkviolet", "2-2"),
-                           ("3-1", "tab:green", "3-1"), ("3-2", "crimson", "3-2")], None),
+        ("Case 2: unloading", [("2-1", "navy", "2-1"), ("2-2", "darkviolet", "2-2")], "2-2"),
+        ("Case 3: full range", [("3-1", "tab:green", "3-1"), ("3-2", "crimson", "3-2")], "3-2"),
         ("Case 4: posture table vs fixed J3", [("4-1", "tab:green", "4-1 posture table"),
                                                ("4-2", "navy", "4-2 J3 held at 70 deg"),
                                                ("4-3", "crimson", "4-3 J3 held at 120 deg")],
@@ -118,16 +118,17 @@ def plot_paths(work, out):
     ]
     if not work.has("1-1"):
         return skip("mhsb_paths.png", "no Case 1-1 run")
-    fig, axes = plt.subplots(1, 3, figsize=(16, 6.5))
-    for ax, (title, runs, s2_case) in zip(axes, panels):
+    fig, axes = plt.subplots(2, 2, figsize=(13, 13))
+    for ax, (title, runs, s2_case) in zip(axes.flat, panels):
         workspace_background(ax, work)
-        for case, colour, label in runs:
+        for i, (case, colour, label) in enumerate(runs):
             if not work.has(case):
                 continue
             r = work.results.get(case, {})
             x, z = tip_path(work.traj(case), work.lengths)
-            ax.plot(x, z, color=colour, lw=2, label=f"{label}: {r.get('energy_j', '?')} J, "
-                    f"{r.get('time_s', '?')} s", zorder=4)
+            # Later runs thinner, on top: overlapping paths stay visible.
+            ax.plot(x, z, color=colour, lw=3.5 - i, zorder=4,
+                    label=f"{label}: {r.get('energy_j', '?')} J, {r.get('time_s', '?')} s")
             p = work.path(case)
             px = [float(n["x_m"]) for n in p]
             pz = [float(n["z_m"]) for n in p]
@@ -142,8 +143,8 @@ def plot_paths(work, out):
         ax.set_title(title)
         ax.legend(fontsize=7, loc="lower left")
     fig.suptitle("Paper 001's cases on our arm: tip paths (S3/S4 trajectory; dashed: the S2 "
-                 "path, open circles: nodes reached in a boost pattern) over the mode regions of "
-                 "the optimal table's all-N postures (lifting at V_L)", fontsize=10)
+                 "path, open circles: nodes reached in a boost pattern)\nover the mode regions of "
+                 "the optimal table's all-N postures (lifting at V_L)", fontsize=11)
     fig.tight_layout()
     save(fig, out, "mhsb_paths.png")
 
