@@ -196,7 +196,7 @@ TEST(PostureTable, FixedLastJointHoldsItWhereverTheOthersReachTheNode) {
   ASSERT_EQ(table.pattern_count(), 3);
   dynamics::KinematicsData data;
   planner::PolytopeArea area(arm());
-  int moved = 0;
+  int moved = 0, curled_nodes = 0;
   for (int n = 0; n < table.grid().nodes(); ++n) {
     const Eigen::Vector2d node = table.grid().node_xz[static_cast<std::size_t>(n)];
     const ArmVector q = table.posture(n, 0);
@@ -221,14 +221,22 @@ TEST(PostureTable, FixedLastJointHoldsItWhereverTheOthersReachTheNode) {
             << "node " << node.transpose() << " reachable with J3 at " << q3 * 180 / M_PI;
       }
     }
-    // J1, J2 are one of the analytic solutions at that J3.
+    // J1, J2 are one of the analytic solutions at that J3, bent J3's way when one is.
     double nearest = 1e9;
-    for (const auto& a : fixed_j3_solutions(node, q[2]))
+    bool curled = false;
+    for (const auto& a : fixed_j3_solutions(node, q[2])) {
       nearest = std::min(nearest, (a - q).norm());
+      curled = curled || a[1] * a[2] >= 0.0;
+    }
     EXPECT_LT(nearest, 1e-6) << "node " << node.transpose();
+    if (curled) {
+      EXPECT_GE(q[1] * q[2], 0.0) << "node " << node.transpose();
+      ++curled_nodes;
+    }
     if (steps != 0.0) ++moved;
   }
   EXPECT_EQ(moved, table.moved_last_joint);
+  EXPECT_GT(curled_nodes, table.grid().nodes() / 2);
   // At 120 deg the arm reaches 0.80 m at most: the far nodes need J3 moved, the near ones not.
   EXPECT_GT(moved, 0);
   EXPECT_LT(moved, table.grid().nodes() / 2);

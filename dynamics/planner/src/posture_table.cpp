@@ -513,14 +513,17 @@ PostureTable PostureTable::fixed_last_joint(const PlanarArm& arm,
   for (int node = 0; node < nodes; ++node) {
     const Eigen::Vector2d target = t.grid_.node_xz[at(node)];
     const auto& starts = w.starts[at(node)];
-    // The solution nearest the reference for the last joint at `last`, if any.
+    // For the last joint at `last`, the solution whose middle joints bend most the way the last
+    // one does, then the nearest the reference, if any.
     const auto solve = [&](double last, ArmVector& out) {
       bool found = false;
       double best = kInf;
       for (std::size_t s = 0; s <= starts.size(); ++s) {
         ArmVector a = s < starts.size() ? starts[s] : reference;
         if (!solve_with_last_fixed(arm, data, target, last, a)) continue;
-        const double d = (a - reference).head(m - 1).norm();
+        int against = 0;  // middle joints bent against the last one
+        for (int k = 1; k + 1 < m; ++k) against += a[k] * last < 0.0 ? 1 : 0;
+        const double d = 100.0 * against + (a - reference).head(m - 1).norm();
         if (d < best) {
           best = d;
           out = a;

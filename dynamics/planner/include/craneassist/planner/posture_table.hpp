@@ -119,11 +119,12 @@ class PostureTable {
   // same grid as build()'s, the other joints come from the inverse kinematics with the last joint
   // there; where no solution lies within the ranges, the last joint is changed by step (rad; the
   // paper: 1 degree) at a time, +step, -step, +2 step, ... from last_joint, until one does. Of
-  // several solutions (elbow up or down) the one nearest the arm's reference posture (q_hold with
-  // the last joint at last_joint) is kept. Every pattern gets the node's posture, with its own
-  // polytope area. Not cached (it takes about a second). Throws std::invalid_argument when the
-  // arm has fewer than two moving joints, its last one is not revolute, or last_joint is outside
-  // the joint's range.
+  // the solutions (elbow up or down) the one whose middle joints bend the way the last one does
+  // (the arm curled one way, as the optimal table's postures of the paper's arm), then the one
+  // nearest the arm's reference posture (q_hold with the last joint at last_joint), is kept. Every
+  // pattern gets the node's posture, with its own polytope area. Not cached (it takes about a
+  // second). Throws std::invalid_argument when the arm has fewer than two moving joints, its last
+  // one is not revolute, or last_joint is outside the joint's range.
   static PostureTable fixed_last_joint(const PlanarArm& arm, const PostureTableSettings& settings,
                                        double last_joint, double step = M_PI / 180.0);
   // Whether the table is the optimal one (build(), load()) or fixed_last_joint()'s.
