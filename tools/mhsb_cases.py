@@ -37,7 +37,8 @@ CASE4_J3_DEG = (70.0, 120.0)
 FIELDS = [
     "case", "group", "description", "from_x_m", "from_z_m", "to_x_m", "to_z_m", "w1", "w2", "w3",
     "options", "s2_nodes", "s2_length_m", "s2_time_s", "s2_energy_j", "s2_switches", "time_s",
-    "energy_j", "length_m", "switches", "peak_speed_ratio", "s2_mean_area_m2_s2", "planning_ms", "s2_modes",
+    "energy_j", "length_m", "switches", "peak_speed_ratio", "s2_mean_area_m2_s2",
+    "s2_mean_n_area_m2_s2", "goal_n_area_m2_s2", "planning_ms", "s2_modes",
     "sim_energy_j", "sim_planned_j", "sim_main_j", "sim_servo_pump_j", "sim_max_error_deg",
     "sim_max_p_supply_mpa", "paper_time_s", "paper_energy_j", "paper_s2_energy_j",
     "paper_max_error_deg", "note",
@@ -99,6 +100,8 @@ class Runner:
             cmd += ["-o", stem + ".traj.csv", "--path-out", stem + ".path.csv"]
         if simulate:
             cmd += ["--simulate", *extra]
+        if case.startswith("4-"):
+            cmd += ["--workspace-out", stem + ".workspace.csv"]
         t0 = time.time()
         out = subprocess.run(cmd, capture_output=True, text=True)
         if out.returncode != 0:
@@ -118,6 +121,15 @@ class Runner:
                 nodes = list(csv.DictReader(line for line in f if not line.startswith("#")))
             row["s2_mean_area_m2_s2"] = "%.3f" % (
                 sum(float(n["area_m2_s2"]) for n in nodes) / len(nodes))
+            if case.startswith("4-"):
+                # The all-N polytope of the postures along the path and at the goal (the paper's
+                # Figure 9 compares them): the same pattern for every method.
+                with open(stem + ".workspace.csv") as f:
+                    grid = {(r["x_m"], r["z_m"]): float(r["area_m2_s2"]) for r in csv.DictReader(
+                        line for line in f if not line.startswith("#"))}
+                areas = [grid[(n["x_m"], n["z_m"])] for n in nodes]
+                row["s2_mean_n_area_m2_s2"] = "%.3f" % (sum(areas) / len(areas))
+                row["goal_n_area_m2_s2"] = "%.3f" % areas[-1]
         self.rows.append(row)
         print(f"  {case:>14}: S2 {row.get('s2_energy_j')} J {row.get('s2_time_s')} s; S3/S4 "
               f"{row.get('energy_j')} J {row.get('time_s')} s; simulated "

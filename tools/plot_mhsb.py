@@ -309,6 +309,45 @@ def plot_moving_goal(work, out):
     save(fig, out, "mhsb_moving_goal.png")
 
 
+def pct(a, b):
+    return f"{100.0 * (float(a) - float(b)) / float(b):+.1f} %"
+
+
+def markdown_table(work):
+    """The side-by-side table of docs/mhsb.md: paper | ours planned | ours simulated."""
+    rows = ["| case | weights | paper: time, energy | ours planned: S2 time, energy; S3/S4 time, "
+            "energy, tip path | ours simulated: energy (against planned), largest joint error |",
+            "| --- | --- | --- | --- | --- |"]
+    for r in work.results.values():
+        if r["group"] not in ("1", "2", "3", "4", "5p", "goal"):
+            continue
+        paper = ", ".join(x for x in (f"{r['paper_time_s']} s" if r["paper_time_s"] else "",
+                                      f"{r['paper_energy_j']} J" if r["paper_energy_j"] else "",
+                                      f"S2 {r['paper_s2_energy_j']} J"
+                                      if r["paper_s2_energy_j"] else "",
+                                      f"error {r['paper_max_error_deg']} deg"
+                                      if r["paper_max_error_deg"] else "") if x)
+        sim = (f"{r['sim_energy_j']} J ({pct(r['sim_energy_j'], r['sim_planned_j'])}), "
+               f"{r['sim_max_error_deg']} deg" if r["sim_energy_j"] else "")
+        rows.append(f"| {r['case']} {r['description']} | {r['w1']}, {r['w2']}, {r['w3']} | "
+                    f"{paper} | {r['s2_time_s']} s, {r['s2_energy_j']} J; {r['time_s']} s, "
+                    f"{r['energy_j']} J, {r['length_m']} m | {sim} |")
+    return "\n".join(rows) + "\n"
+
+
+def update_doc(doc, table):
+    """Replaces the text between the doc's mhsb-cases markers with the table."""
+    begin, end = "<!-- mhsb-cases table: begin -->\n", "<!-- mhsb-cases table: end -->"
+    with open(doc) as f:
+        text = f.read()
+    i, k = text.find(begin), text.find(end)
+    if i < 0 or k < i:
+        sys.exit(f"plot_mhsb: {doc} has no '{begin.strip()}' ... '{end}' markers")
+    with open(doc, "w") as f:
+        f.write(text[:i + len(begin)] + table + text[k:])
+    print(f"plot_mhsb: updated the table in {doc}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -317,6 +356,8 @@ def main():
     ap.add_argument("outdir")
     ap.add_argument("--config", default=os.path.join(os.path.dirname(__file__), "..", "config",
                                                      "cranes", "mhsb_3link.yaml"))
+    ap.add_argument("--doc", help="a Markdown file whose table between the mhsb-cases "
+                    "markers is rewritten from RESULTS")
     args = ap.parse_args()
     work = Work(args.work, args.results, args.config)
     os.makedirs(args.outdir, exist_ok=True)
@@ -324,6 +365,8 @@ def main():
     plot_case1_joints(work, args.outdir)
     plot_case5(work, args.outdir)
     plot_moving_goal(work, args.outdir)
+    if args.doc:
+        update_doc(args.doc, markdown_table(work))
 
 
 if __name__ == "__main__":
