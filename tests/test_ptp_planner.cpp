@@ -162,6 +162,88 @@ TEST(PostureTable, TheFileRoundTripsAndAnotherModelOrGridRebuilds) {
   std::filesystem::remove(file);
 }
 
+// The 2R inverse kinematics of the paper's arm with J3 held at q3: both elbows, within the ranges.
+std::vector<ArmVector> fixed_j3_solutions(const Eigen::Vector2d& node, double q3) {
+  const double l1 = 0.45, l2 = 0.4, l3 = 0.179;
+  // Joint 2 to the tip with J3 at q3: a link of length r at angle beta to link 2.
+  const Eigen::Vector2d b(l2 + l3 * std::cos(q3), l3 * std::sin(q3));
+  const double r = b.norm(), beta = std::atan2(b.y(), b.x());
+  const double c = (node.squaredNorm() - l1 * l1 - r * r) / (2 * l1 * r);
+  std::vector<ArmVector> out;
+  if (std::abs(c) > 1.0) return out;
+  for (const double elbow : {1.0, -1.0}) {
+    const double g = elbow * std::acos(c);  // the angle of link "r" to link 1
+    ArmVector a(3);
+    a[0] = std::atan2(node.y(), node.x()) - std::atan2(r * std::sin(g), l1 + r * std::cos(g));
+    a[1] = std::remainder(g - beta, 2 * M_PI);
+    a[2] = q3;
+    a[0] = std::remainder(a[0], 2 * M_PI);
+    bool inside = true;
+    for (int k = 0; k < 3; ++k) inside = inside && a[k] >= arm().lower(k) && a[k] <= arm().upper(k);
+    if (inside) out.push_back(a);
+  }
+  return out;
+}
+
+// Paper 001's Case 4 conventional method: J3 held where the other joints can reach the node, else
+// changed by the fewest 1-degree steps; J1, J2 one of the inverse kinematics' solutions.
+TEST(PostureTable, FixedLastJointHoldsItWhereverTheOthersReachTheNode) {
+  const auto settings = region_settings(0.1, 3);
+  const double held = 120.0 * M_PI / 180.0, step = M_PI / 180.0;
+  const auto table = planner::PostureTable::fixed_last_joint(arm(), settings, held);
+  EXPECT_FALSE(table.optimal());
+  ASSERT_GT(table.grid().nodes(), 20);
+  ASSERT_EQ(table.pattern_count(), 3);
+  dynamics::KinematicsData data;
+  planner::PolytopeArea area(arm());
+  int moved = 0, curled_nodes = 0;
+  for (int n = 0; n < table.grid().nodes(); ++n) {
+    const Eigen::Vector2d node = table.grid().node_xz[static_cast<std::size_t>(n)];
+    const ArmVector q = table.posture(n, 0);
+    EXPECT_LT((arm().tip(q, data) - node).norm(), 1e-6);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE(q[k], arm().lower(k));
+      EXPECT_LE(q[k], arm().upper(k));
+    }
+    for (int p = 1; p < table.pattern_count(); ++p) EXPECT_EQ(table.posture(n, p), q);
+    for (int p = 0; p < table.pattern_count(); ++p) {
+      const auto full = planner::full_pattern(arm(), table.patterns()[static_cast<std::size_t>(p)]);
+      EXPECT_NEAR(area(q, full), table.area(n, p), 1e-12);
+    }
+    // J3 is on the 1-degree ladder from the held angle, and no rung nearer it has a solution.
+    const double steps = std::round((q[2] - held) / step);
+    EXPECT_NEAR(q[2], held + steps * step, 1e-9) << "node " << node.transpose();
+    for (int s = 0; s < std::abs(steps); ++s) {
+      for (const double sign : {1.0, -1.0}) {
+        const double q3 = held + sign * s * step;
+        if (q3 < arm().lower(2) || q3 > arm().upper(2)) continue;
+        EXPECT_TRUE(fixed_j3_solutions(node, q3).empty())
+            << "node " << node.transpose() << " reachable with J3 at " << q3 * 180 / M_PI;
+      }
+    }
+    // J1, J2 are one of the analytic solutions at that J3, bent J3's way when one is.
+    double nearest = 1e9;
+    bool curled = false;
+    for (const auto& a : fixed_j3_solutions(node, q[2])) {
+      nearest = std::min(nearest, (a - q).norm());
+      curled = curled || a[1] * a[2] >= 0.0;
+    }
+    EXPECT_LT(nearest, 1e-6) << "node " << node.transpose();
+    if (curled) {
+      EXPECT_GE(q[1] * q[2], 0.0) << "node " << node.transpose();
+      ++curled_nodes;
+    }
+    if (steps != 0.0) ++moved;
+  }
+  EXPECT_EQ(moved, table.moved_last_joint);
+  EXPECT_GT(curled_nodes, table.grid().nodes() / 2);
+  // At 120 deg the arm reaches 0.80 m at most: the far nodes need J3 moved, the near ones not.
+  EXPECT_GT(moved, 0);
+  EXPECT_LT(moved, table.grid().nodes() / 2);
+  EXPECT_THROW(planner::PostureTable::fixed_last_joint(arm(), settings, 2.5),
+               std::invalid_argument);
+}
+
 // Every pair of some nodes, several weights: A* and Dijkstra find the same cost.
 TEST(PtpPlanner, AStarCostEqualsDijkstras) {
   planner::PtpPlanner ptp(arm(), small_table(), {});

@@ -87,6 +87,91 @@ int simulate(planner::PtpPlanner& ptp, const Eigen::Vector2d& from, const Eigen:
   return kExitOk;
 }
 
+// --path-out: the S2 path's nodes, and when the time trajectory passes each.
+int write_path(const planner::PlanarArm& arm, const planner::PostureTable& table,
+               const planner::PtpPlan& plan, const std::string& file) {
+  std::ostringstream out;
+  out << "# craneassist ptp: the S2 path (docs/mhsb.md); t_s, energy_j: S2's arrival and energy "
+         "spent; t_trajectory_s: when the S3/S4 trajectory passes the node; q: the moving "
+         "joints, rad; area_m2_s2: the posture's flow manipulability polytope area\n";
+  out << "step,x_m,z_m,pattern,t_s,energy_j,t_trajectory_s,area_m2_s2";
+  for (int k = 0; k < arm.moving(); ++k) {
+    out << ",q_" << arm.model().joints[static_cast<std::size_t>(arm.joint(k))].name << "_rad";
+  }
+  out << '\n';
+  const auto& steps = plan.path.steps;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const auto& s = steps[i];
+    const Eigen::Vector2d xz = table.grid().node_xz[static_cast<std::size_t>(s.node)];
+    char line[200];
+    std::snprintf(
+        line, sizeof line, "%zu,%.4f,%.4f,%s,%.4f,%.3f,%.4f,%.6g", i, xz.x(), xz.y(),
+        dynamics::to_string(table.patterns()[static_cast<std::size_t>(s.pattern)]).c_str(), s.t_s,
+        s.energy_j, i < plan.node_times_s.size() ? plan.node_times_s[i] : s.t_s,
+        table.area(s.node, s.pattern));
+    out << line;
+    for (int k = 0; k < arm.moving(); ++k) {
+      std::snprintf(line, sizeof line, ",%.6f", s.q[k]);
+      out << line;
+    }
+    out << '\n';
+  }
+  char what[64];
+  std::snprintf(what, sizeof what, "%zu S2 nodes", steps.size());
+  return write_output(out.str(), file, what);
+}
+
+// --workspace-out: per node the all-N posture, its polytope area, and per moving joint whether it
+// needs a boost there (dynamics::needs_boost) to hold its load from P0, and to move against it at
+// V_L.
+int write_workspace(const planner::PtpPlanner& ptp, const std::string& file) {
+  const planner::PlanarArm& arm = ptp.arm();
+  const planner::PostureTable& table = ptp.table();
+  int all_n = -1;
+  for (int p = 0; p < table.pattern_count() && all_n < 0; ++p) {
+    bool n = true;
+    for (int k = 0; k < arm.moving(); ++k) {
+      n = n && table.patterns()[static_cast<std::size_t>(p)].mode[static_cast<std::size_t>(k)] ==
+                   dynamics::MhsbMode::kNormal;
+    }
+    if (n) all_n = p;
+  }
+  const auto& model = arm.model();
+  std::ostringstream out;
+  out << "# craneassist ptp: the posture table's grid (" << table.grid().nodes()
+      << " nodes) with the all-N posture (rad), its polytope area (m^2/s^2), the cylinder forces "
+         "that hold the load (N) and whether each joint needs a boost from P0 (1) or not (0) to "
+         "hold it (hold_) and to move against it at V_L (lift_)\n";
+  out << "x_m,z_m,area_m2_s2";
+  for (int k = 0; k < arm.moving(); ++k) {
+    const auto& name = model.joints[static_cast<std::size_t>(arm.joint(k))].name;
+    out << ",q_" << name << "_rad,force_" << name << "_n,hold_" << name << ",lift_" << name;
+  }
+  out << '\n';
+  dynamics::KinematicsData data;
+  planner::PlanarArm::Statics statics;
+  for (int n = 0; n < table.grid().nodes(); ++n) {
+    const Eigen::Vector2d xz = table.grid().node_xz[static_cast<std::size_t>(n)];
+    const planner::ArmVector q = table.posture(n, all_n);
+    arm.statics(q, data, statics);
+    char line[160];
+    std::snprintf(line, sizeof line, "%.4f,%.4f,%.6g", xz.x(), xz.y(), table.area(n, all_n));
+    out << line;
+    for (int k = 0; k < arm.moving(); ++k) {
+      const double f = statics.force_n[k], direction = f < 0.0 ? -1.0 : 1.0;
+      const bool hold = dynamics::needs_boost(model, arm.joint(k), f, 1e-9 * direction);
+      const bool lift =
+          dynamics::needs_boost(model, arm.joint(k), f, ptp.velocity_limit_m_s(k) * direction);
+      std::snprintf(line, sizeof line, ",%.6f,%.1f,%d,%d", q[k], f, hold ? 1 : 0, lift ? 1 : 0);
+      out << line;
+    }
+    out << '\n';
+  }
+  char what[64];
+  std::snprintf(what, sizeof what, "%d nodes", table.grid().nodes());
+  return write_output(out.str(), file, what);
+}
+
 }  // namespace
 
 // "a,b,..." as exactly `count` finite numbers, or a CLI::ValidationError naming the option.
@@ -109,6 +194,20 @@ std::vector<double> parse_numbers(const std::string& option, const std::string& 
   return values;
 }
 
+void check_in_workspace(const planner::WorkspaceGrid& grid, const std::string& crane,
+                        const std::vector<std::pair<std::string, Eigen::Vector2d>>& points) {
+  const double reach = 0.5 * std::sqrt(2.0) * grid.spacing_m + 1e-9;
+  for (const auto& [option, p] : points) {
+    if (grid.nearest_node(p, reach) < 0) {
+      char why[160];
+      std::snprintf(why, sizeof why,
+                    "%s is outside the workspace of %s (no reachable grid node within %.1f cm)",
+                    point_text(p).c_str(), crane.c_str(), 100.0 * reach);
+      throw CLI::ValidationError(option, why);
+    }
+  }
+}
+
 LoadedTable posture_table_for(const config::CraneConfig& cfg, const planner::PlanarArm& arm,
                               const planner::PostureTableSettings& settings,
                               const std::string& table_option,
@@ -119,22 +218,10 @@ LoadedTable posture_table_for(const config::CraneConfig& cfg, const planner::Pla
   std::optional<planner::PostureTable> table;
   if (out.file) table = planner::PostureTable::load(*out.file, arm, settings);
   out.loaded = table.has_value();
-  const auto check_points = [&](const planner::WorkspaceGrid& grid) {
-    const double reach = 0.5 * std::sqrt(2.0) * grid.spacing_m + 1e-9;
-    for (const auto& [option, p] : points) {
-      if (grid.nearest_node(p, reach) < 0) {
-        char why[160];
-        std::snprintf(why, sizeof why,
-                      "%s is outside the workspace of %s (no reachable grid node within %.1f cm)",
-                      point_text(p).c_str(), cfg.model.name.c_str(), 100.0 * reach);
-        throw CLI::ValidationError(option, why);
-      }
-    }
-  };
   if (out.loaded) {
-    check_points(table->grid());
+    check_in_workspace(table->grid(), cfg.model.name, points);
   } else {
-    check_points(planner::sample_workspace(arm, settings).grid);
+    check_in_workspace(planner::sample_workspace(arm, settings).grid, cfg.model.name, points);
     std::fprintf(stderr, "craneassist: building the posture table (%d threads)...\n",
                  settings.threads);
     table = planner::PostureTable::build(arm, settings);
@@ -179,7 +266,20 @@ CLI::App* add_ptp_command(CLI::App& cli, PtpArgs& args) {
       ->check(FiniteRange(0.0, 1e12));
   cmd->add_option("--threads", args.threads, "Threads for building the posture table (default 2)")
       ->check(CLI::Range(1, 64));
+  cmd->add_option("--posture", args.posture,
+                  "Where the postures come from: optimal (default; the optimal posture table, "
+                  "S1) or fixed-last:ANGLE (the conventional method of paper 001's Case 4: the "
+                  "last joint held at ANGLE, degrees or with a unit, changed 1 deg at a time "
+                  "where the other joints cannot reach a node)");
   cmd->add_option("-o,--out", args.out, "Write the joint trajectory with mode columns to this CSV");
+  cmd->add_option(
+      "--path-out", args.path_out,
+      "Write the S2 path's nodes (X, Z, mode pattern, time, energy, polytope area, posture) to "
+      "this CSV");
+  cmd->add_option("--workspace-out", args.workspace_out,
+                  "Write the grid's nodes with the all-N posture of the posture table, its "
+                  "polytope area and which joints need a boost to hold the load there, to this "
+                  "CSV (the mode regions of paper 001's Figure 5)");
   cmd->add_flag("--simulate", args.simulate,
                 "Run the plan on the MHSB simulator under the paper's cascade controller and "
                 "compare the measured energy with the planned (docs/mhsb.md)");
@@ -199,6 +299,7 @@ int run_ptp_command(const PtpArgs& args) {
   planner::PtpWeights weights;
   Eigen::Vector2d from, to;
   std::vector<offline::PtpGoalChange> goal_changes;
+  std::optional<double> fixed_last;  // --posture fixed-last:ANGLE, rad
   try {
     cfg = load_crane(args.config_file);
     try {
@@ -238,6 +339,19 @@ int run_ptp_command(const PtpArgs& args) {
       settings.energy_model = *dynamics::parse_mhsb_energy_model(args.energy_model);
     }
     table_settings.threads = args.threads;
+    if (args.posture != "optimal") {
+      const std::string prefix = "fixed-last:";
+      if (args.posture.rfind(prefix, 0) != 0 || args.posture.size() == prefix.size()) {
+        throw CLI::ValidationError("--posture",
+                                   "'" + args.posture + "': expected optimal or fixed-last:ANGLE");
+      }
+      const std::string angle = args.posture.substr(prefix.size());
+      char* end = nullptr;
+      const double deg = std::strtod(angle.c_str(), &end);
+      fixed_last = end != angle.c_str() && *end == '\0' && std::isfinite(deg)
+                       ? deg * M_PI / 180.0
+                       : cli_quantity("--posture", angle, config::Dimension::kAngle);
+    }
     if (!args.goal_at.empty() && !args.simulate) {
       throw CLI::ValidationError("--goal-at", "goal changes need --simulate");
     }
@@ -257,12 +371,27 @@ int run_ptp_command(const PtpArgs& args) {
     return input_error_exit("config");
   }
 
+  // The table: with --posture fixed-last built by that rule (quick, not cached); else from its
+  // file when it matches, or built and written.
   std::vector<std::pair<std::string, Eigen::Vector2d>> points{{"--from", from}, {"--to", to}};
   for (const auto& g : goal_changes) points.emplace_back("--goal-at", g.xz);
-  LoadedTable loaded_table = posture_table_for(cfg, *arm, table_settings, args.table, points);
-  const std::optional<std::filesystem::path>& file = loaded_table.file;
-  const bool loaded = loaded_table.loaded;
-  std::optional<planner::PostureTable> table = std::move(loaded_table.table);
+  std::optional<std::filesystem::path> file;
+  bool loaded = false;
+  std::optional<planner::PostureTable> table;
+  if (fixed_last) {
+    try {
+      table = planner::PostureTable::fixed_last_joint(*arm, table_settings, *fixed_last);
+    } catch (const std::invalid_argument& e) {
+      spdlog::error("--posture: {}: {}", cfg.model.name, e.what());
+      return kExitUsage;
+    }
+    check_in_workspace(table->grid(), cfg.model.name, points);
+  } else {
+    LoadedTable loaded_table = posture_table_for(cfg, *arm, table_settings, args.table, points);
+    file = loaded_table.file;
+    loaded = loaded_table.loaded;
+    table = std::move(loaded_table.table);
+  }
   planner::PtpPlanner ptp(*arm, *table, settings);
   planner::PtpPlan plan;
   try {
@@ -277,7 +406,15 @@ int run_ptp_command(const PtpArgs& args) {
   std::printf("  posture table: %d nodes x %d patterns, %.0f mm grid, %s\n", grid.nodes(),
               table->pattern_count(), 1000.0 * grid.spacing_m,
               loaded ? ("loaded from " + file->string()).c_str() : "built");
-  if (!loaded) {
+  if (fixed_last) {
+    std::printf(
+        "    postures: %s held at %.1f deg, the others by inverse kinematics (paper 001 Case 4's "
+        "conventional method), %ld nodes with %s moved; %.2f s\n",
+        cfg.model.joints[static_cast<std::size_t>(arm->joint(arm->moving() - 1))].name.c_str(),
+        *fixed_last * 180.0 / M_PI, table->moved_last_joint,
+        cfg.model.joints[static_cast<std::size_t>(arm->joint(arm->moving() - 1))].name.c_str(),
+        table->build_time_s);
+  } else if (!loaded) {
     std::printf(
         "    in %.1f s (%d threads, %ld SLSQP runs, %ld entries without a converged run, %ld "
         "without polytope area)%s\n",
@@ -324,6 +461,12 @@ int run_ptp_command(const PtpArgs& args) {
   }
   if (cfg.model.mhsb) std::printf("  S2 modes: %s\n", modes_line.c_str());
 
+  if (!args.path_out.empty()) {
+    if (const int rc = write_path(*arm, *table, plan, args.path_out); rc != kExitOk) return rc;
+  }
+  if (!args.workspace_out.empty()) {
+    if (const int rc = write_workspace(ptp, args.workspace_out); rc != kExitOk) return rc;
+  }
   if (args.simulate) {
     if (const int rc = simulate(ptp, from, to, weights, goal_changes, args.simulate_log, plan);
         rc != kExitOk) {

@@ -27,7 +27,10 @@ struct PtpArgs {
   std::string table;           // posture table file; empty: the default cache
   std::optional<double> heuristic_scale;
   int threads = 2;
+  std::string posture = "optimal";   // optimal | fixed-last:ANGLE (paper 001 Case 4)
   std::string out;                   // joint trajectory CSV; empty: none
+  std::string path_out;              // the S2 path's nodes as CSV; empty: none
+  std::string workspace_out;         // the grid's nodes with their all-N posture; empty: none
   bool simulate = false;             // run the plan on the MHSB simulator
   std::string simulate_log;          // its per-period CSV; empty: none
   std::vector<std::string> goal_at;  // "T:X,Z" goal changes (with --simulate)
@@ -38,6 +41,11 @@ CLI::App* add_ptp_command(CLI::App& cli, PtpArgs& args);
 // "a,b,..." as exactly `count` finite numbers, or a CLI::ValidationError naming the option.
 std::vector<double> parse_numbers(const std::string& option, const std::string& text,
                                   std::size_t count, const char* what);
+
+// Each (option, point) must have a reachable grid node within half a diagonal, else a
+// CLI::ValidationError naming the option.
+void check_in_workspace(const planner::WorkspaceGrid& grid, const std::string& crane,
+                        const std::vector<std::pair<std::string, Eigen::Vector2d>>& points);
 
 // The posture table for arm (ptp and sim --input goal): from table_option's file (empty: the
 // default cache) when it matches, else built (a line on stderr) and written there. The points are

@@ -146,5 +146,13 @@ expect ptp_bad_velocity "--velocity-limit: unit 'bar' is not a velocity unit" \
   ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --velocity-limit "3 bar"
 expect ptp_bad_grid "--grid: must be between 5 mm and 5 m" \
   ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --grid "1 mm"
+expect ptp_bad_posture "--posture: 'fixed-j3': expected optimal or fixed-last:ANGLE" \
+  ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --posture fixed-j3
+expect ptp_posture_nan "--posture: 'abc' is not a finite number" \
+  ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --posture fixed-last:abc
+expect ptp_posture_range "--posture: MHSB three-link arm (paper 001): 130.0 deg is outside J3's range" \
+  ptp --config "$arm" --from 0.5,0 --to 0.6,0 --posture fixed-last:130
+expect ptp_posture_prismatic "--posture: K70M forestry loader (reference crane): the last moving joint (extension) is not revolute" \
+  ptp --from 4,1 --to 7,4 --posture fixed-last:10
 [ "$failed" -eq 0 ] && echo "bad input files OK"
 exit "$failed"

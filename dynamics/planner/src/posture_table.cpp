@@ -142,6 +142,39 @@ double maximise(const PlanarArm& arm, PolytopeArea& area, dynamics::KinematicsDa
   return area(a, pattern);
 }
 
+// The other moving joints of a with the last one at `last` (Newton on the tip, damped least
+// squares, the last joint held); true when a ends on target within the ranges.
+bool solve_with_last_fixed(const PlanarArm& arm, dynamics::KinematicsData& data,
+                           const Eigen::Vector2d& target, double last, ArmVector& a) {
+  const int m = arm.moving();
+  a[m - 1] = last;
+  ArmJacobian j;
+  ArmJacobian js;
+  Eigen::Vector2d err = target - arm.tip(a, data);
+  for (int it = 0; it < 40 && err.norm() >= 1e-10; ++it) {
+    arm.jacobian(a, data, j);
+    js = j.leftCols(m - 1);
+    const Eigen::Matrix2d jjt = js * js.transpose() + 1e-9 * Eigen::Matrix2d::Identity();
+    const Eigen::Vector2d y = jjt.ldlt().solve(err);
+    double norm2 = 0.0;
+    for (int k = 0; k + 1 < m; ++k) norm2 += std::pow(js.col(k).dot(y), 2);
+    // At most 0.5 rad a step: keeps Newton in its basin.
+    const double scale = norm2 > 0.25 ? 0.5 / std::sqrt(norm2) : 1.0;
+    for (int k = 0; k + 1 < m; ++k) a[k] += scale * js.col(k).dot(y);
+    err = target - arm.tip(a, data);
+  }
+  if (!(err.norm() < kTipTolerance_m)) return false;
+  for (int k = 0; k + 1 < m; ++k) {
+    if (arm.model().joints[at(arm.joint(k))].type == dynamics::JointType::kRevolute) {
+      a[k] = std::remainder(a[k], 2.0 * M_PI);  // the same posture, nearest zero
+      if (a[k] < arm.lower(k)) a[k] += 2.0 * M_PI;
+      if (a[k] > arm.upper(k)) a[k] -= 2.0 * M_PI;
+    }
+    if (a[k] < arm.lower(k) - 1e-12 || a[k] > arm.upper(k) + 1e-12) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 int WorkspaceGrid::node_at(int ix, int iz) const {
@@ -428,6 +461,103 @@ PostureTable PostureTable::build(const PlanarArm& arm, const PostureTableSetting
   t.optimisations = runs.load();
   t.unconverged = unconverged.load();
   t.degenerate = degenerate.load();
+  t.build_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return t;
+}
+
+PostureTable PostureTable::fixed_last_joint(const PlanarArm& arm,
+                                            const PostureTableSettings& settings, double last_joint,
+                                            double step) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const int m = arm.moving();
+  if (m < 2) throw std::invalid_argument("a fixed last joint needs at least two moving joints");
+  if (arm.model().joints[at(arm.joint(m - 1))].type != dynamics::JointType::kRevolute) {
+    throw std::invalid_argument("the last moving joint (" +
+                                arm.model().joints[at(arm.joint(m - 1))].name +
+                                ") is not revolute");
+  }
+  if (!(last_joint >= arm.lower(m - 1) && last_joint <= arm.upper(m - 1))) {
+    char why[160];
+    std::snprintf(why, sizeof why, "%.1f deg is outside %s's range [%.1f, %.1f] deg",
+                  last_joint * 180.0 / M_PI, arm.model().joints[at(arm.joint(m - 1))].name.c_str(),
+                  arm.lower(m - 1) * 180.0 / M_PI, arm.upper(m - 1) * 180.0 / M_PI);
+    throw std::invalid_argument(why);
+  }
+  if (!(step > 0.0)) throw std::invalid_argument("the last joint's step must be positive");
+  PostureTable t;
+  t.optimal_ = false;
+  t.moving_ = m;
+  Fingerprint f;
+  f.add(posture_table_fingerprint(arm, settings));
+  f.add(last_joint);
+  f.add(step);
+  t.fingerprint_ = f.value();
+  t.patterns_ = planner_patterns(arm);
+  if (settings.max_patterns > 0 && settings.max_patterns < t.pattern_count()) {
+    t.patterns_.resize(at(settings.max_patterns));
+  }
+  Workspace w = sample_workspace(arm, settings);
+  t.grid_ = std::move(w.grid);
+  const int nodes = t.grid_.nodes(), np = t.pattern_count();
+  t.q_.assign(at(nodes * np * m), 0.0);
+  t.area_.assign(at(nodes * np), 0.0);
+  std::vector<dynamics::ModePattern> full;
+  for (const auto& p : t.patterns_) full.push_back(full_pattern(arm, p));
+
+  PolytopeArea area(arm);
+  dynamics::KinematicsData data;
+  ArmVector reference = arm.moving_part(arm.q_hold());
+  reference[m - 1] = last_joint;
+  const int max_steps =
+      static_cast<int>(std::ceil((arm.upper(m - 1) - arm.lower(m - 1)) / step)) + 1;
+  for (int node = 0; node < nodes; ++node) {
+    const Eigen::Vector2d target = t.grid_.node_xz[at(node)];
+    const auto& starts = w.starts[at(node)];
+    // For the last joint at `last`, the solution whose middle joints bend most the way the last
+    // one does, then the nearest the reference, if any.
+    const auto solve = [&](double last, ArmVector& out) {
+      bool found = false;
+      double best = kInf;
+      for (std::size_t s = 0; s <= starts.size(); ++s) {
+        ArmVector a = s < starts.size() ? starts[s] : reference;
+        if (!solve_with_last_fixed(arm, data, target, last, a)) continue;
+        int against = 0;  // middle joints bent against the last one
+        for (int k = 1; k + 1 < m; ++k) against += a[k] * last < 0.0 ? 1 : 0;
+        const double d = 100.0 * against + (a - reference).head(m - 1).norm();
+        if (d < best) {
+          best = d;
+          out = a;
+          found = true;
+        }
+      }
+      return found;
+    };
+    ArmVector q;
+    bool found = false;
+    for (int s = 0; s <= max_steps && !found; ++s) {
+      for (const double sign : {1.0, -1.0}) {
+        const double last = last_joint + sign * s * step;
+        if (found || (s == 0 && sign < 0.0) || last < arm.lower(m - 1) || last > arm.upper(m - 1)) {
+          continue;
+        }
+        found = solve(last, q);
+      }
+    }
+    if (!found) {
+      // The solver missed every angle (it should not: the node has starts): the start whose last
+      // joint is nearest the fixed one.
+      q = starts.front();
+      for (const auto& s : starts) {
+        if (std::abs(s[m - 1] - last_joint) < std::abs(q[m - 1] - last_joint)) q = s;
+      }
+    }
+    if (std::abs(q[m - 1] - last_joint) > 1e-12) ++t.moved_last_joint;
+    for (int p = 0; p < np; ++p) {
+      const std::size_t e = t.entry(node, p);
+      for (int k = 0; k < m; ++k) t.q_[e * at(m) + at(k)] = q[k];
+      t.area_[e] = area(q, full[at(p)]);
+    }
+  }
   t.build_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return t;
 }

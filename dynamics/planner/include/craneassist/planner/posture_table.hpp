@@ -26,6 +26,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -113,6 +114,24 @@ class PostureTable {
   // Builds it (progress: called with nodes done and in all, from the building threads, serially).
   static PostureTable build(const PlanarArm& arm, const PostureTableSettings& settings,
                             const std::function<void(int, int)>& progress = {});
+  // The conventional posture rule of paper 001's Case 4 (its reference [18]): no S1, the redundancy
+  // resolved beforehand by holding the last moving joint at last_joint (rad). At each node of the
+  // same grid as build()'s, the other joints come from the inverse kinematics with the last joint
+  // there; where no solution lies within the ranges, the last joint is changed by step (rad; the
+  // paper: 1 degree) at a time, +step, -step, +2 step, ... from last_joint, until one does. Of
+  // the solutions (elbow up or down) the one whose middle joints bend the way the last one does
+  // (the arm curled one way, as the optimal table's postures of the paper's arm), then the one
+  // nearest the arm's reference posture (q_hold with the last joint at last_joint), is kept. Every
+  // pattern gets the node's posture, with its own polytope area. Not cached (it takes about a
+  // second). Throws std::invalid_argument when the arm has fewer than two moving joints, its last
+  // one is not revolute, or last_joint is outside the joint's range.
+  static PostureTable fixed_last_joint(const PlanarArm& arm, const PostureTableSettings& settings,
+                                       double last_joint, double step = M_PI / 180.0);
+  // Whether the table is the optimal one (build(), load()) or fixed_last_joint()'s.
+  bool optimal() const { return optimal_; }
+  // fixed_last_joint(): the nodes where the last joint had to leave last_joint.
+  long moved_last_joint = 0;
+
   // Writes the binary file (throws std::runtime_error naming it when it cannot).
   void save(const std::filesystem::path& file) const;
   // The table in the file when it exists and matches arm and settings; nullopt otherwise.
@@ -136,6 +155,7 @@ class PostureTable {
   std::vector<double> q_;  // per entry: moving() coordinates
   std::vector<double> area_;
   std::uint64_t fingerprint_ = 0;
+  bool optimal_ = true;
 };
 
 // What the table depends on, hashed: the model, the held joints, spacing, seeds and starts.

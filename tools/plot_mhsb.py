@@ -1,0 +1,373 @@
+#!/usr/bin/python3
+"""The figures of docs/mhsb.md#the-papers-results-reproduced from the runs of tools/mhsb_cases.py
+(its work directory: each case's trajectory CSV, S2 path CSV, the moving goal's simulator log and
+the grid's mode regions; its results CSV): paper 001's Figures 5, 6, 7, 9, 10 and 13 for our arm.
+
+    plot_mhsb.py WORK RESULTS.csv OUTDIR [--config config/cranes/mhsb_3link.yaml]
+
+Writes OUTDIR/mhsb_paths.png, mhsb_case1_joints.png, mhsb_case5.png and mhsb_moving_goal.png;
+a figure whose runs are missing from WORK is skipped (said on stderr).
+"""
+import argparse
+import csv
+import math
+import os
+import re
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+MODE_NAMES = ("N", "DB", "SB")
+MODE_COLOURS = ("#dddddd", "#f4a259", "#bc4b51")
+
+
+def read_csv(path):
+    with open(path) as f:
+        rows = [line for line in f if not line.startswith("#")]
+    return list(csv.DictReader(rows))
+
+
+def link_lengths(config):
+    """The DH lengths a of the config's joints, m."""
+    with open(config) as f:
+        text = f.read()
+    return [float(v) / 1000.0 for v in re.findall(r"^    a: ([\d.]+) mm", text, re.M)]
+
+
+def tip_path(rows, lengths):
+    """Tip X, Z along a joint trajectory of the planar arm (joint angles relative, from X)."""
+    xs, zs = [], []
+    for r in rows:
+        phi, x, z = 0.0, 0.0, 0.0
+        for i, a in enumerate(lengths):
+            phi += float(r[f"q_{i + 1}"])
+            x += a * math.cos(phi)
+            z += a * math.sin(phi)
+        xs.append(x)
+        zs.append(z)
+    return np.array(xs), np.array(zs)
+
+
+class Work:
+    def __init__(self, work, results, config):
+        self.dir = work
+        self.lengths = link_lengths(config)
+        self.results = {r["case"]: r for r in read_csv(results)}
+
+    def has(self, case, kind="traj"):
+        return os.path.exists(os.path.join(self.dir, f"{case}.{kind}.csv"))
+
+    def traj(self, case):
+        return read_csv(os.path.join(self.dir, f"{case}.traj.csv"))
+
+    def path(self, case):
+        return read_csv(os.path.join(self.dir, f"{case}.path.csv"))
+
+
+def save(fig, out, name):
+    fig.savefig(os.path.join(out, name), dpi=110)
+    plt.close(fig)
+    print(f"plot_mhsb: wrote {os.path.join(out, name)}")
+
+
+def skip(what, why):
+    print(f"plot_mhsb: {what} skipped: {why}", file=sys.stderr)
+
+
+def workspace_background(ax, work):
+    """The reachable grid (dots at its boundary, the paper's dotted line) and where the all-N
+    postures of the optimal table need a boost to lift at V_L: J1 orange, J2 blue, both purple."""
+    path = os.path.join(work.dir, "workspace.csv")
+    if not os.path.exists(path):
+        return
+    rows = read_csv(path)
+    x = np.array([float(r["x_m"]) for r in rows])
+    z = np.array([float(r["z_m"]) for r in rows])
+    j1 = np.array([r["lift_J1"] == "1" for r in rows])
+    j2 = np.array([r["lift_J2"] == "1" for r in rows])
+    h = np.min(np.diff(np.unique(x)))
+    cells = {(round(a / h), round(b / h)) for a, b in zip(x, z)}
+    edge = np.array([any((round(a / h) + di, round(b / h) + dk) not in cells
+                         for di, dk in ((1, 0), (-1, 0), (0, 1), (0, -1))) for a, b in zip(x, z)])
+    for mask, colour, label in ((j1 & ~j2, "#f6b26b", "J1 needs a boost"),
+                                (j2 & ~j1, "#6fa8dc", "J2 needs a boost"),
+                                (j1 & j2, "#b4a7d6", "J1 and J2 need a boost")):
+        if mask.any():
+            ax.scatter(x[mask], z[mask], s=26, marker="s", c=colour, lw=0, label=label, zorder=1)
+    ax.scatter(x[edge], z[edge], s=2, c="k", zorder=2, label="workspace (grid nodes)")
+    ax.set_aspect("equal")
+    ax.set_xlabel("X (m)")
+    ax.set_ylabel("Z (m)")
+    ax.grid(alpha=0.3)
+
+
+def plot_paths(work, out):
+    panels = [
+        ("Case 1: lifting 10 kg", [("1-1", "tab:green", "1-1 energy-optimal"),
+                                   ("1-2", "navy", "1-2 shortest time")], "1-1"),
+        ("Case 2: unloading", [("2-1", "navy", "2-1"), ("2-2", "darkviolet", "2-2")], "2-2"),
+        ("Case 3: full range", [("3-1", "tab:green", "3-1"), ("3-2", "crimson", "3-2")], "3-2"),
+        ("Case 4: posture table vs fixed J3", [("4-1", "tab:green", "4-1 posture table"),
+                                               ("4-2", "navy", "4-2 J3 held at 70 deg"),
+                                               ("4-3", "crimson", "4-3 J3 held at 120 deg")],
+         None),
+    ]
+    if not work.has("1-1"):
+        return skip("mhsb_paths.png", "no Case 1-1 run")
+    fig, axes = plt.subplots(2, 2, figsize=(13, 13))
+    for ax, (title, runs, s2_case) in zip(axes.flat, panels):
+        workspace_background(ax, work)
+        for i, (case, colour, label) in enumerate(runs):
+            if not work.has(case):
+                continue
+            r = work.results.get(case, {})
+            x, z = tip_path(work.traj(case), work.lengths)
+            # Later runs thinner, on top: overlapping paths stay visible.
+            ax.plot(x, z, color=colour, lw=3.5 - i, zorder=4,
+                    label=f"{label}: {r.get('energy_j', '?')} J, {r.get('time_s', '?')} s")
+            p = work.path(case)
+            px = [float(n["x_m"]) for n in p]
+            pz = [float(n["z_m"]) for n in p]
+            boost = [n["pattern"] != "N-N-N" for n in p]
+            ax.plot(px, pz, color=colour, ls="--", lw=1, zorder=3,
+                    label=f"{case} S2 path: {r.get('s2_energy_j', '?')} J"
+                    if case == s2_case else None)
+            ax.scatter(np.array(px)[boost], np.array(pz)[boost], s=14, facecolors="none",
+                       edgecolors=colour, zorder=5)
+            ax.plot(px[0], pz[0], "ko", ms=4, zorder=6)
+            ax.plot(px[-1], pz[-1], "k*", ms=9, zorder=6)
+        ax.set_title(title)
+        ax.legend(fontsize=7, loc="lower left")
+    fig.suptitle("Paper 001's cases on our arm: tip paths (S3/S4 trajectory; dashed: the S2 "
+                 "path, open circles: nodes reached in a boost pattern)\nover the mode regions of "
+                 "the optimal table's all-N postures (lifting at V_L)", fontsize=11)
+    fig.tight_layout()
+    save(fig, out, "mhsb_paths.png")
+
+
+def mode_bars(ax, t, modes, base):
+    """Each joint's mode over time as a coloured bar at height base + joint."""
+    for j, m in enumerate(modes):
+        start = 0
+        for k in range(1, len(t) + 1):
+            if k == len(t) or m[k] != m[start]:
+                end = t[k] if k < len(t) else t[-1]
+                ax.broken_barh([(t[start], end - t[start])], (base + j - 0.4, 0.8),
+                               facecolors=MODE_COLOURS[m[start]])
+                start = k
+
+
+def plot_case1_joints(work, out):
+    cases = [c for c in ("1-1", "1-2") if work.has(c)]
+    if not cases:
+        return skip("mhsb_case1_joints.png", "no Case 1 run")
+    fig, axes = plt.subplots(2, len(cases), figsize=(6.5 * len(cases), 6.5), squeeze=False,
+                             gridspec_kw={"height_ratios": [3, 1]}, sharex="col")
+    for col, case in enumerate(cases):
+        rows = work.traj(case)
+        t = np.array([float(r["t"]) for r in rows])
+        ax = axes[0][col]
+        for j in range(len(work.lengths)):
+            ax.plot(t, np.degrees([float(r[f"q_{j + 1}"]) for r in rows]), label=f"J{j + 1}")
+        p = work.path(case)
+        for j in range(len(work.lengths)):
+            ax.plot([float(n["t_trajectory_s"]) for n in p],
+                    np.degrees([float(n[f"q_J{j + 1}_rad"]) for n in p]), f"C{j}o", ms=3)
+        r = work.results.get(case, {})
+        ax.set_title(f"Case {case}: {r.get('description', '')}, {r.get('energy_j', '?')} J "
+                     f"planned, {r.get('sim_energy_j', '?')} J simulated")
+        ax.set_ylabel("joint angle (deg); dots: S2 nodes")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        modes = [[int(r[f"mode_{j + 1}"]) for r in rows] for j in range(len(work.lengths))]
+        ax = axes[1][col]
+        mode_bars(ax, t, modes, 1)
+        ax.set_yticks(range(1, len(work.lengths) + 1),
+                      [f"J{j + 1}" for j in range(len(work.lengths))])
+        ax.invert_yaxis()
+        ax.set_xlabel("t (s)")
+        ax.set_ylabel("mode (S4)")
+        for m, c in zip(MODE_NAMES, MODE_COLOURS):
+            ax.bar(0, 0, color=c, label=m)
+        ax.legend(fontsize=7, ncol=3, loc="upper right")
+    fig.tight_layout()
+    save(fig, out, "mhsb_case1_joints.png")
+
+
+def plot_case5(work, out):
+    w1s, w2s = ("0", "0.01", "0.1"), ("0", "1.3", "13")
+    cells = {(w1, w2): work.results.get(f"5-w{w1}-{w2}") for w1 in w1s for w2 in w2s}
+    if any(v is None for v in cells.values()):
+        return skip("mhsb_case5.png", "no Case 5 sweep")
+    fig, axes = plt.subplots(2, 3, figsize=(15, 8.5))
+    for ax, (key, title, unit) in zip(axes[0], (("s2_energy_j", "energy", "J"),
+                                                 ("s2_time_s", "task time", "s"),
+                                                 ("s2_length_m", "path length", "m"))):
+        grid = np.array([[float(cells[(w1, w2)][key]) for w1 in w1s] for w2 in w2s])
+        im = ax.imshow(grid, origin="lower", cmap="viridis")
+        for i in range(3):
+            for k in range(3):
+                ax.text(k, i, f"{grid[i, k]:.3g}", ha="center", va="center", color="w",
+                        fontsize=10)
+        ax.set_xticks(range(3), w1s)
+        ax.set_yticks(range(3), w2s)
+        ax.set_xlabel("w1 (per J)")
+        ax.set_ylabel("w2 (per s)")
+        ax.set_title(f"S2 {title} ({unit}), w3 = 0")
+        fig.colorbar(im, ax=ax, shrink=0.8)
+    # Section 3.4's other variations: V_L and w3 on Case 1-2, P0 on Case 1-1.
+    rows = sorted((r for r in work.results.values() if r["group"] == "5v"),
+                  key=lambda r: float(r["case"][4:]))
+    ax = axes[1][0]
+    if rows:
+        v = [float(r["case"][4:]) for r in rows]
+        ax.plot(v, [float(r["s2_energy_j"]) for r in rows], "o-", label="S2 energy (J)")
+        ax2 = ax.twinx()
+        ax2.plot(v, [float(r["s2_time_s"]) for r in rows], "s-C1", label="S2 time (s)")
+        ax2.set_ylabel("S2 time (s)", color="C1")
+        ax.set_xlabel("V_L (mm/s), Case 1-2's weights")
+        ax.set_ylabel("S2 energy (J)", color="C0")
+        ax.set_title("V_L sweep")
+        ax.grid(alpha=0.3)
+    rows = sorted((r for r in work.results.values() if r["group"] == "5s"),
+                  key=lambda r: float(r["w3"]))
+    ax = axes[1][1]
+    if rows:
+        w3 = [float(r["w3"]) for r in rows]
+        ax.plot(w3, [float(r["s2_energy_j"]) for r in rows], "o-", label="S2 energy (J)")
+        ax2 = ax.twinx()
+        ax2.plot(w3, [int(r["s2_switches"]) for r in rows], "s-C1")
+        ax2.set_ylabel("S2 mode switches", color="C1")
+        ax.set_xlabel("w3, Case 1-2's w1, w2")
+        ax.set_ylabel("S2 energy (J)", color="C0")
+        ax.set_title("w3 sweep")
+        ax.grid(alpha=0.3)
+    ax = axes[1][2]
+    rows = [work.results.get(c) for c in ("5-p0-2.5", "1-1", "5-p0-10")]
+    if all(rows):
+        labels = ["2.5 MPa", "4 MPa (1-1)", "10 MPa"]
+        x = np.arange(3)
+        ax.bar(x - 0.2, [float(r["energy_j"]) for r in rows], 0.4, label="ours, planned")
+        ax.bar(x + 0.2, [float(r["sim_energy_j"]) for r in rows], 0.4, label="ours, simulated")
+        ax.plot(x, [1054, 532, 1011], "k*", ms=12, label="paper")
+        ax.set_xticks(x, labels)
+        ax.set_ylabel("energy (J)")
+        ax.set_title("main-pump pressure P0, Case 1-1")
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    save(fig, out, "mhsb_case5.png")
+
+
+def plot_moving_goal(work, out):
+    path = os.path.join(work.dir, "4.2.sim.csv")
+    if not os.path.exists(path):
+        return skip("mhsb_moving_goal.png", "no simulator log of section 4.2's run")
+    rows = read_csv(path)
+    col = lambda name: np.array([float(r[name]) for r in rows])  # noqa: E731
+    t = col("t_s")
+    fig, axes = plt.subplots(4, 2, figsize=(13, 10), sharex=True)
+    for c, j in enumerate((1, 2)):
+        ax = axes[0][c]
+        ax.plot(t, np.degrees(col(f"j{j}_q_ref")), "k--", lw=1, label="reference")
+        ax.plot(t, np.degrees(col(f"j{j}_q")), "C0", label="simulated")
+        ax.set_ylabel(f"J{j} angle (deg)")
+        ax.legend(fontsize=8)
+        ax = axes[1][c]
+        ax.plot(t, col(f"j{j}_force_ref_n") / 1000, "k--", lw=1, label="desired")
+        ax.plot(t, col(f"j{j}_force_n") / 1000, "C1", label="cylinder")
+        ax.set_ylabel(f"J{j} force (kN)")
+        ax.legend(fontsize=8)
+        ax = axes[2][c]
+        ax.plot(t, col("p_main_pa") / 1e6, "k:", label="P0 (main pump)")
+        ax.plot(t, col(f"j{j}_p_supply_pa") / 1e6, "C3", label=f"P{j} (supply of J{j})")
+        target = col(f"j{j}_p_target_pa") / 1e6
+        ax.plot(t, np.where(target > 0, target, np.nan), "C3--", lw=0.8, label="target (boost)")
+        ax.set_ylabel("pressure (MPa)")
+        ax.legend(fontsize=8)
+        ax = axes[3][c]
+        pumps = sorted({int(k[2:-6]) for k in rows[0] if re.fullmatch(r"sp\d+_joint", k)})
+        for k in pumps:
+            joint = col(f"sp{k}_joint")
+            speed = col(f"sp{k}_speed_rad_s") * 60 / (2 * math.pi)
+            ax.plot(t, np.where(joint == j, speed, np.nan), label=f"SP{k}")
+        ax.set_ylabel(f"servo-pumps on J{j} (rpm)")
+        ax.set_xlabel("t (s)")
+        ax.legend(fontsize=8)
+    err = max(np.max(np.abs(col(f"j{j}_q_error"))) for j in (1, 2, 3))
+    for ax in axes.flat:
+        for ts in (3.0, 6.0):
+            ax.axvline(ts, color="0.6", ls="--", lw=0.8)
+        ax.grid(alpha=0.3)
+    fig.suptitle("Section 4.2 on the MHSB simulator: start (0.7, 0.5) m, goal (0.6, 0.2), "
+                 f"(0.8, 0.2) at 3 s, (0.6, 0.5) at 6 s; largest joint error {math.degrees(err):.2f}"
+                 " deg (paper: 2.43 deg)", fontsize=10)
+    fig.tight_layout()
+    save(fig, out, "mhsb_moving_goal.png")
+
+
+def pct(a, b):
+    return f"{100.0 * (float(a) - float(b)) / float(b):+.1f} %"
+
+
+def markdown_table(work):
+    """The side-by-side table of docs/mhsb.md: paper | ours planned | ours simulated."""
+    rows = ["| case | weights | paper: time, energy | ours planned: S2 time, energy; S3/S4 time, "
+            "energy, tip path | ours simulated: energy (against planned), largest joint error |",
+            "| --- | --- | --- | --- | --- |"]
+    for r in work.results.values():
+        if r["group"] not in ("1", "2", "3", "4", "5p", "goal"):
+            continue
+        paper = ", ".join(x for x in (f"{r['paper_time_s']} s" if r["paper_time_s"] else "",
+                                      f"{r['paper_energy_j']} J" if r["paper_energy_j"] else "",
+                                      f"S2 {r['paper_s2_energy_j']} J"
+                                      if r["paper_s2_energy_j"] else "",
+                                      f"error {r['paper_max_error_deg']} deg"
+                                      if r["paper_max_error_deg"] else "") if x)
+        sim = (f"{r['sim_energy_j']} J ({pct(r['sim_energy_j'], r['sim_planned_j'])}), "
+               f"{r['sim_max_error_deg']} deg" if r["sim_energy_j"] else "")
+        rows.append(f"| {r['case']} {r['description']} | {r['w1']}, {r['w2']}, {r['w3']} | "
+                    f"{paper} | {r['s2_time_s']} s, {r['s2_energy_j']} J; {r['time_s']} s, "
+                    f"{r['energy_j']} J, {r['length_m']} m | {sim} |")
+    return "\n".join(rows) + "\n"
+
+
+def update_doc(doc, table):
+    """Replaces the text between the doc's mhsb-cases markers with the table."""
+    begin, end = "<!-- mhsb-cases table: begin -->\n", "<!-- mhsb-cases table: end -->"
+    with open(doc) as f:
+        text = f.read()
+    i, k = text.find(begin), text.find(end)
+    if i < 0 or k < i:
+        sys.exit(f"plot_mhsb: {doc} has no '{begin.strip()}' ... '{end}' markers")
+    with open(doc, "w") as f:
+        f.write(text[:i + len(begin)] + table + text[k:])
+    print(f"plot_mhsb: updated the table in {doc}")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("work")
+    ap.add_argument("results")
+    ap.add_argument("outdir")
+    ap.add_argument("--config", default=os.path.join(os.path.dirname(__file__), "..", "config",
+                                                     "cranes", "mhsb_3link.yaml"))
+    ap.add_argument("--doc", help="a Markdown file whose table between the mhsb-cases "
+                    "markers is rewritten from RESULTS")
+    args = ap.parse_args()
+    work = Work(args.work, args.results, args.config)
+    os.makedirs(args.outdir, exist_ok=True)
+    plot_paths(work, args.outdir)
+    plot_case1_joints(work, args.outdir)
+    plot_case5(work, args.outdir)
+    plot_moving_goal(work, args.outdir)
+    if args.doc:
+        update_doc(args.doc, markdown_table(work))
+
+
+if __name__ == "__main__":
+    main()
