@@ -34,9 +34,10 @@ class Reader : public YamlReader {
   }
 };
 
-input::AxisShape read_axis(const Reader& r, const YAML::Node& node, const std::string& path,
-                           input::SlewMode slew, bool lateral) {
-  r.check_keys(node, path, {"axis", "deadband", "expo", "max", "invert"});
+// The fields every stick axis has: its axis, deadband, expo and invert; max left to the caller.
+input::AxisShape read_axis_common(const Reader& r, const YAML::Node& node, const std::string& path,
+                                  std::initializer_list<const char*> keys) {
+  r.check_keys(node, path, keys);
   input::AxisShape s;
   s.enabled = true;
   const std::string axis = r.text(node, "axis", path);
@@ -47,31 +48,27 @@ input::AxisShape read_axis(const Reader& r, const YAML::Node& node, const std::s
   }
   s.deadband = r.value(node, "deadband", path, Dimension::kDimensionless, 0.0, 0.9, "0 to 0.9");
   s.expo = r.value(node, "expo", path, Dimension::kDimensionless, 0.0, 1.0, "0 to 1");
+  s.invert = r.flag(node, "invert", path, false);
+  return s;
+}
+
+input::AxisShape read_axis(const Reader& r, const YAML::Node& node, const std::string& path,
+                           input::SlewMode slew, bool lateral) {
+  input::AxisShape s =
+      read_axis_common(r, node, path, {"axis", "deadband", "expo", "max", "invert"});
   if (lateral && slew == input::SlewMode::kAngular) {
     s.max = r.value(node, "max", path, Dimension::kAngularVelocity, 0.0, 3.0,
                     "0 to 3 rad/s (slew: angular takes an angular velocity, e.g. 20 deg/s)");
   } else {
     s.max = r.value(node, "max", path, Dimension::kVelocity, 0.0, 5.0, "0 to 5 m/s");
   }
-  s.invert = r.flag(node, "invert", path, false);
   return s;
 }
 
 // A drive-stick axis (sim --base): as a tip axis without max (a fraction of the drive's limit).
 input::AxisShape read_drive_axis(const Reader& r, const YAML::Node& node, const std::string& path) {
-  r.check_keys(node, path, {"axis", "deadband", "expo", "invert"});
-  input::AxisShape s;
-  s.enabled = true;
-  const std::string axis = r.text(node, "axis", path);
-  if (!input::parse_gamepad_axis(axis, s.axis)) {
-    r.fail(node["axis"], path + ".axis",
-           "unknown axis '" + axis +
-               "' (expected left_x, left_y, right_x, right_y, left_trigger or right_trigger)");
-  }
-  s.deadband = r.value(node, "deadband", path, Dimension::kDimensionless, 0.0, 0.9, "0 to 0.9");
-  s.expo = r.value(node, "expo", path, Dimension::kDimensionless, 0.0, 1.0, "0 to 1");
+  input::AxisShape s = read_axis_common(r, node, path, {"axis", "deadband", "expo", "invert"});
   s.max = 1.0;
-  s.invert = r.flag(node, "invert", path, false);
   return s;
 }
 

@@ -375,21 +375,29 @@ ArmVector PostureTable::posture(int node, int pattern) const {
   return Eigen::Map<const Eigen::VectorXd>(q_.data() + entry(node, pattern) * at(moving_), moving_);
 }
 
-PostureTable PostureTable::build(const PlanarArm& arm, const PostureTableSettings& settings,
-                                 const std::function<void(int, int)>& progress) {
-  const auto t0 = std::chrono::steady_clock::now();
+PostureTable PostureTable::empty(const PlanarArm& arm, const PostureTableSettings& settings,
+                                 std::uint64_t fingerprint, Workspace& workspace) {
   PostureTable t;
   t.moving_ = arm.moving();
-  t.fingerprint_ = posture_table_fingerprint(arm, settings);
+  t.fingerprint_ = fingerprint;
   t.patterns_ = planner_patterns(arm);
   if (settings.max_patterns > 0 && settings.max_patterns < t.pattern_count()) {
     t.patterns_.resize(at(settings.max_patterns));
   }
-  Workspace w = sample_workspace(arm, settings);
-  t.grid_ = std::move(w.grid);
+  workspace = sample_workspace(arm, settings);
+  t.grid_ = workspace.grid;
   const int nodes = t.grid_.nodes(), np = t.pattern_count();
   t.q_.assign(at(nodes * np * t.moving_), 0.0);
   t.area_.assign(at(nodes * np), 0.0);
+  return t;
+}
+
+PostureTable PostureTable::build(const PlanarArm& arm, const PostureTableSettings& settings,
+                                 const std::function<void(int, int)>& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Workspace w;
+  PostureTable t = empty(arm, settings, posture_table_fingerprint(arm, settings), w);
+  const int nodes = t.grid_.nodes(), np = t.pattern_count();
   std::vector<dynamics::ModePattern> full;
   for (const auto& p : t.patterns_) full.push_back(full_pattern(arm, p));
 
@@ -484,23 +492,14 @@ PostureTable PostureTable::fixed_last_joint(const PlanarArm& arm,
     throw std::invalid_argument(why);
   }
   if (!(step > 0.0)) throw std::invalid_argument("the last joint's step must be positive");
-  PostureTable t;
-  t.optimal_ = false;
-  t.moving_ = m;
   Fingerprint f;
   f.add(posture_table_fingerprint(arm, settings));
   f.add(last_joint);
   f.add(step);
-  t.fingerprint_ = f.value();
-  t.patterns_ = planner_patterns(arm);
-  if (settings.max_patterns > 0 && settings.max_patterns < t.pattern_count()) {
-    t.patterns_.resize(at(settings.max_patterns));
-  }
-  Workspace w = sample_workspace(arm, settings);
-  t.grid_ = std::move(w.grid);
+  Workspace w;
+  PostureTable t = empty(arm, settings, f.value(), w);
+  t.optimal_ = false;
   const int nodes = t.grid_.nodes(), np = t.pattern_count();
-  t.q_.assign(at(nodes * np * m), 0.0);
-  t.area_.assign(at(nodes * np), 0.0);
   std::vector<dynamics::ModePattern> full;
   for (const auto& p : t.patterns_) full.push_back(full_pattern(arm, p));
 

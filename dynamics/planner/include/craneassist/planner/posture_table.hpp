@@ -146,6 +146,10 @@ class PostureTable {
   long degenerate = 0;  // entries whose polytope has no area (posture: the load-free optimum)
 
  private:
+  // A table with its grid and patterns sized and no postures yet; the workspace sampled for it
+  // (with each node's starting postures) in `workspace`.
+  static PostureTable empty(const PlanarArm& arm, const PostureTableSettings& settings,
+                            std::uint64_t fingerprint, Workspace& workspace);
   std::size_t entry(int node, int pattern) const {
     return static_cast<std::size_t>(node) * patterns_.size() + static_cast<std::size_t>(pattern);
   }
