@@ -106,6 +106,7 @@ struct TelemetryPublisher::Impl {
     thread.join();
     sem_destroy(&wake);
     for (auto*& w : writers) w = nullptr;
+    base_writer.store(nullptr, std::memory_order_release);
     if (ros2) {
       for (int i = 0; i < Ros2Writers::kTopics; ++i) ros2_written[i] = ros2->written(i);
       ros2.reset();
@@ -156,6 +157,7 @@ struct TelemetryPublisher::Impl {
           write_errors.fetch_add(1, std::memory_order_relaxed);
           continue;
         }
+        base_writer.store(writers[i], std::memory_order_release);
       }
       bool ok = false;
       switch (i) {
@@ -274,8 +276,9 @@ struct TelemetryPublisher::Impl {
     for (int i = 0; i < kTelemetryTopics; ++i) {
       s.samples_written[i] = written[i].load();
       fdds::PublicationMatchedStatus m;
-      if (writers[i] != nullptr &&
-          writers[i]->get_publication_matched_status(m) == ReturnCode_t::RETCODE_OK) {
+      fdds::DataWriter* w =
+          i == kBaseTopic ? base_writer.load(std::memory_order_acquire) : writers[i];
+      if (w != nullptr && w->get_publication_matched_status(m) == ReturnCode_t::RETCODE_OK) {
         s.matched_readers += m.current_count;
       }
     }
@@ -291,6 +294,9 @@ struct TelemetryPublisher::Impl {
   ParticipantPtr participant;
   fdds::Publisher* publisher = nullptr;
   fdds::DataWriter* writers[kTelemetryTopics] = {};
+  // The base topic's writer is created by the publishing thread on the first frame with a base;
+  // stats() (another thread) reads it through this.
+  std::atomic<fdds::DataWriter*> base_writer{nullptr};
   std::optional<Ros2Writers> ros2;                        // config ros2.enabled
   std::uint64_t ros2_written[Ros2Writers::kTopics] = {};  // its counts, after close()
   // Publisher thread only:
