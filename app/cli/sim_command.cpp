@@ -484,6 +484,9 @@ int run_sim_command(const SimArgs& args) {
     done.store(true);
     ui.join();
     const std::string remote_report = remote.report ? remote.report() : std::string();
+    // The goal input's last state (a static string) before the source goes.
+    const char* goal_state = goal_source != nullptr ? goal_source->state() : "";
+    goal_source = nullptr;
     source.reset();  // restores the terminal; ends the DDS input
     signal(SIGINT, SIG_DFL);
     signal(SIGTERM, SIG_DFL);
@@ -518,7 +521,7 @@ int run_sim_command(const SimArgs& args) {
     std::printf("  input device: %d disconnects, %d re-attaches\n", s.disconnects, s.reconnects);
     if (goal_thread) {
       for (const std::string& line : goal_thread->report()) std::printf("  %s\n", line.c_str());
-      std::printf("  goal input at the end: %s\n", goal_source->state());
+      std::printf("  goal input at the end: %s\n", goal_state);
     }
     if (base) {
       const valves::BaseMeasurement b = board.read().base;
