@@ -194,6 +194,26 @@ std::vector<double> parse_numbers(const std::string& option, const std::string& 
   return values;
 }
 
+planner::PtpWeights parse_weights(const std::string& option, const std::string& text) {
+  const auto w = parse_numbers(option, text, 3, "three numbers w1,w2,w3");
+  for (const double x : w) {
+    if (x < 0.0) throw CLI::ValidationError(option, "'" + text + "': negative");
+  }
+  planner::PtpWeights weights;
+  weights.energy = w[0];
+  weights.time = w[1];
+  weights.switches = w[2];
+  return weights;
+}
+
+double parse_grid_spacing(const std::string& option, const std::string& text) {
+  const double spacing_m = cli_quantity(option, text, config::Dimension::kLength);
+  if (!(spacing_m >= 0.005 && spacing_m <= 5.0)) {
+    throw CLI::ValidationError(option, "must be between 5 mm and 5 m");
+  }
+  return spacing_m;
+}
+
 void check_in_workspace(const planner::WorkspaceGrid& grid, const std::string& crane,
                         const std::vector<std::pair<std::string, Eigen::Vector2d>>& points) {
   const double reach = 0.5 * std::sqrt(2.0) * grid.spacing_m + 1e-9;
@@ -309,13 +329,10 @@ int run_ptp_command(const PtpArgs& args) {
     }
     const auto f = parse_numbers("--from", args.from, 2, "two numbers X,Z (m)");
     const auto t = parse_numbers("--to", args.to, 2, "two numbers X,Z (m)");
-    const auto w = parse_numbers("--weights", args.weights, 3, "three numbers w1,w2,w3");
-    for (double x : w) {
-      if (x < 0.0) throw CLI::ValidationError("--weights", "'" + args.weights + "': negative");
-    }
     from = {f[0], f[1]};
     to = {t[0], t[1]};
-    weights = {w[0], w[1], w[2], args.heuristic_scale};
+    weights = parse_weights("--weights", args.weights);
+    weights.heuristic_per_m = args.heuristic_scale;
     if (!args.velocity_limit.empty()) {
       settings.velocity_limit_m_s =
           cli_quantity("--velocity-limit", args.velocity_limit, config::Dimension::kVelocity);
@@ -323,12 +340,7 @@ int run_ptp_command(const PtpArgs& args) {
         throw CLI::ValidationError("--velocity-limit", "must be positive and at most 10 m/s");
       }
     }
-    if (!args.grid.empty()) {
-      table_settings.spacing_m = cli_quantity("--grid", args.grid, config::Dimension::kLength);
-      if (!(table_settings.spacing_m >= 0.005 && table_settings.spacing_m <= 5.0)) {
-        throw CLI::ValidationError("--grid", "must be between 5 mm and 5 m");
-      }
-    }
+    if (!args.grid.empty()) table_settings.spacing_m = parse_grid_spacing("--grid", args.grid);
     if (!args.energy_model.empty()) {
       if (!cfg.model.mhsb) {
         throw CLI::ValidationError("--energy-model", cfg.model.name +

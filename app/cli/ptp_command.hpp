@@ -14,6 +14,7 @@
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/planner/posture_table.hpp"
+#include "craneassist/planner/ptp_planner.hpp"
 
 namespace craneassist::cli {
 
@@ -41,6 +42,11 @@ CLI::App* add_ptp_command(CLI::App& cli, PtpArgs& args);
 // "a,b,..." as exactly `count` finite numbers, or a CLI::ValidationError naming the option.
 std::vector<double> parse_numbers(const std::string& option, const std::string& text,
                                   std::size_t count, const char* what);
+
+// The planner's weights "w1,w2,w3" (energy, time, switches; none negative) and a grid spacing
+// quantity (5 mm to 5 m), or a CLI::ValidationError naming the option.
+planner::PtpWeights parse_weights(const std::string& option, const std::string& text);
+double parse_grid_spacing(const std::string& option, const std::string& text);
 
 // Each (option, point) must have a reachable grid node within half a diagonal, else a
 // CLI::ValidationError naming the option.

@@ -323,14 +323,7 @@ int run_sim_command(const SimArgs& args) {
   planner::PtpWeights goal_weights;
   if (kind == "goal") {
     goals = parse_goals(args.goal, args.goal_at);
-    const auto w = parse_numbers("--goal-weights", args.goal_weights, 3, "three numbers w1,w2,w3");
-    for (const double x : w) {
-      if (x < 0.0)
-        throw CLI::ValidationError("--goal-weights", "'" + args.goal_weights + "': negative");
-    }
-    goal_weights.energy = w[0];
-    goal_weights.time = w[1];
-    goal_weights.switches = w[2];
+    goal_weights = parse_weights("--goal-weights", args.goal_weights);
     try {
       goal_arm.emplace(cfg.model, cfg.simulation.q_initial);
     } catch (const std::invalid_argument& e) {
@@ -338,11 +331,7 @@ int run_sim_command(const SimArgs& args) {
     }
     planner::PostureTableSettings table_settings;
     if (!args.goal_grid.empty()) {
-      table_settings.spacing_m =
-          cli_quantity("--goal-grid", args.goal_grid, config::Dimension::kLength);
-      if (!(table_settings.spacing_m >= 0.005 && table_settings.spacing_m <= 5.0)) {
-        throw CLI::ValidationError("--goal-grid", "must be between 5 mm and 5 m");
-      }
+      table_settings.spacing_m = parse_grid_spacing("--goal-grid", args.goal_grid);
     }
     std::vector<std::pair<std::string, Eigen::Vector2d>> points;
     for (const auto& g : goals)
