@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "craneassist/input/hermite.hpp"
+
 namespace craneassist::input {
 namespace {
 
@@ -72,15 +74,8 @@ void GoalSource::sample(double tau_s, Eigen::Vector3d& p, Eigen::Vector3d& v) no
   while (cursor_ + 1 < n - 1 && s[cursor_ + 1].t_s <= tau_s) ++cursor_;
   const TipSample& a = s[cursor_];
   const TipSample& b = s[cursor_ + 1];
-  // Cubic Hermite between the samples: positions and velocities both continuous.
-  const double h = b.t_s - a.t_s, u = (tau_s - a.t_s) / h;
-  const double u2 = u * u, u3 = u2 * u;
-  const double h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u, h01 = -2 * u3 + 3 * u2,
-               h11 = u3 - u2;
-  p = h00 * a.p_m + h10 * h * a.v_m_s + h01 * b.p_m + h11 * h * b.v_m_s;
-  const double d00 = (6 * u2 - 6 * u) / h, d10 = 3 * u2 - 4 * u + 1, d01 = (-6 * u2 + 6 * u) / h,
-               d11 = 3 * u2 - 2 * u;
-  v = d00 * a.p_m + d10 * a.v_m_s + d01 * b.p_m + d11 * b.v_m_s;
+  const double h = b.t_s - a.t_s;
+  cubic_hermite(a.p_m, a.v_m_s, b.p_m, b.v_m_s, h, (tau_s - a.t_s) / h, p, v);
 }
 
 void GoalSource::begin_cycle(double now_s, const Eigen::Vector3d& tip_m) noexcept {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "craneassist/input/hermite.hpp"
+
 namespace craneassist::offline {
 namespace {
 
@@ -36,11 +38,8 @@ void sample_plan(const planner::PtpPlan& plan, double tau, planner::ArmVector& q
     return;
   }
   const auto &a = s[k], &b = s[k + 1];
-  const double h = b.t_s - a.t_s, u = (tau - a.t_s) / h, u2 = u * u, u3 = u2 * u;
-  q = (2 * u3 - 3 * u2 + 1) * a.q + (u3 - 2 * u2 + u) * h * a.qdot + (-2 * u3 + 3 * u2) * b.q +
-      (u3 - u2) * h * b.qdot;
-  qdot = ((6 * u2 - 6 * u) / h) * a.q + (3 * u2 - 4 * u + 1) * a.qdot +
-         ((-6 * u2 + 6 * u) / h) * b.q + (3 * u2 - 2 * u) * b.qdot;
+  const double h = b.t_s - a.t_s, u = (tau - a.t_s) / h;
+  input::cubic_hermite(a.q, a.qdot, b.q, b.qdot, h, u, q, qdot);
   qddot = (1 - u) * a.qddot + u * b.qddot;
 }
 
