@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "config_edit.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/config/quantity.hpp"
 #include "craneassist/config/yaml_reader.hpp"
@@ -17,36 +18,24 @@ using craneassist::config::Dimension;
 
 namespace {
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using craneassist::test::read_text_file;
 
 const std::string kK70mPath = std::string(CRANEASSIST_SOURCE_DIR) + "/config/cranes/k70m.yaml";
 
 // Replaces the first occurrence of `from` in the K70M file and parses the result; returns the
 // error it throws.
 ConfigError error_after_edit(const std::string& from, const std::string& to) {
-  std::string text = read_file(kK70mPath);
-  const auto pos = text.find(from);
-  EXPECT_NE(pos, std::string::npos) << from;
-  text.replace(pos, from.size(), to);
-  return craneassist::test::thrown_error<ConfigError>(
-      [&] { craneassist::config::parse_crane_config(text, "edited.yaml"); },
-      "no error after replacing '" + from + "' with '" + to + "'");
+  return craneassist::test::crane_config_error_after_edit(kK70mPath, from, to);
 }
 
 // Replaces the first occurrence of `from` in the K70M file and parses the result.
 craneassist::config::CraneConfig config_after_edit(const std::string& from, const std::string& to) {
-  std::string text = read_file(kK70mPath);
-  const auto pos = text.find(from);
-  EXPECT_NE(pos, std::string::npos) << from;
-  text.replace(pos, from.size(), to);
-  return craneassist::config::parse_crane_config(text, "edited.yaml");
+  return craneassist::config::parse_crane_config(
+      craneassist::test::edited_text(kK70mPath, from, to), "edited.yaml");
 }
 
 int line_of(const std::string& needle) {
-  const std::string text = read_file(kK70mPath);
+  const std::string text = read_text_file(kK70mPath);
   const auto pos = text.find(needle);
   return 1 +
          static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(pos), '\n'));
@@ -230,7 +219,7 @@ TEST(CraneConfig, ConstantPressurePumpIsParsed) {
   EXPECT_NEAR(bar.model.pump.supply_pressure_pa, 18e6, 1e-6);
   EXPECT_EQ(bar.unsourced_quantities, 1);
   // Both fields are optional in load-sensing mode; the mode defaults to load sensing.
-  auto text = read_file(kK70mPath);
+  auto text = read_text_file(kK70mPath);
   for (const std::string line : {"    mode: load-sensing", "    supply_pressure: 20 MPa"}) {
     const auto pos = text.find(line);
     ASSERT_NE(pos, std::string::npos) << line;
@@ -268,7 +257,7 @@ TEST(CraneConfig, SupplyPressureMustBePositiveAndWithinTheRelief) {
 }
 
 TEST(CraneConfig, ConstantPressureModeNeedsTheSupplyPressure) {
-  std::string text = read_file(kK70mPath);
+  std::string text = read_text_file(kK70mPath);
   text.replace(text.find("mode: load-sensing"), 18, "mode: constant-pressure");
   const auto pos = text.find("    supply_pressure: 20 MPa");
   text.erase(pos, text.find('\n', pos) + 1 - pos);
@@ -341,7 +330,7 @@ TEST(CraneConfig, AFileOverTheSizeLimitIsRefused) {
   const std::string big = ::testing::TempDir() + "craneassist_big_crane.yaml";
   {
     std::ofstream out(big, std::ios::binary);
-    out << read_file(kK70mPath);
+    out << read_text_file(kK70mPath);
     while (out.tellp() <= static_cast<std::streamoff>(1 << 20)) {
       out << "# a comment line that makes the file larger than the limit\n";
     }
@@ -418,13 +407,13 @@ TEST(CraneConfig, BackendAndCanSettings) {
   const auto can = config_after_edit("backend: sim", "backend: can");
   EXPECT_EQ(can.backend.kind, BackendKind::kCan);
   // A relative mapping path is resolved against the config file's folder.
-  std::string text = read_file(kK70mPath);
+  std::string text = read_text_file(kK70mPath);
   text.replace(text.find("  # mapping:"), 12, "  mapping:");
   const auto mapped = craneassist::config::parse_crane_config(text, "/etc/crane/k70m.yaml");
   EXPECT_EQ(mapped.backend.can.mapping, "/etc/crane/../can/k70m_can.yaml");
 
   // Both may be left out: sim.
-  text = read_file(kK70mPath);
+  text = read_text_file(kK70mPath);
   text.erase(text.find("backend: sim"));
   EXPECT_EQ(craneassist::config::parse_crane_config(text, "bare.yaml").backend.kind,
             BackendKind::kSim);

@@ -3,14 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
 #include <random>
 #include <string>
 
+#include "config_edit.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/mhsb.hpp"
-#include "thrown_error.hpp"
 
 namespace {
 
@@ -19,19 +18,8 @@ using namespace craneassist::dynamics;
 
 const std::string kPath = std::string(CRANEASSIST_SOURCE_DIR) + "/config/cranes/mhsb_3link.yaml";
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 ConfigError error_after_edit(const std::string& from, const std::string& to) {
-  std::string text = read_file(kPath);
-  const auto pos = text.find(from);
-  EXPECT_NE(pos, std::string::npos) << from;
-  text.replace(pos, from.size(), to);
-  return craneassist::test::thrown_error<ConfigError>(
-      [&] { craneassist::config::parse_crane_config(text, "edited.yaml"); },
-      "no error after replacing '" + from + "' with '" + to + "'");
+  return craneassist::test::crane_config_error_after_edit(kPath, from, to);
 }
 
 TEST(MhsbConfig, TheShippedArmIsThePapersTable1) {
