@@ -7,15 +7,8 @@
 #include "craneassist/input/hermite.hpp"
 
 namespace craneassist::input {
-namespace {
-
-constexpr int kFresh = 4;
-constexpr int kIndexMask = 3;
-
-}  // namespace
-
 GoalSource::GoalSource(const GoalSourceSettings& settings) : settings_(settings) {
-  for (auto& plan : plans_) plan.samples.resize(settings.capacity);
+  for (auto& plan : plans_.slots()) plan.samples.resize(settings.capacity);
 }
 
 bool GoalSource::publish(std::span<const TipSample> samples, double start_t_s) {
@@ -27,12 +20,11 @@ bool GoalSource::publish(std::span<const TipSample> samples, double start_t_s) {
     if (!std::isfinite(s.t_s) || !s.p_m.allFinite() || !s.v_m_s.allFinite()) return false;
     if (k > 0 && !(s.t_s > samples[k - 1].t_s)) return false;
   }
-  Plan& plan = plans_[static_cast<std::size_t>(back_index_)];
+  Plan& plan = plans_.back();
   std::copy(samples.begin(), samples.end(), plan.samples.begin());
   plan.count = samples.size();
   plan.start_t_s = start_t_s;
-  // Hand the written plan over; take back whichever the middle held.
-  back_index_ = middle_.exchange(back_index_ | kFresh, std::memory_order_acq_rel) & kIndexMask;
+  plans_.publish();
   return true;
 }
 
@@ -56,8 +48,8 @@ bool GoalSource::last_tip(Eigen::Vector3d& tip_m, double& t_s) const noexcept {
 }
 
 void GoalSource::sample(double tau_s, Eigen::Vector3d& p, Eigen::Vector3d& v) noexcept {
-  const auto& s = front_->samples;
-  const std::size_t n = front_->count;
+  const auto& s = plans_.front().samples;
+  const std::size_t n = plans_.front().count;
   if (tau_s <= s[0].t_s) {
     p = s[0].p_m;
     v = tau_s < s[0].t_s ? Eigen::Vector3d::Zero() : s[0].v_m_s;
@@ -91,9 +83,7 @@ void GoalSource::begin_cycle(double now_s, const Eigen::Vector3d& tip_m) noexcep
 
 SourceState GoalSource::poll(OperatorCommand& out) noexcept {
   // A newer plan?
-  if (middle_.load(std::memory_order_acquire) & kFresh) {
-    front_index_ = middle_.exchange(front_index_, std::memory_order_acq_rel) & kIndexMask;
-    front_ = &plans_[static_cast<std::size_t>(front_index_)];
+  if (plans_.update()) {
     cursor_ = 0;
     reached_ = false;
     // A plan taken while the tip is not being commanded starts once the monitor has armed.
@@ -109,7 +99,7 @@ SourceState GoalSource::poll(OperatorCommand& out) noexcept {
   out.v_m_s.setZero();
   out.deadman = false;
   Eigen::Vector3d v_ref;
-  const double tau = now_s_ - front_->start_t_s;
+  const double tau = now_s_ - plans_.front().start_t_s;
   sample(tau, reference_, v_ref);
   if (!tip_m_.allFinite()) {
     state_ = "no tip measurement";
@@ -117,7 +107,7 @@ SourceState GoalSource::poll(OperatorCommand& out) noexcept {
     return SourceState::kOk;
   }
   const Eigen::Vector3d error = reference_ - tip_m_;
-  const bool ended = !waiting_ && tau >= front_->samples[front_->count - 1].t_s;
+  const bool ended = !waiting_ && tau >= plans_.front().samples[plans_.front().count - 1].t_s;
   if (ended && (reached_ || error.norm() <= settings_.goal_tolerance_m)) {
     reached_ = true;
     state_ = "goal reached";
@@ -141,7 +131,7 @@ SourceState GoalSource::poll(OperatorCommand& out) noexcept {
       return SourceState::kOk;
     }
     waiting_ = false;
-    front_->start_t_s = now_s_;
+    plans_.front().start_t_s = now_s_;
     cursor_ = 0;
     sample(0.0, reference_, v_ref);
   }

@@ -21,6 +21,7 @@
 #include "craneassist/input/gamepad.hpp"
 #include "craneassist/input/joystick_mapping.hpp"
 #include "craneassist/input/latest_pad.hpp"
+#include "craneassist/input/triple_buffer.hpp"
 #include "pad_message.hpp"
 #include "scene.hpp"
 
@@ -114,13 +115,13 @@ struct WebServer::Impl {
     Impl& impl_;
   };
 
-  // Hands a row to the I/O thread; a busy slot skips it (the page samples at its own rate).
+  // Hands a row to the I/O thread without waiting; the page samples the newest at its own rate,
+  // and the last row of a run (its end) is always sent.
   void publish(const control::LogRow& r) noexcept {
-    if (row_mutex.try_lock()) {
-      row = r;
-      ++row_seq;
-      row_mutex.unlock();
-    }
+    Published& p = rows.back();
+    p.row = r;
+    p.seq = ++published_seq;
+    rows.publish();
   }
   void start();
   void tick();
@@ -141,12 +142,13 @@ struct WebServer::Impl {
   std::promise<void> stopped;
 
   // Loop -> I/O thread.
-  std::mutex row_mutex;
-  control::LogRow row;
-  std::uint64_t row_seq = 0;
+  struct Published {
+    control::LogRow row;
+    std::uint64_t seq = 0;  // how many rows were published up to this one
+  };
+  input::TripleBuffer<Published> rows;  // from the loop (or the DDS watch) to the I/O thread
+  std::uint64_t published_seq = 0;      // the publishing thread's
   // I/O thread only.
-  control::LogRow taken;
-  std::uint64_t sent_seq = 0;
   std::string frame_text;
   std::vector<std::weak_ptr<WsSession>> sessions;
   WsSession* holder = nullptr;
@@ -371,17 +373,9 @@ void WebServer::Impl::start() {
 }
 
 void WebServer::Impl::tick() {
-  bool fresh = false;
-  {
-    std::lock_guard<std::mutex> lock(row_mutex);
-    if (row_seq != sent_seq) {
-      taken = row;
-      sent_seq = row_seq;
-      fresh = true;
-    }
-  }
-  if (fresh && !sessions.empty()) {  // no page: no drawing to compute
-    scene.frame_json(taken, sent_seq, frame_text);
+  // No page: no drawing to compute (the newest row waits for the first page).
+  if (!sessions.empty() && rows.update()) {
+    scene.frame_json(rows.front().row, rows.front().seq, frame_text);
     broadcast(std::make_shared<const std::string>(frame_text));
   }
   const double rate = options.frame_rate_hz > 0.0 ? options.frame_rate_hz : 30.0;

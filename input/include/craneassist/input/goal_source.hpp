@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "craneassist/input/command_source.hpp"
+#include "craneassist/input/triple_buffer.hpp"
 
 namespace craneassist::input {
 
@@ -61,7 +62,7 @@ class GoalSource final : public CommandSource {
   const char* name() const noexcept override { return "goal"; }
 
   // Control thread (or after the run): the plan in use and where on it the last cycle was.
-  bool has_plan() const noexcept { return front_ != nullptr && front_->count > 0; }
+  bool has_plan() const noexcept { return plans_.front().count > 0; }
   bool reached() const noexcept { return reached_; }
   // "no goal", "arming" (before a move from rest: one cycle with the deadman released, as the input
   // monitor arms on a press, then arming_s with it held and no motion), "following", "goal
@@ -83,14 +84,8 @@ class GoalSource final : public CommandSource {
   const char* state_ = "no goal";
   bool primed_ = false;  // the deadman was reported released since the last stop
   double primed_at_s_ = 0.0;
-  bool waiting_ = false;  // the plan's clock waits for the arming to end
-  std::array<Plan, 3> plans_;
-  // Triple buffer: the producer owns back_, the consumer front_; middle_ holds the third plan's
-  // index with bit 2 set when it is newer than the consumer's.
-  int back_index_ = 0;
-  std::atomic<int> middle_{1};
-  int front_index_ = 2;
-  Plan* front_ = nullptr;
+  bool waiting_ = false;      // the plan's clock waits for the arming to end
+  TripleBuffer<Plan> plans_;  // the producer writes the back plan, the loop follows the front
   std::size_t cursor_ = 0;
   bool reached_ = false;
   Eigen::Vector3d reference_ = Eigen::Vector3d::Zero();
