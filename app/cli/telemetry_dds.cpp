@@ -71,6 +71,12 @@ void Telemetry::finish() {
       static_cast<unsigned long long>(s.samples_written[3]),
       static_cast<unsigned long long>(s.frames_dropped),
       static_cast<unsigned long long>(s.write_errors));
+  if (s.end_unacknowledged > 0) {
+    std::printf(
+        "  telemetry: the end of the run was not acknowledged on %d topic(s) within 0.5 s (a "
+        "reader that left, or a slow network): watchers may not show it\n",
+        s.end_unacknowledged);
+  }
   if (s.samples_written[4] > 0) {  // a run with a wheeled base (sim --drive)
     std::printf("  telemetry base: %llu samples on craneassist/base\n",
                 static_cast<unsigned long long>(s.samples_written[4]));

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
@@ -137,7 +138,25 @@ struct TelemetryPublisher::Impl {
         publish(latest, false);
       }
       if (stopping) {
-        if (have_latest) publish(latest, true);  // the final state on every topic
+        if (have_latest) {
+          publish(latest, true);  // the final state on every topic
+          // The end of the run (status "stopped" and why) is on reliable topics: let the
+          // matched readers have it before the writers go, for at most half a second (a reader
+          // that died cannot hold the exit up).
+          const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
+          for (auto* w : writers) {
+            const auto left_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                     until - std::chrono::steady_clock::now())
+                                     .count();
+            if (w == nullptr) continue;
+            if (left_ns <= 0 || w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(
+                                    static_cast<std::int32_t>(left_ns / 1000000000),
+                                    static_cast<std::uint32_t>(left_ns % 1000000000))) !=
+                                    ReturnCode_t::RETCODE_OK) {
+              end_unacknowledged.fetch_add(1, std::memory_order_relaxed);
+            }
+          }
+        }
         return;
       }
     }
@@ -287,6 +306,7 @@ struct TelemetryPublisher::Impl {
     }
     if (ros2) s.matched_readers += ros2->matched_readers();
     s.write_errors = write_errors.load();
+    s.end_unacknowledged = end_unacknowledged.load();
     return s;
   }
 
@@ -314,6 +334,7 @@ struct TelemetryPublisher::Impl {
   std::atomic<bool> stop{false};
   std::atomic<std::uint64_t> pushed{0}, dropped{0}, write_errors{0};
   std::atomic<std::uint64_t> written[kTelemetryTopics] = {};
+  std::atomic<int> end_unacknowledged{0};
   std::thread thread;
 };
 

@@ -22,6 +22,9 @@ struct PublisherStats {
   std::uint64_t ros2_samples_written[3] = {};
   std::uint64_t write_errors = 0;
   int matched_readers = 0;  // over all topics, at the time of the call
+  // After close(): topics whose final sample (the end of the run) some reliable reader had not
+  // acknowledged within the 0.5 s close() waits.
+  int end_unacknowledged = 0;
 };
 
 class TelemetryPublisher {
