@@ -429,9 +429,20 @@ int run_ptp_command(const PtpArgs& args) {
   } else if (!loaded) {
     std::printf(
         "    in %.1f s (%d threads, %ld SLSQP runs, %ld entries without a converged run, %ld "
-        "without polytope area)%s\n",
+        "without polytope area, %ld not the best for continuity)%s\n",
         table->build_time_s, table_settings.threads, table->optimisations, table->unconverged,
-        table->degenerate, file ? (", written to " + file->string()).c_str() : "");
+        table->degenerate, table->continued,
+        file ? (", written to " + file->string()).c_str() : "");
+  }
+  {
+    // Posture jumps between neighbouring nodes (docs/mhsb.md#s1-the-optimal-posture-table).
+    long all = 0;
+    for (int p = 0; p < table->pattern_count(); ++p) all += table->jumps(*arm, p);
+    std::printf(
+        "    posture jumps (a joint moving over a quarter of its range between neighbouring "
+        "nodes): %d of %d pairs all N, %ld of %ld over all patterns\n",
+        table->jumps(*arm, 0), table->neighbour_pairs(), all,
+        static_cast<long>(table->neighbour_pairs()) * table->pattern_count());
   }
   std::string limits;
   for (int k = 0; k < arm->moving(); ++k) {
