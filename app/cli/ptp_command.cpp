@@ -429,13 +429,13 @@ int run_ptp_command(const PtpArgs& args) {
   } else if (!loaded) {
     std::printf(
         "    in %.1f s (%d threads, %ld SLSQP runs, %ld entries without a converged run, %ld "
-        "without polytope area, %ld not the best for continuity)%s\n",
+        "without polytope area)%s\n",
         table->build_time_s, table_settings.threads, table->optimisations, table->unconverged,
-        table->degenerate, table->continued,
-        file ? (", written to " + file->string()).c_str() : "");
+        table->degenerate, file ? (", written to " + file->string()).c_str() : "");
   }
   {
-    // Posture jumps between neighbouring nodes (docs/mhsb.md#s1-the-optimal-posture-table).
+    // Posture jumps between neighbouring nodes (docs/mhsb.md#where-and-why-our-figures-differ);
+    // pattern 0 is all N.
     long all = 0;
     for (int p = 0; p < table->pattern_count(); ++p) all += table->jumps(*arm, p);
     std::printf(
