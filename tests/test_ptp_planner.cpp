@@ -142,6 +142,28 @@ TEST(PostureTable, EntriesAreOnTheirNodesWithinTheRangesAndBeatRandomPostures) {
   EXPECT_GT(compared, 20);
 }
 
+// The continuity tie-break (docs/mhsb.md#s1-the-optimal-posture-table): the all-N table of a
+// region where the largest polytopes jump between the arm's mirror branches, built with and
+// without it. With it, fewer neighbouring nodes jump, and no entry falls more than the tolerance
+// below the best-only table (its first pass is the same).
+TEST(PostureTable, TheContinuityTieBreakKeepsNeighboursOnOneBranch) {
+  auto settings = region_settings(0.05, 1);
+  const auto best_only = planner::PostureTable::build(arm(), settings);
+  settings.continuity_tolerance = 0.3;
+  const auto continued = planner::PostureTable::build(arm(), settings);
+  ASSERT_EQ(continued.grid().nodes(), best_only.grid().nodes());
+  EXPECT_EQ(best_only.continued, 0);
+  EXPECT_GT(continued.continued, 0);
+  const int jumps_before = best_only.jumps(arm(), 0), jumps_after = continued.jumps(arm(), 0);
+  EXPECT_GT(jumps_before, 0);  // else the region shows nothing
+  EXPECT_LT(jumps_after, jumps_before);
+  for (int n = 0; n < continued.grid().nodes(); ++n) {
+    EXPECT_GE(continued.area(n, 0), (1.0 - 0.3) * best_only.area(n, 0) - 1e-12) << "node " << n;
+  }
+  // A tolerance is another table: its fingerprint differs.
+  EXPECT_NE(continued.fingerprint(), best_only.fingerprint());
+}
+
 TEST(PostureTable, TheFileRoundTripsAndAnotherModelOrGridRebuilds) {
   const auto settings = region_settings(0.1, 0);
   const auto file = std::filesystem::path(testing::TempDir()) / "ptp-table-test.bin";
