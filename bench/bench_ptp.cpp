@@ -43,6 +43,8 @@ void BM_PostureTable(benchmark::State& state) {
     state.counters["nodes"] = table.grid().nodes();
     state.counters["patterns"] = table.pattern_count();
     state.counters["slsqp_runs"] = static_cast<double>(table.optimisations);
+    state.counters["jumps_all_n"] = table.jumps(arm, 0);  // pattern 0: all N
+    state.counters["neighbour_pairs"] = table.neighbour_pairs();
   }
 }
 BENCHMARK(BM_PostureTable)

@@ -142,6 +142,28 @@ TEST(PostureTable, EntriesAreOnTheirNodesWithinTheRangesAndBeatRandomPostures) {
   EXPECT_GT(compared, 20);
 }
 
+// The continuity tie-break (docs/mhsb.md#s1-the-optimal-posture-table): the all-N table of a
+// region where the largest polytopes jump between the arm's mirror branches, built with and
+// without it. With it, fewer neighbouring nodes jump, and no entry falls more than the tolerance
+// below the best-only table (its first pass is the same).
+TEST(PostureTable, TheContinuityTieBreakKeepsNeighboursOnOneBranch) {
+  auto settings = region_settings(0.05, 1);
+  const auto best_only = planner::PostureTable::build(arm(), settings);
+  settings.continuity_tolerance = 0.3;
+  const auto continued = planner::PostureTable::build(arm(), settings);
+  ASSERT_EQ(continued.grid().nodes(), best_only.grid().nodes());
+  EXPECT_EQ(best_only.continued, 0);
+  EXPECT_GT(continued.continued, 0);
+  const int jumps_before = best_only.jumps(arm(), 0), jumps_after = continued.jumps(arm(), 0);
+  EXPECT_GT(jumps_before, 0);  // else the region shows nothing
+  EXPECT_LT(jumps_after, jumps_before);
+  for (int n = 0; n < continued.grid().nodes(); ++n) {
+    EXPECT_GE(continued.area(n, 0), (1.0 - 0.3) * best_only.area(n, 0) - 1e-12) << "node " << n;
+  }
+  // A tolerance is another table: its fingerprint differs.
+  EXPECT_NE(continued.fingerprint(), best_only.fingerprint());
+}
+
 TEST(PostureTable, TheFileRoundTripsAndAnotherModelOrGridRebuilds) {
   const auto settings = region_settings(0.1, 0);
   const auto file = std::filesystem::path(testing::TempDir()) / "ptp-table-test.bin";
@@ -160,6 +182,40 @@ TEST(PostureTable, TheFileRoundTripsAndAnotherModelOrGridRebuilds) {
   const planner::PlanarArm lighter(cfg.model, cfg.simulation.q_initial);
   EXPECT_FALSE(planner::PostureTable::load(file, lighter, settings).has_value());
   std::filesystem::remove(file);
+}
+
+// jumps() looks at every pair of neighbouring nodes (8-neighbourhood) once: against all pairs of
+// nodes, each checked by the rule (a joint moving more than the fraction of its range).
+TEST(PostureTable, JumpsCountEveryNeighbourPairOnce) {
+  const auto& t = small_table();
+  const auto& g = t.grid();
+  int pairs = 0;
+  for (int p : {0, 5}) {
+    for (const double fraction : {0.0, 0.05, 0.25}) {
+      int jumps = 0;
+      pairs = 0;
+      for (int a = 0; a < g.nodes(); ++a) {
+        for (int b = a + 1; b < g.nodes(); ++b) {
+          const auto sa = static_cast<std::size_t>(a), sb = static_cast<std::size_t>(b);
+          if (std::max(std::abs(g.node_i[sa] - g.node_i[sb]),
+                       std::abs(g.node_k[sa] - g.node_k[sb])) != 1) {
+            continue;
+          }
+          ++pairs;
+          bool jump = false;
+          for (int k = 0; k < 3; ++k) {
+            jump = jump || std::abs(t.posture(a, p)[k] - t.posture(b, p)[k]) >
+                               fraction * (arm().upper(k) - arm().lower(k));
+          }
+          jumps += jump ? 1 : 0;
+        }
+      }
+      EXPECT_EQ(t.jumps(arm(), p, fraction), jumps) << "pattern " << p << " fraction " << fraction;
+    }
+  }
+  EXPECT_EQ(t.neighbour_pairs(), pairs);
+  EXPECT_GT(pairs, 20);
+  EXPECT_EQ(t.jumps(arm(), 0, 1.0), 0);  // no joint moves more than its range
 }
 
 // The 2R inverse kinematics of the paper's arm with J3 held at q3: both elbows, within the ranges.

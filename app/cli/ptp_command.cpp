@@ -286,6 +286,11 @@ CLI::App* add_ptp_command(CLI::App& cli, PtpArgs& args) {
       ->check(FiniteRange(0.0, 1e12));
   cmd->add_option("--threads", args.threads, "Threads for building the posture table (default 2)")
       ->check(CLI::Range(1, 64));
+  cmd->add_option("--continuity-tolerance", args.continuity_tolerance,
+                  "Posture table: of the postures within this fraction of a node's largest "
+                  "polytope area, keep the one nearest the neighbouring nodes' (e.g. 0.3; "
+                  "default 0: the largest, paper 001's S1)")
+      ->check(FiniteRange(0.0, 0.99));
   cmd->add_option("--posture", args.posture,
                   "Where the postures come from: optimal (default; the optimal posture table, "
                   "S1) or fixed-last:ANGLE (the conventional method of paper 001's Case 4: the "
@@ -351,6 +356,7 @@ int run_ptp_command(const PtpArgs& args) {
       settings.energy_model = *dynamics::parse_mhsb_energy_model(args.energy_model);
     }
     table_settings.threads = args.threads;
+    table_settings.continuity_tolerance = args.continuity_tolerance;
     if (args.posture != "optimal") {
       const std::string prefix = "fixed-last:";
       if (args.posture.rfind(prefix, 0) != 0 || args.posture.size() == prefix.size()) {
@@ -415,8 +421,13 @@ int run_ptp_command(const PtpArgs& args) {
 
   const auto& grid = table->grid();
   std::printf("craneassist ptp: %s\n", cfg.model.name.c_str());
-  std::printf("  posture table: %d nodes x %d patterns, %.0f mm grid, %s\n", grid.nodes(),
-              table->pattern_count(), 1000.0 * grid.spacing_m,
+  char continuity[64] = "";
+  if (table_settings.continuity_tolerance > 0.0 && !fixed_last) {
+    std::snprintf(continuity, sizeof continuity, ", continuity tolerance %.3g %%",
+                  100.0 * table_settings.continuity_tolerance);
+  }
+  std::printf("  posture table: %d nodes x %d patterns, %.0f mm grid%s, %s\n", grid.nodes(),
+              table->pattern_count(), 1000.0 * grid.spacing_m, continuity,
               loaded ? ("loaded from " + file->string()).c_str() : "built");
   if (fixed_last) {
     std::printf(
@@ -429,9 +440,21 @@ int run_ptp_command(const PtpArgs& args) {
   } else if (!loaded) {
     std::printf(
         "    in %.1f s (%d threads, %ld SLSQP runs, %ld entries without a converged run, %ld "
-        "without polytope area)%s\n",
+        "without polytope area, %ld kept off the best for continuity)%s\n",
         table->build_time_s, table_settings.threads, table->optimisations, table->unconverged,
-        table->degenerate, file ? (", written to " + file->string()).c_str() : "");
+        table->degenerate, table->continued,
+        file ? (", written to " + file->string()).c_str() : "");
+  }
+  {
+    // Posture jumps between neighbouring nodes (docs/mhsb.md#where-and-why-our-figures-differ);
+    // pattern 0 is all N.
+    long all = 0;
+    for (int p = 0; p < table->pattern_count(); ++p) all += table->jumps(*arm, p);
+    std::printf(
+        "    posture jumps (a joint moving over a quarter of its range between neighbouring "
+        "nodes): %d of %d pairs all N, %ld of %ld over all patterns\n",
+        table->jumps(*arm, 0), table->neighbour_pairs(), all,
+        static_cast<long>(table->neighbour_pairs()) * table->pattern_count());
   }
   std::string limits;
   for (int k = 0; k < arm->moving(); ++k) {

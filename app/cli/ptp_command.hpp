@@ -28,6 +28,7 @@ struct PtpArgs {
   std::string table;           // posture table file; empty: the default cache
   std::optional<double> heuristic_scale;
   int threads = 2;
+  double continuity_tolerance = 0.0;
   std::string posture = "optimal";   // optimal | fixed-last:ANGLE (paper 001 Case 4)
   std::string out;                   // joint trajectory CSV; empty: none
   std::string path_out;              // the S2 path's nodes as CSV; empty: none

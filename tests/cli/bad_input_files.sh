@@ -146,6 +146,8 @@ expect ptp_bad_velocity "--velocity-limit: unit 'bar' is not a velocity unit" \
   ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --velocity-limit "3 bar"
 expect ptp_bad_grid "--grid: must be between 5 mm and 5 m" \
   ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --grid "1 mm"
+expect ptp_bad_continuity "--continuity-tolerance: '2' is not a finite number in [0, 0.99]" \
+  ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --continuity-tolerance 2
 expect ptp_bad_posture "--posture: 'fixed-j3': expected optimal or fixed-last:ANGLE" \
   ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --posture fixed-j3
 expect ptp_posture_nan "--posture: 'abc' is not a finite number" \

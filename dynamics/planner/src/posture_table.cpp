@@ -397,15 +397,26 @@ PostureTable PostureTable::build(const PlanarArm& arm, const PostureTableSetting
   const auto t0 = std::chrono::steady_clock::now();
   Workspace w;
   PostureTable t = empty(arm, settings, posture_table_fingerprint(arm, settings), w);
-  const int nodes = t.grid_.nodes(), np = t.pattern_count();
+  const int nodes = t.grid_.nodes(), np = t.pattern_count(), m = t.moving_;
   std::vector<dynamics::ModePattern> full;
   for (const auto& p : t.patterns_) full.push_back(full_pattern(arm, p));
+  const double tolerance = std::max(0.0, settings.continuity_tolerance);
 
+  // Per entry the local optima found (with the best start), by the area compared: the true one,
+  // or for a degenerate entry the load-free one.
+  struct Candidate {
+    ArmVector a;
+    double area;
+  };
+  std::vector<std::vector<Candidate>> candidates(at(nodes * np));
+  std::vector<char> degenerate_entry(at(nodes * np), 0);
+  std::atomic<long> runs{0}, unconverged{0}, degenerate{0}, continued{0};
+
+  // Pass 1, in parallel over nodes: SLSQP from the best starts of each node and pattern.
   std::atomic<int> next{0};
-  std::atomic<long> runs{0}, unconverged{0}, degenerate{0};
   std::mutex progress_mutex;
   int done = 0;
-  auto work = [&] {
+  auto optimise_nodes = [&] {
     PolytopeArea area(arm);
     dynamics::KinematicsData data;
     std::vector<std::pair<double, int>> ranked;
@@ -413,15 +424,17 @@ PostureTable PostureTable::build(const PlanarArm& arm, const PostureTableSetting
       const auto& starts = w.starts[at(node)];
       const Eigen::Vector2d target = t.grid_.node_xz[at(node)];
       for (int p = 0; p < np; ++p) {
-        // The best of the starts, then SLSQP from the best few.
-        const auto optimise = [&](ArmVector& best, double& best_area) {
+        auto& found = candidates[t.entry(node, p)];
+        // The best of the starts, then SLSQP from the best few; the best area found.
+        const auto optimise = [&] {
+          found.clear();
           ranked.clear();
           for (std::size_t s = 0; s < starts.size(); ++s) {
             ranked.emplace_back(area(starts[s], full[at(p)]), static_cast<int>(s));
           }
           std::sort(ranked.begin(), ranked.end(), std::greater<>());
-          best = starts[at(ranked[0].second)];
-          best_area = ranked[0].first;
+          found.push_back({starts[at(ranked[0].second)], ranked[0].first});
+          double best_area = ranked[0].first;
           bool converged = false;
           const int tries = std::min(static_cast<int>(ranked.size()), settings.refined_starts);
           for (int r = 0; r < tries; ++r) {
@@ -430,30 +443,23 @@ PostureTable PostureTable::build(const PlanarArm& arm, const PostureTableSetting
             runs.fetch_add(1);
             if (s < 0.0) continue;
             converged = true;
-            if (s > best_area) {
-              best_area = s;
-              best = a;
-            }
+            found.push_back({a, s});
+            best_area = std::max(best_area, s);
           }
-          return converged;
+          return std::pair{converged, best_area};
         };
-        ArmVector best;
-        double best_area = 0.0;
-        bool converged = optimise(best, best_area);
+        auto [converged, best_area] = optimise();
         if (!(best_area > kDegenerateArea)) {
           // No posture lets every joint move both ways in this pattern (a joint cannot hold its
           // load from its mode's supply anywhere): the posture of the largest polytope without
           // the load instead, a well-defined one (the stored area stays the true one).
           area.set_ignore_load(true);
-          converged = optimise(best, best_area);
+          converged = optimise().first;
           area.set_ignore_load(false);
-          best_area = area(best, full[at(p)]);
+          degenerate_entry[t.entry(node, p)] = 1;
           degenerate.fetch_add(1);
         }
         if (!converged) unconverged.fetch_add(1);
-        const std::size_t e = t.entry(node, p);
-        for (int k = 0; k < t.moving_; ++k) t.q_[e * at(t.moving_) + at(k)] = best[k];
-        t.area_[e] = best_area;
       }
       if (progress) {
         std::lock_guard lock(progress_mutex);
@@ -461,16 +467,114 @@ PostureTable PostureTable::build(const PlanarArm& arm, const PostureTableSetting
       }
     }
   };
+
+  // Pass 2, in parallel over patterns: each swept over the nodes in their numbering (row by row
+  // from the lowest, each in increasing X), so a node's W, SW, S and SE neighbours are done
+  // before it. SLSQP also runs from the postures of the first two of them (in the order S, W, SW,
+  // SE) pulled onto the node; of the candidates within the tolerance of the best, the one nearest
+  // the done neighbours' postures (joint differences as fractions of the joints' ranges) is kept.
+  std::vector<double> range(at(m));
+  for (int k = 0; k < m; ++k) range[at(k)] = std::max(arm.upper(k) - arm.lower(k), 1e-9);
+  const auto distance = [&](const ArmVector& a, const ArmVector& b) {
+    double d2 = 0.0;
+    for (int k = 0; k < m; ++k) d2 += std::pow((a[k] - b[k]) / range[at(k)], 2);
+    return std::sqrt(d2);
+  };
+  std::atomic<int> next_pattern{0};
+  auto sweep_patterns = [&] {
+    PolytopeArea area(arm);
+    dynamics::KinematicsData data;
+    std::vector<ArmVector> done_neighbours, seeds;
+    for (int p; (p = next_pattern.fetch_add(1)) < np;) {
+      for (int node = 0; node < nodes; ++node) {
+        const std::size_t e = t.entry(node, p);
+        auto& found = candidates[e];
+        const bool load_free = degenerate_entry[e] != 0;
+        done_neighbours.clear();
+        seeds.clear();
+        for (const int d : {6, 4, 5, 7}) {  // S, W, SW, SE
+          const int n = t.grid_.neighbour(node, d);
+          if (n < 0) continue;
+          done_neighbours.push_back(t.posture(n, p));
+          if (seeds.size() < 2) seeds.push_back(done_neighbours.back());  // the first two
+        }
+        if (tolerance > 0.0) {
+          area.set_ignore_load(load_free);
+          const Eigen::Vector2d target = t.grid_.node_xz[at(node)];
+          for (ArmVector a : seeds) {
+            if (!pull_onto(arm, data, target, a)) continue;
+            const double s = maximise(arm, area, data, full[at(p)], target, a);
+            runs.fetch_add(1);
+            if (s >= 0.0) found.push_back({a, s});
+          }
+          area.set_ignore_load(false);
+        }
+        std::size_t best = 0;
+        for (std::size_t c = 1; c < found.size(); ++c) {
+          if (found[c].area > found[best].area) best = c;
+        }
+        std::size_t chosen = best;
+        if (tolerance > 0.0 && !done_neighbours.empty()) {
+          double nearest = kInf;
+          for (std::size_t c = 0; c < found.size(); ++c) {
+            if (found[c].area < (1.0 - tolerance) * found[best].area) continue;
+            double d = 0.0;
+            for (const auto& q : done_neighbours) d += distance(found[c].a, q);
+            if (d < nearest) {
+              nearest = d;
+              chosen = c;
+            }
+          }
+        }
+        if (distance(found[chosen].a, found[best].a) > 0.01) continued.fetch_add(1);
+        const ArmVector& q = found[chosen].a;
+        for (int k = 0; k < m; ++k) t.q_[e * at(m) + at(k)] = q[k];
+        t.area_[e] = load_free ? area(q, full[at(p)]) : found[chosen].area;
+        std::vector<Candidate>().swap(found);
+      }
+    }
+  };
+
   const int threads = std::clamp(settings.threads, 1, 64);
-  std::vector<std::thread> pool;
-  for (int i = 1; i < threads; ++i) pool.emplace_back(work);
-  work();
-  for (auto& th : pool) th.join();
+  for (const auto& work :
+       {std::function<void()>(optimise_nodes), std::function<void()>(sweep_patterns)}) {
+    std::vector<std::thread> pool;
+    for (int i = 1; i < threads; ++i) pool.emplace_back(work);
+    work();
+    for (auto& th : pool) th.join();
+  }
   t.optimisations = runs.load();
   t.unconverged = unconverged.load();
   t.degenerate = degenerate.load();
+  t.continued = continued.load();
   t.build_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return t;
+}
+
+int PostureTable::neighbour_pairs() const {
+  int pairs = 0;
+  for (int n = 0; n < grid_.nodes(); ++n) {
+    for (int d = 0; d < 4; ++d) pairs += grid_.neighbour(n, d) >= 0 ? 1 : 0;
+  }
+  return pairs;
+}
+
+int PostureTable::jumps(const PlanarArm& arm, int pattern, double fraction) const {
+  int count = 0;
+  for (int n = 0; n < grid_.nodes(); ++n) {
+    const ArmVector a = posture(n, pattern);
+    for (int d = 0; d < 4; ++d) {  // E, NE, N, NW: every pair once
+      const int o = grid_.neighbour(n, d);
+      if (o < 0) continue;
+      const ArmVector b = posture(o, pattern);
+      bool jump = false;
+      for (int k = 0; k < moving_; ++k) {
+        jump = jump || std::abs(a[k] - b[k]) > fraction * (arm.upper(k) - arm.lower(k));
+      }
+      count += jump ? 1 : 0;
+    }
+  }
+  return count;
 }
 
 PostureTable PostureTable::fixed_last_joint(const PlanarArm& arm,
@@ -697,6 +801,8 @@ std::uint64_t posture_table_fingerprint(const PlanarArm& arm,
   f.add(settings.seeds_per_node);
   f.add(settings.refined_starts);
   f.add(settings.max_patterns);
+  // Only when set: the default table is the one built before the setting existed.
+  if (settings.continuity_tolerance > 0.0) f.add(settings.continuity_tolerance);
   if (settings.region) {
     for (int i = 0; i < 4; ++i) f.add((*settings.region)[i]);
   }

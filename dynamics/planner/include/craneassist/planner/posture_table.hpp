@@ -20,9 +20,17 @@
 // table then keeps the posture of the largest polytope without the load, so that neighbouring
 // nodes get neighbouring postures rather than arbitrary ones.
 //
-// The table is built in parallel over nodes and kept in a binary file whose header holds a
-// fingerprint of everything it depends on (model, held joints, grid, settings): a file that does
-// not match is rebuilt (save(), load()).
+// Continuity (optional, continuity_tolerance > 0): a redundant arm often has optima on two
+// branches (the paper's arm: its mirror postures, elbow one way or the other), and the best alone
+// jumps between branches from node to node. Then each pattern is swept over the nodes row by row
+// (from the lowest, each row in increasing X); at a node whose lower or left neighbours are done,
+// SLSQP also runs from their postures pulled onto the node, and of the results whose area is
+// within continuity_tolerance of the node's best, the one nearest those neighbours' postures is
+// kept. The table is then no longer the largest polytope per node, only within the tolerance.
+//
+// The table is built in parallel over nodes (the continuity sweep over patterns) and kept in a
+// binary file whose header holds a fingerprint of everything it depends on (model, held joints,
+// grid, settings): a file that does not match is rebuilt (save(), load()).
 #pragma once
 
 #include <Eigen/Core>
@@ -72,6 +80,9 @@ struct PostureTableSettings {
   int threads = 2;
   int seeds_per_node = 36;  // starting postures per node (slices of the last joint's range)
   int refined_starts = 4;   // SLSQP runs per node and pattern
+  // Of the postures whose area is within this fraction of the node's best, the one nearest the
+  // neighbours' (the continuity sweep above); 0 (default): the best, paper 001's S1.
+  double continuity_tolerance = 0.0;
   // Only nodes inside this box (X, Z min, max; tests); empty: the whole workspace.
   std::optional<Eigen::Vector4d> region;
   int max_patterns = 0;  // the first patterns only (tests); 0: all
@@ -144,6 +155,13 @@ class PostureTable {
   long optimisations = 0;
   long unconverged = 0;
   long degenerate = 0;  // entries whose polytope has no area (posture: the load-free optimum)
+  long continued = 0;   // entries the continuity tie-break moved off the best optimum found
+
+  // Neighbouring nodes (E, N, NE and NW of each node: every pair once) whose postures of pattern
+  // differ in some moving joint by more than `fraction` of its range: a jump between branches.
+  int jumps(const PlanarArm& arm, int pattern, double fraction = 0.25) const;
+  // The neighbour pairs jumps() looks at.
+  int neighbour_pairs() const;
 
  private:
   // A table with its grid and patterns sized and no postures yet; the workspace sampled for it
