@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -195,6 +196,10 @@ void warn_if_other_crane(const dds::WatchedRun& run, const config::CraneConfig& 
 
 }  // namespace
 
+// The page's status of a watched run that went silent before it said it stopped.
+constexpr const char* kLost = "lost";
+constexpr const char* kLostReason = "no telemetry: the watched run died or its network failed";
+
 int run_web_watch_command(const WebWatchArgs& args) {
   const auto settings = tool_settings(args);
   if (!settings) return kExitUsage;
@@ -212,6 +217,7 @@ int run_web_watch_command(const WebWatchArgs& args) {
     o.domain_id = settings->domain_id;
     o.transport = settings->transport;
     o.type_propagation = settings->type_propagation;
+    o.status = settings->status;
     watch = std::make_unique<dds::TelemetryWatch>(o);
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
@@ -225,15 +231,30 @@ int run_web_watch_command(const WebWatchArgs& args) {
   const auto elapsed_s = [&] {
     return std::chrono::duration<double>(Clock::now() - start).count();
   };
+  // A run that goes silent before it says it stopped has died (or its network has): after three
+  // periods of its fastest topic, at least 1 s (the dashboard's STALE), the page says so.
+  const double fastest_hz =
+      std::max({settings->status.rate_hz, settings->joints.rate_hz, settings->hydraulics.rate_hz,
+                settings->command_path.rate_hz});
+  const double lost_after_s = std::max(1.0, fastest_hz > 0.0 ? 3.0 / fastest_hz : 1.0);
   dds::TelemetryFrame frame;
   control::LogRow row;
   std::uint64_t seen = 0;  // 0: nothing received yet
   bool announced = false;
+  bool lost = false;
+  bool told_incompatible = false;  // checked every 100 polls (0.5 s)
+  unsigned polls = 0;
+  double last_sample_s = 0.0;
   std::string last_status;
   int rc = kExitOk;
   while (!dds::stop_requested()) {
     if (args.duration_s > 0.0 && elapsed_s() >= args.duration_s) break;
     if (watch->latest(frame, seen)) {
+      last_sample_s = elapsed_s();
+      if (lost) {
+        lost = false;
+        spdlog::info("web: receiving from the watched run again");
+      }
       from_frame(frame, row);
       view.publish(row);
       if (!announced) {  // once the status (the crane's name) and the joints are in
@@ -252,6 +273,18 @@ int run_web_watch_command(const WebWatchArgs& args) {
                        frame.stop_reason);
         }
       }
+    } else if (seen != 0 && !lost && last_status != "stopped" &&
+               elapsed_s() - last_sample_s > lost_after_s) {
+      lost = true;
+      last_status = kLost;
+      frame.status = kLost;
+      frame.stop_reason = kLostReason;
+      from_frame(frame, row);
+      view.publish(row);
+      spdlog::warn(
+          "web: no telemetry from the watched run for {:.1f} s before it said it stopped: "
+          "it died, or its network failed",
+          elapsed_s() - last_sample_s);
     } else if (seen == 0 && args.timeout_s > 0.0 && elapsed_s() > args.timeout_s) {
       const dds::WatchedRun run = watch->run();
       spdlog::error(
@@ -260,6 +293,15 @@ int run_web_watch_command(const WebWatchArgs& args) {
           settings->domain_id, args.timeout_s, run.writers);
       rc = kExitRuntime;
       break;
+    }
+    if (!told_incompatible && ++polls % 100 == 0 && watch->run().status_incompatible > 0) {
+      told_incompatible = true;
+      spdlog::warn(
+          "web: a run publishes its status with a QoS that does not give the {}, {} status this "
+          "watcher asks for (from {}): its status and end will not show; give `web` the run's "
+          "--telemetry-config",
+          to_string(settings->status.reliability), to_string(settings->status.durability),
+          settings->source_name);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }

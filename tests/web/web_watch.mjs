@@ -35,6 +35,7 @@ console.log(`page: ${url}`);
 const browser = await launchChromium(nodeModules);
 const errors = [];
 let replay;
+let dying;
 try {
   const { page } = await openPage(browser, errors);
   await page.goto(url);
@@ -72,16 +73,36 @@ try {
     null, { timeout: 5000 }).catch(() => {});
   const end = await page.evaluate(() => window.craneassist.last);
   check(end.status === 'stopped', `the replay's end shows on the page: ${end.status}${end.stop_reason ? ': ' + end.stop_reason : ''}`);
+
+  // A run that dies (kill -9: no end state sent) shows as lost, not as running forever.
+  const dyingFile = join(work, 'dying.csv');
+  writeFileSync(dyingFile, 't,v_x,v_y,v_z\n0.0,0,0,0\n60,0,0,0\n');
+  dying = run(craneassist, ['replay', dyingFile, '--realtime', '--settle', '1', '--telemetry',
+    '--domain', domain, '--no-log']);
+  await page.waitForFunction(() => window.craneassist.last.status === 'running', null,
+    { timeout: 20000 }).catch(() => {});
+  const alive = await page.evaluate(() => window.craneassist.last.status);
+  check(alive === 'running', `a second run shows as running: ${alive}`);
+  dying.child.kill('SIGKILL');
+  const killedAt = Date.now();
+  await page.waitForFunction(() => window.craneassist.last.status === 'lost', null,
+    { timeout: 10000 }).catch(() => {});
+  const gone = await page.evaluate(() => window.craneassist.last);
+  check(gone.status === 'lost' && /died/.test(gone.stop_reason),
+    `a run killed with SIGKILL shows '${gone.status}: ${gone.stop_reason}' ${((Date.now() - killedAt) / 1000).toFixed(1)} s later`);
   check(errors.length === 0, `no errors in the page${errors.length ? ': ' + errors.join('; ') : ''}`);
 } finally {
   await browser.close();
   if (replay) replay.child.kill('SIGINT');
+  if (dying) dying.child.kill('SIGKILL');
   web.child.kill('SIGINT');
   rmSync(work, { recursive: true, force: true });
 }
 const { code } = await web.exit;
 check(code === 0, `web ended with exit ${code}`);
 check(/web: receiving from crane 'K70M/.test(web.output), 'web named the watched crane');
+check(/web: no telemetry from the watched run for .* before it said it stopped/.test(web.output),
+  'web said the killed run went silent');
 const report = web.output.match(/ {2}web watch: .*\n.*/);
 console.log(failed() === 0 && report ? report[0] : `web printed:\n${web.output}\nreplay printed:\n${replay ? replay.output : ''}`);
 process.exit(failed() === 0 ? 0 : 1);

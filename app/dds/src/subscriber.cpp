@@ -81,7 +81,8 @@ void TopicReader::on_requested_incompatible_qos(fdds::DataReader* /*reader*/,
 }
 
 SubscriberSession::SubscriberSession(const ParticipantOptions& options,
-                                     const std::vector<Topic>& topics, DataCallback on_data)
+                                     const std::vector<Topic>& topics, DataCallback on_data,
+                                     const ReaderSettings& reader_settings)
     : start_ns_(monotonic_ns()) {
   participant_ = make_participant(options);
   fdds::Subscriber* subscriber = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
@@ -89,7 +90,7 @@ SubscriberSession::SubscriberSession(const ParticipantOptions& options,
   for (Topic topic : topics) {
     auto r = std::make_unique<TopicReader>(topic, wakeup_, on_data);
     r->reader_ = subscriber->create_datareader(get_topic(*participant_, topic),
-                                               reader_qos(default_reader_settings(topic)), r.get());
+                                               reader_qos(reader_settings(topic)), r.get());
     if (r->reader_ == nullptr) {
       throw std::runtime_error("DDS: cannot create the reader of " +
                                std::string(topic_info(topic).dds_name));

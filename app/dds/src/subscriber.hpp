@@ -77,9 +77,12 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
 
 class SubscriberSession {
  public:
-  // Throws std::runtime_error when DDS cannot be set up.
+  // Throws std::runtime_error when DDS cannot be set up. Each reader takes `reader_settings` of
+  // its topic (default: best-effort and volatile, which match every writer).
+  using ReaderSettings = std::function<config::TopicSettings(Topic)>;
   SubscriberSession(const ParticipantOptions& options, const std::vector<Topic>& topics,
-                    DataCallback on_data = nullptr);
+                    DataCallback on_data = nullptr,
+                    const ReaderSettings& reader_settings = default_reader_settings);
   ~SubscriberSession();
   SubscriberSession(const SubscriberSession&) = delete;
   SubscriberSession& operator=(const SubscriberSession&) = delete;

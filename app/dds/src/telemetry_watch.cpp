@@ -48,7 +48,15 @@ struct TelemetryWatch::Impl {
     session = std::make_unique<SubscriberSession>(
         po,
         std::vector<Topic>{Topic::kStatus, Topic::kJoints, Topic::kHydraulics, Topic::kCommandPath},
-        [this](Topic topic, fdds::DataReader& reader) { take(topic, reader); });
+        [this](Topic topic, fdds::DataReader& reader) { take(topic, reader); },
+        [status = o.status](Topic topic) {
+          config::TopicSettings s = default_reader_settings(topic);
+          if (topic == Topic::kStatus) {
+            s.reliability = status.reliability;
+            s.durability = status.durability;
+          }
+          return s;
+        });
   }
 
   // On Fast DDS's threads (the samples are the caller's: two threads may take one topic).
@@ -188,6 +196,7 @@ WatchedRun TelemetryWatch::run() const {
   for (Topic t : {Topic::kStatus, Topic::kJoints, Topic::kHydraulics, Topic::kCommandPath}) {
     r.writers += impl_->session->reader(t).matched_writers();
   }
+  r.status_incompatible = impl_->session->reader(Topic::kStatus).incompatible_writers();
   return r;
 }
 

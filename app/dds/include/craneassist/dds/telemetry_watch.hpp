@@ -18,6 +18,12 @@ struct WatchOptions {
   config::DdsTransport transport = config::DdsTransport::kDefault;
   config::TypePropagation type_propagation;
   std::string participant_name = "craneassist-web";
+  // The watched run's status topic as it publishes it (the telemetry settings' `status`): the
+  // status reader takes its reliability and durability, so that the end of a run (`stopped`,
+  // the last sample a run sends) is delivered and acknowledged, not dropped as a best-effort
+  // sample can be. The other topics are read best-effort (the latest sample is enough).
+  config::TopicSettings status{10.0, config::Reliability::kReliable,
+                               config::Durability::kTransientLocal, 1};
 };
 
 // What the watched run says about itself (its latest status and joints samples).
@@ -28,6 +34,9 @@ struct WatchedRun {
   std::uint64_t samples = 0;    // every topic, so far
   std::uint64_t malformed = 0;  // dropped: could not be deserialized
   int writers = 0;              // matched on this side, all topics
+  // Status writers not matched because their QoS does not give what the status reader asks
+  // (WatchOptions::status): a run published with other telemetry settings.
+  int status_incompatible = 0;
 };
 
 class TelemetryWatch {
