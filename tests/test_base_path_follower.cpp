@@ -216,3 +216,27 @@ TEST(BasePathFollower, TrackingFactorAndMotorLimitSlowIt) {
   shared.update({start, 1.0, 0.75 * cfg.model.pump_max_flow_m3_s}, out);
   EXPECT_NEAR(out.wheels.flow_sum_m3_s, 0.25 * cfg.model.pump_max_flow_m3_s, 1e-12);
 }
+
+TEST(CompositeBezierPath, TheOffsetCheckSeesATightTurnOnALongPath) {
+  // 6000 via points 1 m apart along x, one of them 0.3 m aside: a turn within a few segments of
+  // thousands, on the tool path itself (offset 0).
+  std::vector<Eigen::Vector2d> via;
+  for (int i = 0; i < 6000; ++i) via.emplace_back(i, i == 3000 ? 0.3 : 0.0);
+  const scaling::CompositeBezierPath path(via);
+  const auto sharpest = [&](int samples) {  // the sharpest turn seen at `samples` even steps
+    double kappa = 0.0;
+    scaling::OffsetReference r;
+    for (int k = 0; k <= samples; ++k) {
+      scaling::offset_reference(path, 0.0, static_cast<double>(k) / samples, r);
+      kappa = std::max(kappa, std::abs(r.omega_prime_rad / r.v_prime_m));
+    }
+    return kappa;
+  };
+  const double dense = sharpest(256 * path.segments());
+  const scaling::OffsetPathCheck check = scaling::check_offset_path(path, 0.0);
+  EXPECT_GT(dense, 0.5);
+  EXPECT_GT(check.max_curvature_1_m, 0.95 * dense);
+  EXPECT_NEAR(check.max_curvature_s * path.segments(), 3000.0, 0.5);
+  // 4000 samples over the whole path (the check before it sampled every segment) miss it.
+  EXPECT_LT(sharpest(4000), 0.65 * dense);  // 0.58 of it
+}

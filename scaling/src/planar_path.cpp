@@ -79,10 +79,15 @@ OffsetPathCheck check_offset_path(const CompositeBezierPath& path, double offset
   OffsetPathCheck check;
   check.min_v_prime_m = 1e300;
   OffsetReference r;
-  for (int k = 0; k <= samples; ++k) {
-    const double s = static_cast<double>(k) / samples;
+  // Every segment gets its share, however many there are (a long path's tight turn lies within
+  // one segment).
+  const int n = std::max(samples, kMinOffsetSamplesPerSegment * path.segments());
+  for (int k = 0; k <= n; ++k) {
+    const double s = static_cast<double>(k) / n;
     offset_reference(path, offset_m, s, r);
-    if (r.v_prime_m < check.min_v_prime_m) {
+    // A NaN (the tool path stands still) is kept as the lowest: no path to follow there.
+    if (std::isnan(r.v_prime_m) ? !std::isnan(check.min_v_prime_m)
+                                : r.v_prime_m < check.min_v_prime_m) {
       check.min_v_prime_m = r.v_prime_m;
       check.min_v_prime_s = s;
     }

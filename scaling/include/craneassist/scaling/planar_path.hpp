@@ -55,14 +55,16 @@ void offset_reference(const CompositeBezierPath& path, double offset_m, double s
                       OffsetReference& out) noexcept;
 
 // Where the platform's offset path cannot be followed: the lowest v'(s) over s (a cusp at or
-// below zero), and the highest |curvature| omega'/v' of the platform's path, each with its s,
-// sampled `samples` times.
+// below zero; NaN where the tool path itself stands still), and the highest |curvature|
+// omega'/v' of the platform's path, each with its s, sampled `samples` times, at least
+// kMinOffsetSamplesPerSegment times in every segment.
 struct OffsetPathCheck {
   double min_v_prime_m = 0.0;
   double min_v_prime_s = 0.0;
   double max_curvature_1_m = 0.0;
   double max_curvature_s = 0.0;
 };
+inline constexpr int kMinOffsetSamplesPerSegment = 64;
 OffsetPathCheck check_offset_path(const CompositeBezierPath& path, double offset_m,
                                   int samples = 4000);
 
