@@ -4,7 +4,9 @@
 // trajectory's mode columns. Tables are built on small regions of the workspace to stay fast.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -182,6 +184,50 @@ TEST(PostureTable, TheFileRoundTripsAndAnotherModelOrGridRebuilds) {
   const planner::PlanarArm lighter(cfg.model, cfg.simulation.q_initial);
   EXPECT_FALSE(planner::PostureTable::load(file, lighter, settings).has_value());
   std::filesystem::remove(file);
+}
+
+// A damaged table file (cut short, its grid, patterns, postures or areas changed) is refused
+// and rebuilt, never used: the bytes after the fingerprint are checked too.
+TEST(PostureTable, ADamagedFileIsRefused) {
+  const auto settings = region_settings(0.1, 0);
+  std::ostringstream out;
+  small_table().write(out);
+  const std::string good = out.str();
+  const auto read = [&](const std::string& bytes) {
+    std::istringstream in(bytes);
+    return planner::PostureTable::read(in, arm(), settings).has_value();
+  };
+  ASSERT_TRUE(read(good));
+  const int nodes = small_table().grid().nodes(), np = small_table().pattern_count();
+  const int m = small_table().moving();
+  // Layout: magic 8, fingerprint 8, moving 4, spacing 8, ix0 iz0 nx nz 16, nodes 4, patterns 4,
+  // node cells 8 each, pattern modes m each, postures 8 m each entry, areas 8 each entry.
+  const std::size_t nodes_at = 44, patterns_at = 48, cells_at = 52;
+  const std::size_t modes_at = cells_at + 8 * static_cast<std::size_t>(nodes);
+  const std::size_t q_at = modes_at + static_cast<std::size_t>(np * m);
+  const std::size_t area_at = q_at + 8 * static_cast<std::size_t>(nodes * np * m);
+  ASSERT_EQ(good.size(), area_at + 8 * static_cast<std::size_t>(nodes * np));
+  const auto with = [&](std::size_t at, const auto& value) {
+    std::string bytes = good;
+    std::memcpy(bytes.data() + at, &value, sizeof value);
+    return bytes;
+  };
+  EXPECT_FALSE(read(good.substr(0, good.size() - 1)));           // cut short
+  EXPECT_FALSE(read(good + '\0'));                               // a byte too many
+  EXPECT_FALSE(read(with(20, 0.2)));                             // another spacing
+  EXPECT_FALSE(read(with(nodes_at, std::int32_t{nodes + 1})));   // more nodes than written
+  EXPECT_FALSE(read(with(patterns_at, std::int32_t{1 << 30})));  // a billion patterns
+  EXPECT_FALSE(read(with(patterns_at, std::int32_t{np - 1})));
+  std::string two_on_one = good;  // node 1 on node 0's cell
+  std::memcpy(two_on_one.data() + cells_at + 8, good.data() + cells_at, 8);
+  EXPECT_FALSE(read(two_on_one));
+  EXPECT_FALSE(read(with(modes_at + 1, std::uint8_t{2})));  // another pattern
+  EXPECT_FALSE(read(with(q_at, std::numeric_limits<double>::quiet_NaN())));
+  EXPECT_FALSE(read(with(q_at + 8, 10.0)));  // outside the joint's range
+  const double q0 = small_table().posture(0, 0)[0];
+  EXPECT_FALSE(read(with(q_at, q0 + (q0 > 0.0 ? -0.01 : 0.01))));  // the tip off its node
+  EXPECT_FALSE(read(with(area_at, -1.0)));
+  EXPECT_FALSE(read(with(area_at + 8, std::numeric_limits<double>::infinity())));
 }
 
 // jumps() looks at every pair of neighbouring nodes (8-neighbourhood) once: against all pairs of

@@ -665,33 +665,37 @@ PostureTable PostureTable::fixed_last_joint(const PlanarArm& arm,
   return t;
 }
 
+void PostureTable::write(std::ostream& out) const {
+  auto put = [&](const auto& v) { out.write(reinterpret_cast<const char*>(&v), sizeof v); };
+  out.write(kMagic, sizeof kMagic);
+  put(fingerprint_);
+  put(moving_);
+  put(grid_.spacing_m);
+  put(grid_.ix0);
+  put(grid_.iz0);
+  put(grid_.nx);
+  put(grid_.nz);
+  put(grid_.nodes());
+  put(pattern_count());
+  for (int n = 0; n < grid_.nodes(); ++n) {
+    put(grid_.node_i[at(n)]);
+    put(grid_.node_k[at(n)]);
+  }
+  for (const auto& p : patterns_) {
+    for (int k = 0; k < moving_; ++k) put(static_cast<std::uint8_t>(p.mode[at(k)]));
+  }
+  out.write(reinterpret_cast<const char*>(q_.data()),
+            static_cast<std::streamsize>(q_.size() * sizeof(double)));
+  out.write(reinterpret_cast<const char*>(area_.data()),
+            static_cast<std::streamsize>(area_.size() * sizeof(double)));
+}
+
 void PostureTable::save(const std::filesystem::path& file) const {
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
   const auto tmp = file.string() + ".tmp";
   {
     std::ofstream out(tmp, std::ios::binary);
-    auto put = [&](const auto& v) { out.write(reinterpret_cast<const char*>(&v), sizeof v); };
-    out.write(kMagic, sizeof kMagic);
-    put(fingerprint_);
-    put(moving_);
-    put(grid_.spacing_m);
-    put(grid_.ix0);
-    put(grid_.iz0);
-    put(grid_.nx);
-    put(grid_.nz);
-    put(grid_.nodes());
-    put(pattern_count());
-    for (int n = 0; n < grid_.nodes(); ++n) {
-      put(grid_.node_i[at(n)]);
-      put(grid_.node_k[at(n)]);
-    }
-    for (const auto& p : patterns_) {
-      for (int k = 0; k < moving_; ++k) put(static_cast<std::uint8_t>(p.mode[at(k)]));
-    }
-    out.write(reinterpret_cast<const char*>(q_.data()),
-              static_cast<std::streamsize>(q_.size() * sizeof(double)));
-    out.write(reinterpret_cast<const char*>(area_.data()),
-              static_cast<std::streamsize>(area_.size() * sizeof(double)));
+    write(out);
     if (!out) throw std::runtime_error(file.string() + ": cannot write the posture table");
   }
   std::filesystem::rename(tmp, file);
@@ -702,10 +706,18 @@ std::optional<PostureTable> PostureTable::load(const std::filesystem::path& file
                                                const PostureTableSettings& settings) {
   std::ifstream in(file, std::ios::binary);
   if (!in) return std::nullopt;
+  return read(in, arm, settings);
+}
+
+std::optional<PostureTable> PostureTable::read(std::istream& in, const PlanarArm& arm,
+                                               const PostureTableSettings& settings) {
   char magic[sizeof kMagic];
   in.read(magic, sizeof magic);
   if (!in || std::memcmp(magic, kMagic, sizeof kMagic) != 0) return std::nullopt;
-  auto get = [&](auto& v) { in.read(reinterpret_cast<char*>(&v), sizeof v); };
+  auto get = [&](auto& v) {
+    in.read(reinterpret_cast<char*>(&v), sizeof v);
+    return static_cast<bool>(in);
+  };
   PostureTable t;
   int nodes = 0, np = 0;
   get(t.fingerprint_);
@@ -716,42 +728,71 @@ std::optional<PostureTable> PostureTable::load(const std::filesystem::path& file
   get(t.grid_.nx);
   get(t.grid_.nz);
   get(nodes);
-  get(np);
-  if (!in || t.fingerprint_ != posture_table_fingerprint(arm, settings) ||
-      t.moving_ != arm.moving() || nodes < 0 || np < 1 || t.grid_.nx < 0 || t.grid_.nz < 0 ||
-      static_cast<long long>(t.grid_.nx) * t.grid_.nz > 100'000'000LL || nodes > 10'000'000) {
+  if (!get(np)) return std::nullopt;
+  // What the table must be for this arm and these settings (the fingerprint says it was made
+  // for them; a damaged file can still say anything after it).
+  std::vector<dynamics::ModePattern> patterns = planner_patterns(arm);
+  if (settings.max_patterns > 0 && settings.max_patterns < static_cast<int>(patterns.size())) {
+    patterns.resize(at(settings.max_patterns));
+  }
+  const double spacing = settings.spacing_m > 0.0 ? settings.spacing_m : default_spacing(arm);
+  const long long cells = static_cast<long long>(t.grid_.nx) * t.grid_.nz;
+  if (t.fingerprint_ != posture_table_fingerprint(arm, settings) || t.moving_ != arm.moving() ||
+      t.grid_.spacing_m != spacing || np != static_cast<int>(patterns.size()) || nodes < 0 ||
+      t.grid_.nx < 0 || t.grid_.nz < 0 || cells > 100'000'000LL || nodes > cells ||
+      std::abs(static_cast<long long>(t.grid_.ix0)) > 1'000'000'000LL ||
+      std::abs(static_cast<long long>(t.grid_.iz0)) > 1'000'000'000LL) {
     return std::nullopt;
   }
-  t.grid_.node_of_cell.assign(at(t.grid_.nx * t.grid_.nz), -1);
+  t.grid_.node_of_cell.assign(static_cast<std::size_t>(cells), -1);
   for (int n = 0; n < nodes; ++n) {
     int i = 0, k = 0;
     get(i);
-    get(k);
-    const int ci = i - t.grid_.ix0, ck = k - t.grid_.iz0;
-    if (!in || ci < 0 || ck < 0 || ci >= t.grid_.nx || ck >= t.grid_.nz) return std::nullopt;
-    t.grid_.node_of_cell[at(ci + t.grid_.nx * ck)] = n;
+    if (!get(k)) return std::nullopt;
+    const long long ci = static_cast<long long>(i) - t.grid_.ix0;
+    const long long ck = static_cast<long long>(k) - t.grid_.iz0;
+    if (ci < 0 || ck < 0 || ci >= t.grid_.nx || ck >= t.grid_.nz) return std::nullopt;
+    int& cell = t.grid_.node_of_cell[static_cast<std::size_t>(ci + t.grid_.nx * ck)];
+    if (cell != -1) return std::nullopt;  // two nodes on one cell
+    cell = n;
     t.grid_.node_i.push_back(i);
     t.grid_.node_k.push_back(k);
     t.grid_.node_xz.emplace_back(i * t.grid_.spacing_m, k * t.grid_.spacing_m);
   }
-  for (int p = 0; p < np; ++p) {
-    dynamics::ModePattern pattern;
-    pattern.dof = t.moving_;
+  for (const dynamics::ModePattern& expected : patterns) {
     for (int k = 0; k < t.moving_; ++k) {
       std::uint8_t mode = 0;
-      get(mode);
-      if (mode > 2) return std::nullopt;
-      pattern.mode[at(k)] = static_cast<dynamics::MhsbMode>(mode);
+      if (!get(mode) || mode != static_cast<std::uint8_t>(expected.mode[at(k)])) {
+        return std::nullopt;
+      }
     }
-    t.patterns_.push_back(pattern);
   }
-  t.q_.resize(at(nodes * np * t.moving_));
-  t.area_.resize(at(nodes * np));
+  t.patterns_ = std::move(patterns);
+  const std::size_t entries = static_cast<std::size_t>(nodes) * static_cast<std::size_t>(np);
+  t.q_.resize(entries * static_cast<std::size_t>(t.moving_));
+  t.area_.resize(entries);
   in.read(reinterpret_cast<char*>(t.q_.data()),
           static_cast<std::streamsize>(t.q_.size() * sizeof(double)));
   in.read(reinterpret_cast<char*>(t.area_.data()),
           static_cast<std::streamsize>(t.area_.size() * sizeof(double)));
   if (!in || in.peek() != std::char_traits<char>::eof()) return std::nullopt;
+  // Every posture within the joint ranges with the tip on its node (within 0.1 mm), every area a
+  // finite non-negative number.
+  dynamics::KinematicsData data;
+  for (int n = 0; n < nodes; ++n) {
+    for (int p = 0; p < np; ++p) {
+      const std::size_t e = t.entry(n, p);
+      if (!(std::isfinite(t.area_[e]) && t.area_[e] >= 0.0)) return std::nullopt;
+      for (int k = 0; k < t.moving_; ++k) {
+        const double q = t.q_[e * static_cast<std::size_t>(t.moving_) + at(k)];
+        const double slack = 1e-9 * (1.0 + arm.upper(k) - arm.lower(k));
+        if (!(q >= arm.lower(k) - slack && q <= arm.upper(k) + slack)) return std::nullopt;
+      }
+      if (!((arm.tip(t.posture(n, p), data) - t.grid_.node_xz[at(n)]).norm() <= 1e-4)) {
+        return std::nullopt;
+      }
+    }
+  }
   return t;
 }
 

@@ -38,6 +38,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <iosfwd>
 #include <optional>
 #include <string>
 #include <vector>
@@ -143,10 +144,16 @@ class PostureTable {
   // fixed_last_joint(): the nodes where the last joint had to leave last_joint.
   long moved_last_joint = 0;
 
-  // Writes the binary file (throws std::runtime_error naming it when it cannot).
+  // Writes the binary file (throws std::runtime_error naming it when it cannot), through a
+  // temporary file and a rename.
   void save(const std::filesystem::path& file) const;
-  // The table in the file when it exists and matches arm and settings; nullopt otherwise.
+  void write(std::ostream& out) const;
+  // The table in the file when it exists and matches arm and settings; nullopt otherwise. A file
+  // made for another arm or grid, cut short or damaged (a grid, patterns, postures outside the
+  // joint ranges, areas that are not finite non-negative numbers) is refused, never trusted.
   static std::optional<PostureTable> load(const std::filesystem::path& file, const PlanarArm& arm,
+                                          const PostureTableSettings& settings);
+  static std::optional<PostureTable> read(std::istream& in, const PlanarArm& arm,
                                           const PostureTableSettings& settings);
 
   // What the build did (not saved): wall time, SLSQP runs, entries where none converged (the best
