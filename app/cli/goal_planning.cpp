@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -26,6 +27,18 @@ std::optional<Eigen::Vector2d> parse_xz(const std::string& text) {
   if (b.empty() || *end != '\0' || !std::isfinite(z)) return std::nullopt;
   return Eigen::Vector2d(x, z);
 }
+
+// A typed line as it may be shown: at most 40 characters, other than printable ASCII as '?'.
+std::string printable(const std::string& text) {
+  std::string out = text.substr(0, 40);
+  for (char& c : out) {
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) c = '?';
+  }
+  return text.size() > 40 ? out + "..." : out;
+}
+
+// The longest goal line taken; more without an end of line is dropped.
+constexpr std::size_t kMaxGoalLine = 256;
 
 double smoothstep(double u) {
   u = std::clamp(u, 0.0, 1.0);
@@ -203,19 +216,29 @@ void GoalPlanner::run() {
           read_stdin_ = false;  // end of input: the scheduled goals go on
         } else {
           stdin_buffer_.append(buffer, static_cast<std::size_t>(n));
+          if (stdin_buffer_.size() > kMaxGoalLine &&
+              stdin_buffer_.find('\n') == std::string::npos) {
+            // Not a goal: bytes without an end of line. Drop them rather than grow without end.
+            spdlog::warn(
+                "goal input: {} bytes without an end of line, dropped (expected X,Z lines)",
+                stdin_buffer_.size());
+            stdin_buffer_.clear();
+          }
           std::size_t eol;
           while ((eol = stdin_buffer_.find('\n')) != std::string::npos) {
             std::string text = stdin_buffer_.substr(0, eol);
             stdin_buffer_.erase(0, eol + 1);
-            text.erase(std::remove_if(text.begin(), text.end(), ::isspace), text.end());
+            text.erase(std::remove_if(text.begin(), text.end(),
+                                      [](unsigned char c) { return std::isspace(c) != 0; }),
+                       text.end());
             if (text.empty()) continue;
             const auto xz = parse_xz(text);
             if (!xz) {
-              spdlog::warn("goal '{}': expected X,Z in m, e.g. 6,2", text);
+              spdlog::warn("goal '{}': expected X,Z in m, e.g. 6,2", printable(text));
             } else if (source_.last_tip(tip, now)) {
               plan_to(*xz, tip, now, "typed");
             } else {
-              spdlog::warn("goal '{}': no tip measurement yet", text);
+              spdlog::warn("goal '{}': no tip measurement yet", printable(text));
             }
           }
         }
