@@ -100,7 +100,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size == 0) return 0;
   const std::uint8_t* payload = data + 1;
   const std::size_t length = size - 1;
-  switch (data[0] % 6) {
+  switch (data[0] % 7) {
     case 0:
       check_topic<msg::StatusPubSubType, msg::Status>(payload, length);
       break;
@@ -115,6 +115,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       break;
     case 4:
       check_topic<msg::OperatorCommandPubSubType, msg::OperatorCommand>(payload, length);
+      break;
+    case 6:
+      check_topic<msg::BaseStatePubSubType, msg::BaseState>(payload, length);
       break;
     default: {
       msg::Header header;  // the type every telemetry sample starts with

@@ -54,6 +54,20 @@ write("fuzz_joint_trajectory", "six_joints.csv",
       ",".join(f"qddot_{i}" for i in range(1, 7)) + "\n0" + ",0" * 18 + "\n2" + ",1" * 18 + "\n")
 write("fuzz_joint_trajectory", "bad_trajectory.csv", read("tests/data/bad_trajectory.csv"))
 
+# Tool paths of the crane on wheels (craneassist follow).
+write("fuzz_tool_path", "mobile_s_curve.csv", read("examples/paths/mobile_s_curve.csv"))
+write("fuzz_tool_path", "edge_two_points.csv", "x,y\n0,0\n0.01,0\n")
+write("fuzz_tool_path", "edge_crlf_bom_turn.csv",
+      "\ufeff# a U-turn\r\nx , y\r\n0,0\r\n5,0\r\n5,0.5\r\n-1e4,0.5\r\n")
+write("fuzz_tool_path", "bad_header.csv", "t,x,y\n0,0,0\n1,1,1\n")
+
+# Posture tables of the planner (the first byte picks how the rest changes a real table).
+write("fuzz_posture_table", "as_built.bin", b"\x01")
+write("fuzz_posture_table", "cut.bin", b"\x02\x40\x00")
+write("fuzz_posture_table", "patched.bin", b"\x01\x30\x00\x07\x2c\x00\x00\x60\x01\xff")
+write("fuzz_posture_table", "replaced.bin",
+      b"\x00" + struct.pack("<diiiiii", 0.1, 3, -1, 4, 3, 2, 3) + struct.pack("<ii", 3, -1) * 2)
+
 # Joint poses (--initial, suite poses) and suite manifests.
 for name, text in (("folded.txt", "lift=0 deg, tilt=-125 deg, extension=0.2 m"),
                    ("units.txt", "slew=0.5 rad,lift=10deg , extension = 150 mm"),
@@ -85,6 +99,8 @@ for path in files("config/cranes/*.yaml") + [os.path.join(ROOT, "tests/data/bad_
     write("fuzz_crane_config", os.path.basename(path), open(path, "rb").read())
 for path in files("config/joysticks/*.yaml") + [os.path.join(ROOT, "tests/data/bad_joystick.yaml")]:
     write("fuzz_joystick_config", os.path.basename(path), open(path, "rb").read())
+for path in files("config/machines/*.yaml"):
+    write("fuzz_base_config", os.path.basename(path), open(path, "rb").read())
 for path in files("config/telemetry/*.yaml"):
     write("fuzz_telemetry_config", os.path.basename(path), open(path, "rb").read())
 write("fuzz_telemetry_config", "commands.yaml",
@@ -118,7 +134,7 @@ for name, text in (("flow_block.yaml", "[[[[{a: [b, {c: d}]}]]]]\n"),
                    ("anchors.yaml", "a: &x [1, 2]\nb: *x\n? [complex]\n: key\n"),
                    ("tags.yaml", "!!binary aGVsbG8=\n--- !custom {x: 1}\n")):
     for harness in ("fuzz_crane_config", "fuzz_joystick_config", "fuzz_telemetry_config",
-                    "fuzz_can_mapping"):
+                    "fuzz_can_mapping", "fuzz_base_config"):
         write(harness, name, text)
 
 # --- CAN ----------------------------------------------------------------------------------------
@@ -260,3 +276,10 @@ write("fuzz_dds_samples", "operator_command_be.bin",
 c = Cdr()
 header(c, 1)
 write("fuzz_dds_samples", "header.bin", b"\x05" + c.bytes())
+
+c = Cdr()
+header(c, 46)
+c.doubles([12.5, -3.0, 0.4, 0.3, 0.05, 0.33, 0.06])
+c.doubles([2.6e-4, 2.7e-4, 2.6e-4, 2.7e-4, 1.06e-3, 1.05e-3])
+c.put("B", 1)
+write("fuzz_dds_samples", "base.bin", b"\x06" + c.bytes())
