@@ -156,6 +156,15 @@ TEST(JoystickConfig, DriveStick) {
   EXPECT_DOUBLE_EQ(d[1], -1.0);
   // The default mapping has no drive stick.
   EXPECT_TRUE(input::JoystickMapper(config::default_joystick_config().mapping).drive(pad).isZero());
+  // The drive mode's embedded mappings (sim --drive without --joystick): the gamepad's is the
+  // file above; the web page's drives the same way with web.yaml's input rules.
+  const auto embedded = config::drive_joystick_config();
+  EXPECT_TRUE(input::JoystickMapper(embedded.mapping).drive(pad).isApprox(d));
+  const auto web = config::web_drive_joystick_config();
+  EXPECT_TRUE(input::JoystickMapper(web.mapping).drive(pad).isApprox(d));
+  EXPECT_DOUBLE_EQ(web.monitor.stale_timeout_s,
+                   config::web_joystick_config().monitor.stale_timeout_s);
+  EXPECT_NE(web.source_name.find("web_drive.yaml"), std::string::npos);
 
   // A drive axis that a tip axis uses already, and one axis for both drive axes: errors.
   std::string text = default_text();

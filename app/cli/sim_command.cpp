@@ -180,7 +180,8 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
       ->expected(1, 2);
   sim->add_option("--joystick", args.joystick_file,
                   "Joystick mapping YAML (docs/joystick.md; default: the embedded "
-                  "config/joysticks/gamepad.yaml, web.yaml for --input web)")
+                  "config/joysticks/gamepad.yaml, web.yaml for --input web; with --drive "
+                  "gamepad_drive.yaml, web_drive.yaml)")
       ->check(CLI::ExistingFile);
   sim->add_option("--device", args.device, "evdev: the device, e.g. /dev/input/event5");
   sim->add_option(
@@ -294,8 +295,13 @@ int run_sim_command(const SimArgs& args) {
     cfg = load_crane(args.config_file);
     apply_crane_options(cfg, {args.payload_kg, args.initial, args.resolution,
                               !uses_can_backend(args.machine, cfg)});
+    // In the drive mode a pad's and the page's right stick drive the base (a mapping with a
+    // drive stick); the keyboard has its own drive keys.
+    const bool pad = kind == "evdev" || kind == "sdl";
     jcfg = !args.joystick_file.empty() ? config::load_joystick_config(args.joystick_file)
+           : kind == "web" && drive    ? config::web_drive_joystick_config()
            : kind == "web"             ? config::web_joystick_config()
+           : pad && drive              ? config::drive_joystick_config()
                                        : config::default_joystick_config();
     if (kind == "replay") replay = input::Replay::load_file(args.input[1]);
     tcfg = load_telemetry_settings(args.telemetry);
@@ -435,11 +441,11 @@ int run_sim_command(const SimArgs& args) {
                  options.realtime ? ", real time" : ", as fast as possible");
     if (keyboard != nullptr) print_keys(drive);
     if (base) {
-      const bool pad = kind == "evdev" || kind == "sdl";
-      if (pad && !(jcfg.mapping.drive[0].enabled || jcfg.mapping.drive[1].enabled)) {
+      const bool stick = kind == "evdev" || kind == "sdl" || kind == "web";
+      if (stick && !(jcfg.mapping.drive[0].enabled || jcfg.mapping.drive[1].enabled)) {
         spdlog::warn(
-            "--drive: the joystick mapping ({}) has no drive stick (joystick.drive); "
-            "config/joysticks/gamepad_drive.yaml has one",
+            "--drive: the joystick mapping ({}) has no drive stick (joystick.drive): the base "
+            "does not move; config/joysticks/gamepad_drive.yaml and web_drive.yaml have one",
             jcfg.source_name);
       }
       spdlog::info("drive: {} ({}), {}; the crane's tip in the world includes the base's pose",

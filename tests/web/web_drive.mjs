@@ -1,6 +1,7 @@
 // The drive mode in the web view, in a real browser (docs/mobile.md#live): `craneassist sim
-// --drive --web` with the drive-mode gamepad mapping (the right stick drives); the frames carry
-// the base, the page shows its panel, and the page's right stick forward drives the base ahead.
+// --drive --web` with its default mapping (config/joysticks/web_drive.yaml: the right stick
+// drives); the frames carry the base, the page shows its panel, and the page's right stick
+// forward drives the base ahead.
 //
 //   node tests/web/web_drive.mjs CRANEASSIST NODE_MODULES SOURCE_DIR [SCREENSHOT.png]
 import { check, failed, launchChromium, openPage, printedUrl, run, sleep } from './lib.mjs';
@@ -12,7 +13,7 @@ if (!craneassist || !nodeModules || !source) {
 }
 
 const sim = run(craneassist, ['sim', '--drive', '--pump', 'shared', '--web', '--web-listen', '127.0.0.1:0',
-  '--no-telemetry', '--joystick', `${source}/config/joysticks/gamepad_drive.yaml`, '--duration', '60']);
+  '--no-telemetry', '--duration', '60']);
 const url = await printedUrl(sim);
 console.log(`page: ${url}`);
 
@@ -40,9 +41,12 @@ try {
   check(later.base.flow_sum <= later.base.flow_max * (1 + 1e-9),
     `the hub motors within Q_max: ${(later.base.flow_sum * 6e4).toFixed(1)} of ${(later.base.flow_max * 6e4).toFixed(0)} L/min`);
   check(Math.abs(later.base.root_p[0] - first.base.root_p[0] - dx) < 0.05, 'the crane rides on the base');
+  await page.evaluate(() => window.craneassist.stick('right', 0.8, 0.8));  // ahead, turning right
+  await sleep(3000);
+  const turned = await page.evaluate(() => window.craneassist.last);
+  const dphi = turned.base.pose[2] - later.base.pose[2];
+  check(dphi < -0.05, `the right stick to the right turned the base right: ${(dphi * 180 / Math.PI).toFixed(1)} deg`);
   if (screenshot) {
-    await page.evaluate(() => window.craneassist.stick('right', 0.8, 0.8));  // ahead, turning
-    await sleep(3000);
     await page.screenshot({ path: screenshot });
     console.log(`screenshot: ${screenshot}`);
   }
@@ -54,4 +58,6 @@ try {
 }
 const { code } = await sim.exit;
 check(code === 0, `sim ended with exit ${code}`);
+check(/input \(<embedded config\/joysticks\/web_drive.yaml>\)/.test(sim.output),
+  'sim --drive --web takes the page\'s drive mapping by default');
 process.exit(failed() === 0 ? 0 : 1);

@@ -196,4 +196,14 @@ JoystickConfig web_joystick_config() {
   return parse_joystick_config(embedded::kWebJoystickYaml, "<embedded config/joysticks/web.yaml>");
 }
 
+JoystickConfig drive_joystick_config() {
+  return parse_joystick_config(embedded::kGamepadDriveYaml,
+                               "<embedded config/joysticks/gamepad_drive.yaml>");
+}
+
+JoystickConfig web_drive_joystick_config() {
+  return parse_joystick_config(embedded::kWebDriveJoystickYaml,
+                               "<embedded config/joysticks/web_drive.yaml>");
+}
+
 }  // namespace craneassist::config

@@ -31,5 +31,11 @@ JoystickConfig default_joystick_config();
 // The web view's virtual joystick (config/joysticks/web.yaml): the gamepad mapping with a stale
 // timeout for a browser over a network connection (250 ms).
 JoystickConfig web_joystick_config();
+// The drive mode's (sim --drive, docs/mobile.md#live): the right stick drives the wheeled base,
+// the left stick moves the tip in the horizontal plane; on a gamepad
+// (config/joysticks/gamepad_drive.yaml) and on the web page (config/joysticks/web_drive.yaml,
+// web.yaml's input rules).
+JoystickConfig drive_joystick_config();
+JoystickConfig web_drive_joystick_config();
 
 }  // namespace craneassist::config
