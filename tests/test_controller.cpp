@@ -19,6 +19,7 @@
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/flow_polytope.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
+#include "csv_cells.hpp"
 
 using namespace craneassist;
 
@@ -486,6 +487,43 @@ TEST(CsvLog, PushDoesNotAllocateAndEveryRowArrives) {
   int rows = 0;
   while (std::getline(in, line)) ++rows;
   EXPECT_EQ(rows, 1000);
+}
+
+TEST(CsvLog, TheBasesColumnsFollowWhenThereIsABase) {
+  const auto path = std::filesystem::temp_directory_path() / "craneassist_test_base_log.csv";
+  {
+    control::CsvLog log(path, 4, 64, /*base=*/true);
+    control::LogRow row;
+    row.active_limit = "none";
+    row.pump_limit = "none";
+    row.base_pose = {1.5, -2.25, 0.125};
+    row.base_velocity = {0.3, 0.05};
+    row.base_command = {0.32, 0.06};
+    row.base_motor_flow = {1e-4, 2e-4, 3e-4, 4e-4};
+    row.base_flow_sum_m3s = 1e-3;
+    row.base_flow_max_m3s = 1.05e-3;
+    ASSERT_TRUE(log.push(row));
+  }
+  std::ifstream in(path);
+  std::string header, line;
+  std::getline(in, header);
+  std::getline(in, line);
+  EXPECT_EQ(header, control::CsvLog::header(4, true));
+  EXPECT_EQ(header.rfind(control::CsvLog::header(4), 0), 0u);  // the fixed base's columns first
+  const auto cells = test::csv_cells(line);
+  const auto names = test::csv_cells(header);
+  ASSERT_EQ(cells.size(), names.size());
+  const auto at = [&](const std::string& name) {
+    const auto it = std::find(names.begin(), names.end(), name);
+    return it == names.end() ? -1.0
+                             : std::stod(cells[static_cast<std::size_t>(it - names.begin())]);
+  };
+  EXPECT_DOUBLE_EQ(at("base_x"), 1.5);
+  EXPECT_DOUBLE_EQ(at("base_y"), -2.25);
+  EXPECT_DOUBLE_EQ(at("base_phi"), 0.125);
+  EXPECT_DOUBLE_EQ(at("base_omega_cmd"), 0.06);
+  EXPECT_DOUBLE_EQ(at("base_flow_rr_m3s"), 4e-4);
+  EXPECT_DOUBLE_EQ(at("base_flow_max_m3s"), 1.05e-3);
 }
 
 TEST(CsvLog, UnwritablePathIsReported) {

@@ -411,7 +411,9 @@ int run_sim_command(const SimArgs& args) {
       return rc;
     }
     std::optional<control::CsvLog> log;
-    if (!args.log_file.empty()) log.emplace(args.log_file, cfg.model.dof());
+    if (!args.log_file.empty()) {
+      log.emplace(args.log_file, cfg.model.dof(), std::size_t{1} << 14, base.has_value());
+    }
     std::vector<input::ReplayRow> record;
     control::LiveStatusBoard board;
     control::LiveOptions options;

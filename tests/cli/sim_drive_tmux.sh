@@ -27,7 +27,7 @@ wait_for() {
 }
 
 tmux -S "$sock" new-session -d -s "$session" -x 220 -y 40 sh
-keys "$bin sim --drive --pump shared --no-telemetry; echo DRIVE-\$((40 + 2))" Enter
+keys "$bin sim --drive --pump shared --no-telemetry --log $work/drive.csv; echo DRIVE-\$((40 + 2))" Enter
 wait_for "drive: i/k forward/back" 10
 wait_for "base x" 5
 keys Space
@@ -47,4 +47,16 @@ echo "$line" | awk '{
   ok = (x > 0.1) && (y > 0.0) && (h > 1.0)
   if (!ok) { print "the base did not drive forward and left: " $0; exit 1 }
 }'
+# The log has the base's columns: it ends forward and left of where it started, turned left, and
+# the motors never drew more than the drive pump.
+python3 - "$work/drive.csv" <<'PY' || exit 1
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+last = rows[-1]
+x, y, phi = (float(last[k]) for k in ("base_x", "base_y", "base_phi"))
+peak = max(float(r["base_flow_sum_m3s"]) / float(r["base_flow_max_m3s"]) for r in rows)
+print(f"log: {len(rows)} rows, base at x {x:.2f} m, y {y:.2f} m, {phi:.2f} rad, peak flow ratio {peak:.3f}")
+if not (x > 0.1 and y > 0.0 and phi > 0.0 and peak <= 1.0 + 1e-9):
+    sys.exit("the log's base columns do not show the drive")
+PY
 echo "drive session OK"

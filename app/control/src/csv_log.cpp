@@ -5,7 +5,7 @@
 
 namespace craneassist::control {
 
-std::string CsvLog::header(int dof) {
+std::string CsvLog::header(int dof, bool base) {
   std::string h =
       "t,cmd_vx,cmd_vy,cmd_vz,ref_vx,ref_vy,ref_vz,tip_x,tip_y,tip_z,tip_vx,tip_vy,tip_vz";
   for (int i = 1; i <= dof; ++i) h += ",q" + std::to_string(i);
@@ -16,16 +16,20 @@ std::string CsvLog::header(int dof) {
   h += ",avail_speed_m_s,avail_speed_resolved_m_s,polytope_volume_m3s3";
   for (int i = 1; i <= dof; ++i) h += ",spool" + std::to_string(i);
   for (int i = 1; i <= dof; ++i) h += ",p_load" + std::to_string(i) + "_pa";
+  if (base) {
+    h += ",base_x,base_y,base_phi,base_v,base_omega,base_v_cmd,base_omega_cmd,base_flow_fl_m3s,"
+         "base_flow_fr_m3s,base_flow_rl_m3s,base_flow_rr_m3s,base_flow_sum_m3s,base_flow_max_m3s";
+  }
   return h;
 }
 
-CsvLog::CsvLog(const std::filesystem::path& path, int dof, std::size_t capacity_rows)
-    : path_(path), dof_(dof), ring_(capacity_rows) {
+CsvLog::CsvLog(const std::filesystem::path& path, int dof, std::size_t capacity_rows, bool base)
+    : path_(path), dof_(dof), base_(base), ring_(capacity_rows) {
   file_ = std::fopen(path.c_str(), "w");
   if (file_ == nullptr) {
     throw std::runtime_error(path.string() + ": cannot open the log file for writing");
   }
-  std::fprintf(file_, "%s\n", header(dof).c_str());
+  std::fprintf(file_, "%s\n", header(dof, base).c_str());
   writer_ = std::thread([this] { writer_loop(); });
 }
 
@@ -61,6 +65,13 @@ void CsvLog::write_row(const LogRow& r) {
   for (int i = 0; i < dof_; ++i) std::fprintf(file_, ",%.5f", r.spool[static_cast<std::size_t>(i)]);
   for (int i = 0; i < dof_; ++i) {
     std::fprintf(file_, ",%.6g", r.load_pressure[static_cast<std::size_t>(i)]);
+  }
+  if (base_) {
+    std::fprintf(file_, ",%.6f,%.6f,%.7f,%.6g,%.6g,%.6g,%.6g", r.base_pose[0], r.base_pose[1],
+                 r.base_pose[2], r.base_velocity[0], r.base_velocity[1], r.base_command[0],
+                 r.base_command[1]);
+    for (double q : r.base_motor_flow) std::fprintf(file_, ",%.6g", q);
+    std::fprintf(file_, ",%.6g,%.6g", r.base_flow_sum_m3s, r.base_flow_max_m3s);
   }
   std::fputc('\n', file_);
   written_.fetch_add(1, std::memory_order_relaxed);

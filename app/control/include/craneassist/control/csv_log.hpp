@@ -72,7 +72,9 @@ struct LogRow {
 class CsvLog {
  public:
   // Opens the file and writes the header; throws std::runtime_error naming the file on failure.
-  CsvLog(const std::filesystem::path& path, int dof, std::size_t capacity_rows = 1 << 14);
+  // With `base` (a crane on the wheeled base, sim --drive) the base's columns follow.
+  CsvLog(const std::filesystem::path& path, int dof, std::size_t capacity_rows = 1 << 14,
+         bool base = false);
   ~CsvLog();
   CsvLog(const CsvLog&) = delete;
   CsvLog& operator=(const CsvLog&) = delete;
@@ -86,7 +88,7 @@ class CsvLog {
   std::size_t rows_written() const { return written_.load(); }
   const std::filesystem::path& path() const { return path_; }
 
-  static std::string header(int dof);
+  static std::string header(int dof, bool base = false);
 
  private:
   void writer_loop();
@@ -94,6 +96,7 @@ class CsvLog {
 
   std::filesystem::path path_;
   int dof_;
+  bool base_ = false;
   std::FILE* file_ = nullptr;
   std::vector<LogRow> ring_;
   std::atomic<std::size_t> head_{0};  // next slot the producer writes
