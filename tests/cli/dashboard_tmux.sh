@@ -13,31 +13,11 @@ export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}new_delete_type_mismatch=0"
 bin=$1
 publisher=$2
 domain=$3
-command -v tmux >/dev/null || { echo "tmux is not installed (tools/install-deps.sh)"; exit 1; }
-work=$(mktemp -d)
-sock="$work/tmux.sock"
 session=craneassist_dash
+. "$(dirname "$0")/tmux_lib.sh"
 pub_pid=
-cleanup() {
-  [ -n "$pub_pid" ] && kill -TERM "$pub_pid" 2>/dev/null && wait "$pub_pid" 2>/dev/null
-  tmux -S "$sock" kill-server 2>/dev/null || true
-  rm -rf "$work"
-}
-trap cleanup EXIT
-
-pane() { tmux -S "$sock" capture-pane -p -t "$session" | grep -v "^ *$"; }
-keys() { tmux -S "$sock" send-keys -t "$session" "$@"; }
+on_exit() { [ -z "$pub_pid" ] || { kill -TERM "$pub_pid" 2>/dev/null && wait "$pub_pid" 2>/dev/null; } || true; }
 cursor_visible() { tmux -S "$sock" display-message -p -t "$session" '#{cursor_flag}'; }
-fail() { echo "FAIL: $*; the pane:"; pane; exit 1; }
-# wait_for TEXT SECONDS: until the pane shows TEXT.
-wait_for() {
-  i=0
-  while ! pane | grep -q -F -- "$1"; do
-    i=$((i + 1))
-    [ $i -le $(($2 * 10)) ] || fail "timed out waiting for '$1'"
-    sleep 0.1
-  done
-}
 
 tmux -S "$sock" new-session -d -s "$session" -x 100 -y 40 sh
 keys "stty -g > $work/before.stty; $bin dashboard --domain $domain; echo EXIT1-\$?; stty -g > $work/after.stty; echo DONE1-\$((40 + 2))" Enter

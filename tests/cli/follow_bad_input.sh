@@ -7,23 +7,7 @@
 set -u
 bin=$1 src=$2 work=$3
 mkdir -p "$work"
-failed=0
-# expect NAME MESSAGE ARGS...: craneassist ARGS must exit 2 and print MESSAGE (a fixed string).
-expect() {
-  name=$1 message=$2
-  shift 2
-  "$bin" "$@" > "$work/$name.txt" 2>&1 < /dev/null
-  code=$?
-  if [ "$code" -ne 2 ]; then
-    echo "$name: exit code $code, expected 2"
-    failed=1
-  fi
-  if ! grep -qF -e "$message" "$work/$name.txt"; then
-    echo "$name: no '$message' in:"
-    cat "$work/$name.txt"
-    failed=1
-  fi
-}
+. "$(dirname "$0")/expect_lib.sh"
 printf '# a typo\nx,y\n0,0\n8,0.O\n' > "$work/typo.csv"
 expect typo "tool path: $work/typo.csv:4: field 'y': not a number: '0.O'" follow "$work/typo.csv" --no-log
 printf 'x,y,z\n0,0,1\n8,0,1\n' > "$work/header.csv"

@@ -6,26 +6,8 @@
 # Usage: sim_keyboard_tmux.sh CRANEASSIST
 set -eu
 bin=$1
-command -v tmux >/dev/null || { echo "tmux is not installed (tools/install-deps.sh)"; exit 1; }
-work=$(mktemp -d)
-sock="$work/tmux.sock"
 session=craneassist_kb
-cleanup() { tmux -S "$sock" kill-server 2>/dev/null || true; rm -rf "$work"; }
-trap cleanup EXIT
-
-pane() { tmux -S "$sock" capture-pane -p -t "$session" | grep -v "^ *$"; }
-keys() { tmux -S "$sock" send-keys -t "$session" "$@"; }
-# wait_for TEXT SECONDS: until the pane shows TEXT.
-wait_for() {
-  i=0
-  while ! pane | grep -q -- "$1"; do
-    i=$((i + 1))
-    if [ $i -gt $(($2 * 10)) ]; then
-      echo "timed out waiting for '$1'; the pane:"; pane; exit 1
-    fi
-    sleep 0.1
-  done
-}
+. "$(dirname "$0")/tmux_lib.sh"
 # hold KEY SECONDS: the key as a terminal sends it while held (auto-repeat every 30 ms).
 hold() {
   n=$(awk "BEGIN { print int($2 / 0.03) }")
