@@ -156,7 +156,11 @@ void GoalPlanner::stop() {
 
 std::vector<std::string> GoalPlanner::report() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return report_;
+  std::vector<std::string> lines = report_;
+  if (unlisted_ > 0) {
+    lines.push_back("(" + std::to_string(unlisted_) + " more goals, not listed)");
+  }
+  return lines;
 }
 
 void GoalPlanner::plan_to(const Eigen::Vector2d& goal, const Eigen::Vector3d& tip, double now_s,
@@ -164,13 +168,18 @@ void GoalPlanner::plan_to(const Eigen::Vector2d& goal, const Eigen::Vector3d& ti
   const planner::PlanarArm& arm = planner_.arm();
   const Eigen::Vector2d from = arm.to_plane(tip);
   char head[160];
-  std::snprintf(head, sizeof head, "goal (%.2f, %.2f) m %s at %.2f s", goal.x(), goal.y(), origin,
+  // A goal far outside any workspace in %g, not in hundreds of digits.
+  const char* format = goal.cwiseAbs().maxCoeff() < 1e6 ? "goal (%.2f, %.2f) m %s at %.2f s"
+                                                        : "goal (%.3g, %.3g) m %s at %.2f s";
+  std::snprintf(head, sizeof head, format, goal.x(), goal.y(), origin,
                 now_s - start_s_.value_or(now_s));
   std::string line = head;
+  bool refused = false;
   try {
     const planner::PtpPlan plan = planner_.plan(from, goal, weights_);
     if (!plan.path.found || plan.samples.empty()) {
       line += ": no path (the arm cannot get there from here)";
+      refused = true;
     } else {
       const auto samples = tip_trajectory(arm, plan, tip, goal, limits_);
       if (!source_.publish(samples, now_s)) {
@@ -188,10 +197,19 @@ void GoalPlanner::plan_to(const Eigen::Vector2d& goal, const Eigen::Vector3d& ti
     }
   } catch (const std::exception& e) {
     line += std::string(": refused: ") + e.what();
+    refused = true;
   }
-  spdlog::info("{}", line);
+  if (refused) {
+    spdlog::warn("{}", line);
+  } else {
+    spdlog::info("{}", line);
+  }
   std::lock_guard<std::mutex> lock(mutex_);
-  report_.push_back(line);
+  if (report_.size() < kMaxReportedGoals) {
+    report_.push_back(line);
+  } else {
+    ++unlisted_;  // a script typing goals without end: the summary stays short
+  }
 }
 
 void GoalPlanner::run() {

@@ -78,7 +78,9 @@ class GoalPlanner {
   std::atomic<bool> stop_{false};
   std::thread thread_;
   mutable std::mutex mutex_;
-  std::vector<std::string> report_;
+  std::vector<std::string> report_;  // the first kMaxReportedGoals goals' lines
+  long unlisted_ = 0;                // goals after those
+  static constexpr std::size_t kMaxReportedGoals = 100;
   std::string stdin_buffer_;
   std::optional<double> start_s_;  // the loop clock at the first measured tip
 };
