@@ -613,4 +613,27 @@ TEST(Dashboard, ShowsTheStickAgainstTheAvailableSpeedAndThePolytopeMeasure) {
   EXPECT_NE(std::find(lines.begin(), lines.end(), "polytope  -"), lines.end());
 }
 
+// The wheeled base's lines (sim --drive): only when the base topic has a sample.
+TEST(Dashboard, ShowsTheBaseWhenThereIsOne) {
+  craneassist::msg::BaseState base;
+  base.pose({12.5, -3.0, 0.4});
+  base.velocity({0.3, 0.05});
+  base.motor_flow_sum_m3_s(0.8e-3);
+  base.drive_max_flow_m3_s(1.05e-3);
+  base.shared_pump(true);
+  std::string all;
+  for (const auto& line : cdds::dashboard_view(nullptr, nullptr, nullptr, nullptr, &base)) {
+    all += line + "\n";
+  }
+  for (const char* text :
+       {"base      x  +12.500  y   -3.000 m  heading   22.9 deg   +0.30 m/s  +2.9 deg/s",
+        "drive     [#######################.......]   48.0 /   63.0 L/min   76 %  hub motors "
+        "(the crane shares the pump)"}) {
+    EXPECT_NE(all.find(text), std::string::npos) << "missing: " << text << "\n" << all;
+  }
+  for (const auto& line : cdds::dashboard_view(nullptr, nullptr, nullptr, nullptr)) {
+    EXPECT_NE(line.rfind("base", 0), 0u) << "a fixed crane has no base line: " << line;
+  }
+}
+
 }  // namespace

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "crane_options.hpp"
+#include "craneassist/config/base_config.hpp"
 #include "craneassist/config/config_error.hpp"
 #include "craneassist/config/telemetry_config.hpp"
 #include "craneassist/dds/telemetry_watch.hpp"
@@ -157,6 +158,10 @@ CLI::App* add_web_watch_command(CLI::App& cli, WebWatchArgs& args) {
       ->description(
           "The crane config of the watched run: the page draws its geometry (default: "
           "the embedded K70M reference crane)");
+  web->add_option("--base", args.base_file,
+                  "The wheeled base config of a run on a base (sim --drive): the page draws its "
+                  "chassis and wheels (default: the embedded config/machines/mobile_base.yaml)")
+      ->check(CLI::ExistingFile);
   web->add_option("--web-listen", args.web.listen,
                   "Where the page is served, ADDR:PORT (port 0: any free port)")
       ->capture_default_str();
@@ -204,13 +209,18 @@ int run_web_watch_command(const WebWatchArgs& args) {
   const auto settings = tool_settings(args);
   if (!settings) return kExitUsage;
   config::CraneConfig cfg;
+  config::BaseConfig base;
   try {
     cfg = load_crane(args.crane_file);
+    base = config::load_base_or_default(args.base_file);
   } catch (...) {
     return input_error_exit("config");
   }
   WebView view;
-  if (const int rc = view.open(args.web, cfg, /*commands=*/false); rc != kExitOk) return rc;
+  // The base is drawn only while the watched run sends one (craneassist/base).
+  if (const int rc = view.open(args.web, cfg, /*commands=*/false, &base.model); rc != kExitOk) {
+    return rc;
+  }
   std::unique_ptr<dds::TelemetryWatch> watch;
   try {
     dds::WatchOptions o;

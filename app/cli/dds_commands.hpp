@@ -33,6 +33,7 @@ struct DashboardArgs : DdsToolArgs {
 
 struct WebWatchArgs : DdsToolArgs {
   std::string crane_file;   // --config: the crane the page draws (empty: the K70M reference)
+  std::string base_file;    // --base: the wheeled base it draws (empty: the shipped one)
   WebArgs web;              // --web-listen, --web-rate
   double duration_s = 0.0;  // > 0: serve this long; 0: until Ctrl-C or SIGTERM
 };

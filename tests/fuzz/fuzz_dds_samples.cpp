@@ -74,6 +74,8 @@ void check_topic(const std::uint8_t* data, std::size_t size) {
     (void)craneassist::dds::dashboard_view(nullptr, nullptr, &sample, nullptr);
   } else if constexpr (std::is_same_v<T, msg::CommandPath>) {
     (void)craneassist::dds::dashboard_view(nullptr, nullptr, nullptr, &sample);
+  } else if constexpr (std::is_same_v<T, msg::BaseState>) {
+    (void)craneassist::dds::dashboard_view(nullptr, nullptr, nullptr, nullptr, &sample);
   } else if constexpr (std::is_same_v<T, msg::OperatorCommand>) {
     // What the DDS command input passes on (DdsCommandSource::poll) through the input monitor.
     craneassist::input::InputMonitor monitor(craneassist::input::InputMonitorSettings{});

@@ -74,6 +74,19 @@ try {
   const end = await page.evaluate(() => window.craneassist.last);
   check(end.status === 'stopped', `the replay's end shows on the page: ${end.status}${end.stop_reason ? ': ' + end.stop_reason : ''}`);
 
+  // A run on the wheeled base (sim --drive): its base comes over craneassist/base and is drawn.
+  const driving = run(craneassist, ['sim', '--drive', '--input', 'replay', replayFile, '--duration', '4',
+    '--domain', domain]);
+  await page.waitForFunction(() => window.craneassist.last && window.craneassist.last.base, null,
+    { timeout: 20000 }).catch(() => {});
+  const onBase = await page.evaluate(() => window.craneassist.last);
+  check(onBase.base && onBase.base.boxes && onBase.base.boxes.length === 5,
+    'a watched run on a base: the frames carry its chassis and four wheels');
+  check(await page.evaluate(() => !document.getElementById('base-panel').hidden),
+    'a watched run on a base: the base panel shows');
+  const drove = await driving.exit;
+  check(drove.code === 0, `the drive run ended with exit ${drove.code}${drove.code === 0 ? '' : ': ' + driving.output}`);
+
   // A run that dies (kill -9: no end state sent) shows as lost, not as running forever.
   const dyingFile = join(work, 'dying.csv');
   writeFileSync(dyingFile, 't,v_x,v_y,v_z\n0.0,0,0,0\n60,0,0,0\n');
@@ -83,6 +96,10 @@ try {
     { timeout: 20000 }).catch(() => {});
   const alive = await page.evaluate(() => window.craneassist.last.status);
   check(alive === 'running', `a second run shows as running: ${alive}`);
+  await page.waitForFunction(() => !window.craneassist.last.base, null, { timeout: 5000 })
+    .catch(() => {});
+  check(await page.evaluate(() => !window.craneassist.last.base &&
+    document.getElementById('base-panel').hidden), 'a run without a base: no base drawn');
   dying.child.kill('SIGKILL');
   const killedAt = Date.now();
   await page.waitForFunction(() => window.craneassist.last.status === 'lost', null,

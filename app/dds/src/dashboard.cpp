@@ -53,6 +53,10 @@ struct Snapshot {
   msg::Hydraulics hydraulics;
   msg::CommandPath command_path;
   std::int64_t received_ns[kTelemetryTopics] = {};  // CLOCK_MONOTONIC; 0: nothing yet
+  // The wheeled base (craneassist/base): only a crane on a base publishes it, so it is not one
+  // of the topics the view waits for.
+  msg::BaseState base;
+  std::int64_t base_received_ns = 0;
   int matched[kTelemetryTopics] = {};
   std::uint64_t malformed[kTelemetryTopics] = {};  // dropped: could not be deserialized
 
@@ -90,8 +94,18 @@ class LatestSamples {
       case Topic::kCommandPath:
         take_into<msg::CommandPath>(reader, &Snapshot::command_path, topic);
         break;
+      case Topic::kBase: {
+        msg::BaseState sample;
+        fdds::SampleInfo info;
+        std::uint64_t malformed = 0;
+        while (take_next_valid(reader, &sample, info, malformed)) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          latest_.base = sample;
+          latest_.base_received_ns = monotonic_ns();
+        }
+        break;
+      }
       case Topic::kOperatorCommand:
-      case Topic::kBase:
         break;
     }
   }
@@ -299,6 +313,21 @@ std::vector<std::string> render(const Snapshot& s, const DashboardOptions& o, st
     lines.push_back("-");
     lines.push_back(fmt("%-10s-", "tip"));
   }
+  // The wheeled base, when the crane stands on one (sim --drive): where it is, how fast it
+  // goes, and the hub motors' flow against the drive pump.
+  if (s.base_received_ns != 0) {
+    const auto& b = s.base;
+    const bool stale = static_cast<double>(now_ns - s.base_received_ns) * 1e-9 > kStaleS;
+    lines.push_back(fmt("%-10sx %+8.3f  y %+8.3f m  heading %6.1f deg   %+.2f m/s  %+.1f deg/s%s",
+                        "base", shown(b.pose()[0], 3), shown(b.pose()[1], 3),
+                        shown(b.pose()[2] * 180.0 / kPi, 1), shown(b.velocity()[0], 2),
+                        shown(b.velocity()[1] * 180.0 / kPi, 1), stale ? "   STALE" : ""));
+    lines.push_back(fmt("%-10s%s %6.1f / %6.1f L/min  %s  %s", "drive",
+                        bar(b.motor_flow_sum_m3_s(), b.drive_max_flow_m3_s(), kBar).c_str(),
+                        b.motor_flow_sum_m3_s() * 60e3, b.drive_max_flow_m3_s() * 60e3,
+                        percent(b.motor_flow_sum_m3_s(), b.drive_max_flow_m3_s()).c_str(),
+                        b.shared_pump() ? "hub motors (the crane shares the pump)" : "hub motors"));
+  }
 
   // How old each topic's latest sample is (by the clock of this host, at arrival), two topics
   // a line so that STALE fits in 80 columns.
@@ -437,9 +466,14 @@ int report_timeout(const Snapshot& s, const DashboardOptions& o) {
 
 std::vector<std::string> dashboard_view(const msg::Status* status, const msg::JointState* joints,
                                         const msg::Hydraulics* hydraulics,
-                                        const msg::CommandPath* command_path) {
+                                        const msg::CommandPath* command_path,
+                                        const msg::BaseState* base) {
   Snapshot s;
   const std::int64_t now_ns = monotonic_ns();
+  if (base != nullptr) {
+    s.base = *base;
+    s.base_received_ns = now_ns;
+  }
   if (status != nullptr) {
     s.status = *status;
     s.received_ns[index_of(Topic::kStatus)] = now_ns;
@@ -467,8 +501,9 @@ int run_dashboard(const DashboardOptions& o) {
   LatestSamples latest;
   const auto session = open_tool_session(
       "craneassist-dashboard", o.domain_id, o.transport, o.type_propagation,
-      std::vector<Topic>(std::begin(kTelemetry), std::end(kTelemetry)), o.err,
-      [&latest](Topic topic, fdds::DataReader& reader) { latest.take(topic, reader); });
+      std::vector<Topic>{Topic::kStatus, Topic::kJoints, Topic::kHydraulics, Topic::kCommandPath,
+                         Topic::kBase},
+      o.err, [&latest](Topic topic, fdds::DataReader& reader) { latest.take(topic, reader); });
   if (!session) return kToolRuntime;
   auto snapshot = [&] {
     Snapshot s = latest.copy();

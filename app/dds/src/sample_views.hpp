@@ -22,9 +22,10 @@ void echo_sample(const msg::OperatorCommand& sample, EchoFormat format, std::FIL
 void echo_sample(const msg::BaseState& sample, EchoFormat format, std::FILE* out);
 
 // The dashboard's plain view (as --once prints it) of the latest sample of each telemetry topic;
-// nullptr: none received yet.
+// nullptr: none received yet (base: a crane without a wheeled base).
 std::vector<std::string> dashboard_view(const msg::Status* status, const msg::JointState* joints,
                                         const msg::Hydraulics* hydraulics,
-                                        const msg::CommandPath* command_path);
+                                        const msg::CommandPath* command_path,
+                                        const msg::BaseState* base = nullptr);
 
 }  // namespace craneassist::dds

@@ -47,7 +47,8 @@ struct TelemetryWatch::Impl {
     po.type_propagation = o.type_propagation;
     session = std::make_unique<SubscriberSession>(
         po,
-        std::vector<Topic>{Topic::kStatus, Topic::kJoints, Topic::kHydraulics, Topic::kCommandPath},
+        std::vector<Topic>{Topic::kStatus, Topic::kJoints, Topic::kHydraulics, Topic::kCommandPath,
+                           Topic::kBase},
         [this](Topic topic, fdds::DataReader& reader) { take(topic, reader); },
         [status = o.status](Topic topic) {
           config::TopicSettings s = default_reader_settings(topic);
@@ -75,8 +76,10 @@ struct TelemetryWatch::Impl {
       case Topic::kCommandPath:
         take_all<msg::CommandPath>(reader, bad);
         break;
-      case Topic::kOperatorCommand:
       case Topic::kBase:
+        take_all<msg::BaseState>(reader, bad);
+        break;
+      case Topic::kOperatorCommand:
         break;
     }
     if (bad > 0) {
@@ -162,6 +165,20 @@ struct TelemetryWatch::Impl {
     updated();
   }
 
+  void apply(const msg::BaseState& b) {
+    std::lock_guard<std::mutex> lock(mutex);
+    frame.base_present = true;
+    frame.base_shared_pump = b.shared_pump();
+    frame.base_pose = b.pose();
+    frame.base_velocity = b.velocity();
+    frame.base_command = b.command();
+    frame.base_motor_flow_m3_s = b.motor_flow_m3_s();
+    frame.base_flow_sum_m3_s = b.motor_flow_sum_m3_s();
+    frame.base_flow_max_m3_s = b.drive_max_flow_m3_s();
+    base_ns = monotonic_ns();
+    updated();
+  }
+
   void updated() {
     ++seq;
     ++run.samples;
@@ -171,6 +188,7 @@ struct TelemetryWatch::Impl {
   TelemetryFrame frame;
   WatchedRun run;
   std::uint64_t seq = 0;
+  std::int64_t base_ns = 0;                    // when the latest base sample came (CLOCK_MONOTONIC)
   std::unique_ptr<SubscriberSession> session;  // last: its listeners stop before the rest goes
 };
 
@@ -182,6 +200,11 @@ TelemetryWatch::~TelemetryWatch() = default;
 bool TelemetryWatch::latest(TelemetryFrame& out, std::uint64_t& seen) const {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   if (impl_->seq == seen) return false;
+  // A run on a wheeled base sends its base with every frame (sim --drive): one that stopped
+  // sending it for a second (another run, a fixed crane) stands on no base.
+  if (impl_->frame.base_present && monotonic_ns() - impl_->base_ns > 1'000'000'000) {
+    impl_->frame.base_present = false;
+  }
   out = impl_->frame;
   seen = impl_->seq;
   return true;
