@@ -6,7 +6,10 @@
  *
  *   cyclone reader: received status 9, joints 232, hydraulics 232, command_path 232; ...
  *
- * Usage: cyclone_reader DOMAIN SECONDS
+ * With `base` it reads craneassist/base too (a crane on the wheeled base, `sim --drive`) and
+ * counts it with the others.
+ *
+ * Usage: cyclone_reader DOMAIN SECONDS [base]
  * Exit 0: every topic received, every field sane; 1: a check failed (each failure on stderr);
  * 2: usage; 3: DDS failed. "cyclone reader: ready" on stdout once the readers exist. */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime */
@@ -22,8 +25,9 @@
 #include "cyclone_common.h"
 #include "dds/dds.h"
 
-enum { kStatus, kJoints, kHydraulics, kCommandPath, kTopics };
-static const char* const kNames[kTopics] = {"status", "joints", "hydraulics", "command_path"};
+enum { kStatus, kJoints, kHydraulics, kCommandPath, kBase, kTopics };
+static const char* const kNames[kTopics] = {"status", "joints", "hydraulics", "command_path",
+                                            "base"};
 
 #define CHECK(cond, topic, ...) CHECK_AS("cyclone reader", kNames[topic], cond, __VA_ARGS__)
 
@@ -36,6 +40,7 @@ struct TopicState {
 };
 static struct TopicState g_state[kTopics];
 static char g_last_status[32] = "";
+static bool g_seen_running = false; /* `sim` says stopped before it runs: the end comes after */
 static long g_nan_commands = 0; /* command_path samples without a valid operator command */
 /* The flow manipulability polytope's figures of the status samples. */
 static long g_solid_polytopes = 0;     /* dimension 3, volume > 0, area 0 */
@@ -124,6 +129,7 @@ static void check_status(const craneassist_msg_Status* m) {
   g_volume_min = fmin(g_volume_min, m->polytope_volume_m3_s3);
   g_volume_max = fmax(g_volume_max, m->polytope_volume_m3_s3);
   if (m->state != NULL) snprintf(g_last_status, sizeof g_last_status, "%s", m->state);
+  if (m->state != NULL && strcmp(m->state, "running") == 0) g_seen_running = true;
 }
 
 static void check_joints(const craneassist_msg_JointState* m) {
@@ -201,6 +207,28 @@ static void check_command_path(const craneassist_msg_CommandPath* m) {
   }
 }
 
+static void check_base(const craneassist_msg_BaseState* m) {
+  check_header(kBase, &m->header);
+  CHECK(finite_all(m->pose, 3) && finite_all(m->velocity, 2) && finite_all(m->command, 2), kBase,
+        "pose, velocity or command not finite");
+  /* The shipped base starts at the origin; in a few seconds it goes no further than 5 m. */
+  CHECK(fabs(m->pose[0]) < 5.0 && fabs(m->pose[1]) < 5.0, kBase, "pose [%g, %g]", m->pose[0],
+        m->pose[1]);
+  double sum = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    CHECK(isfinite(m->motor_flow_m3_s[i]) && m->motor_flow_m3_s[i] >= 0.0, kBase,
+          "motor_flow_m3_s %d = %g", i, m->motor_flow_m3_s[i]);
+    sum += m->motor_flow_m3_s[i];
+  }
+  CHECK(fabs(sum - m->motor_flow_sum_m3_s) <= 1e-9 + 1e-6 * sum, kBase,
+        "motor_flow_sum_m3_s %g, the flows add to %g", m->motor_flow_sum_m3_s, sum);
+  /* The shipped base's drive pump: 63 L/min. */
+  CHECK(fabs(m->drive_max_flow_m3_s - 63e-3 / 60.0) < 1e-9, kBase, "drive_max_flow_m3_s %g",
+        m->drive_max_flow_m3_s);
+  CHECK(m->motor_flow_sum_m3_s <= m->drive_max_flow_m3_s * (1.0 + 1e-6), kBase,
+        "motor_flow_sum_m3_s %g above Q_max %g", m->motor_flow_sum_m3_s, m->drive_max_flow_m3_s);
+}
+
 static dds_entity_t make_reader(dds_entity_t pp, const dds_topic_descriptor_t* desc,
                                 const char* name, bool reliable) {
   /* status: reliable and transient local like craneassist's status writer (the last status
@@ -230,6 +258,9 @@ static int take_all(dds_entity_t reader, int topic) {
       case kHydraulics:
         check_hydraulics(samples[i]);
         break;
+      case kBase:
+        check_base(samples[i]);
+        break;
       default:
         check_command_path(samples[i]);
         break;
@@ -240,18 +271,21 @@ static int take_all(dds_entity_t reader, int topic) {
 }
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
-    fprintf(stderr, "usage: cyclone_reader DOMAIN SECONDS\n");
+  const bool base = argc == 4 && strcmp(argv[3], "base") == 0;
+  if (argc != 3 && !base) {
+    fprintf(stderr, "usage: cyclone_reader DOMAIN SECONDS [base]\n");
     return 2;
   }
   const dds_domainid_t domain = (dds_domainid_t)atoi(argv[1]);
   const double seconds = atof(argv[2]);
   const dds_entity_t pp = create_participant_or_exit(domain, "cyclone reader");
+  const int topics = base ? kTopics : kBase;
   const dds_entity_t readers[kTopics] = {
       make_reader(pp, &craneassist_msg_Status_desc, "craneassist/status", true),
       make_reader(pp, &craneassist_msg_JointState_desc, "craneassist/joints", false),
       make_reader(pp, &craneassist_msg_Hydraulics_desc, "craneassist/hydraulics", false),
-      make_reader(pp, &craneassist_msg_CommandPath_desc, "craneassist/command_path", false)};
+      make_reader(pp, &craneassist_msg_CommandPath_desc, "craneassist/command_path", false),
+      base ? make_reader(pp, &craneassist_msg_BaseState_desc, "craneassist/base", false) : 0};
   printf("cyclone reader: ready on domain %d\n", (int)domain);
   fflush(stdout);
 
@@ -262,10 +296,12 @@ int main(int argc, char** argv) {
     if ((double)(now - start) * 1e-9 > seconds) break;
     /* After the final `stopped` status: a moment for the last samples of the other topics. */
     if (stopped_at != 0 && now - stopped_at > 500000000) break;
-    for (int t = 0; t < kTopics; ++t) {
+    for (int t = 0; t < topics; ++t) {
       if (take_all(readers[t], t) > 0 && first_sample == 0) first_sample = monotonic_ns();
     }
-    if (stopped_at == 0 && strcmp(g_last_status, "stopped") == 0) stopped_at = monotonic_ns();
+    if (stopped_at == 0 && g_seen_running && strcmp(g_last_status, "stopped") == 0) {
+      stopped_at = monotonic_ns();
+    }
     dds_sleepfor(DDS_MSECS(5));
   }
   dds_delete(pp);
@@ -284,17 +320,18 @@ int main(int argc, char** argv) {
         "the polytope's volume never changed (%g)", g_volume_max);
 
   printf(
-      "cyclone reader: received status %ld, joints %ld, hydraulics %ld, command_path %ld; "
+      "cyclone reader: received status %ld, joints %ld, hydraulics %ld, command_path %ld, "
+      "base %ld; "
       "first sample %.2f s after start; last status '%s'; latency max %.1f ms; %ld commands "
       "NaN (input not valid); %ld failed checks\n",
       g_state[kStatus].count, g_state[kJoints].count, g_state[kHydraulics].count,
-      g_state[kCommandPath].count, first_sample != 0 ? (double)(first_sample - start) * 1e-9 : -1.0,
+      g_state[kCommandPath].count, g_state[kBase].count, first_sample != 0 ? (double)(first_sample - start) * 1e-9 : -1.0,
       g_last_status,
       1e3 * fmax(fmax(g_state[0].latency_max_s, g_state[1].latency_max_s),
                  fmax(g_state[2].latency_max_s, g_state[3].latency_max_s)),
       g_nan_commands, *check_errors());
   bool ok = *check_errors() == 0;
-  for (int t = 0; t < kTopics; ++t) {
+  for (int t = 0; t < topics; ++t) {
     if (g_state[t].count == 0) {
       fprintf(stderr, "cyclone reader: no sample on craneassist/%s\n", kNames[t]);
       ok = false;

@@ -5,6 +5,8 @@
 # reader builds from craneassist's discovery data.
 # Usage: interop.sh CASE CRANEASSIST PROGRAM REPLAY DOMAIN
 #   reader: cyclone_reader reads and checks every topic of `craneassist replay REPLAY --telemetry`
+#   base: cyclone_reader reads craneassist/base too, of `craneassist sim --drive --input replay
+#     REPLAY` (the crane on the wheeled base)
 #   writer: cyclone_writer drives `craneassist echo` on every telemetry topic
 #   type_information: with `type_propagation.type_information: true` (Fast DDS 2.9's
 #     TYPE_INFORMATION record) Cyclone matches nothing: what the setting's default avoids
@@ -74,6 +76,19 @@ reader)
     echo "$topic: Cyclone received $received of $published published"
   done
   echo "reader OK"
+  ;;
+base)
+  start_reader 40 base
+  "$bin" sim --drive --input replay "$replay" --duration 6 --domain "$domain" \
+    > "$work/replay.out" 2>&1 || { cat "$work/replay.out"; fail "sim --drive failed"; }
+  finish_reader "telemetry:"
+  [ "$reader_rc" = 0 ] || fail "cyclone reader: exit $reader_rc"
+  has reader.out "last status 'stopped'"
+  has reader.out " 0 failed checks"
+  received=$(count_of base reader.out)
+  [ -n "$received" ] && [ "$received" -gt 50 ] || fail "base: Cyclone received '$received' samples"
+  echo "base: Cyclone received $received samples of craneassist/base"
+  echo "base OK"
   ;;
 writer)
   "$program" "$domain" 40 > "$work/writer.out" 2>&1 &
