@@ -41,7 +41,7 @@ struct TopicState {
 static struct TopicState g_state[kTopics];
 static char g_last_status[32] = "";
 static bool g_seen_running = false; /* `sim` says stopped before it runs: the end comes after */
-static long g_nan_commands = 0; /* command_path samples without a valid operator command */
+static long g_nan_commands = 0;     /* command_path samples without a valid operator command */
 /* The flow manipulability polytope's figures of the status samples. */
 static long g_solid_polytopes = 0;     /* dimension 3, volume > 0, area 0 */
 static double g_avail_speed_max = 0.0; /* the largest available speed along the stick */
@@ -325,8 +325,8 @@ int main(int argc, char** argv) {
       "first sample %.2f s after start; last status '%s'; latency max %.1f ms; %ld commands "
       "NaN (input not valid); %ld failed checks\n",
       g_state[kStatus].count, g_state[kJoints].count, g_state[kHydraulics].count,
-      g_state[kCommandPath].count, g_state[kBase].count, first_sample != 0 ? (double)(first_sample - start) * 1e-9 : -1.0,
-      g_last_status,
+      g_state[kCommandPath].count, g_state[kBase].count,
+      first_sample != 0 ? (double)(first_sample - start) * 1e-9 : -1.0, g_last_status,
       1e3 * fmax(fmax(g_state[0].latency_max_s, g_state[1].latency_max_s),
                  fmax(g_state[2].latency_max_s, g_state[3].latency_max_s)),
       g_nan_commands, *check_errors());
