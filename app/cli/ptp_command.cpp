@@ -214,6 +214,21 @@ double parse_grid_spacing(const std::string& option, const std::string& text) {
   return spacing_m;
 }
 
+void check_grid_size(const planner::PlanarArm& arm, const std::string& crane, double spacing_m,
+                     const std::string& option) {
+  const double cells = planner::grid_cells(arm, spacing_m);
+  if (cells > planner::kMaxGridCells) {
+    const double finest = 2.0 * planner::arm_reach_m(arm) / std::sqrt(planner::kMaxGridCells);
+    char why[240];
+    std::snprintf(why, sizeof why,
+                  "%.0f mm gives up to %.3g grid cells for %s (reach %.2f m): its table would "
+                  "take hours; at most %.3g cells, %.0f mm or coarser",
+                  1000.0 * spacing_m, cells, crane.c_str(), planner::arm_reach_m(arm),
+                  planner::kMaxGridCells, std::ceil(1000.0 * finest));
+    throw CLI::ValidationError(option, why);
+  }
+}
+
 void check_in_workspace(const planner::WorkspaceGrid& grid, const std::string& crane,
                         const std::vector<std::pair<std::string, Eigen::Vector2d>>& points) {
   const double reach = 0.5 * std::sqrt(2.0) * grid.spacing_m + 1e-9;
@@ -345,7 +360,10 @@ int run_ptp_command(const PtpArgs& args) {
         throw CLI::ValidationError("--velocity-limit", "must be positive and at most 10 m/s");
       }
     }
-    if (!args.grid.empty()) table_settings.spacing_m = parse_grid_spacing("--grid", args.grid);
+    if (!args.grid.empty()) {
+      table_settings.spacing_m = parse_grid_spacing("--grid", args.grid);
+      check_grid_size(*arm, cfg.model.name, table_settings.spacing_m, "--grid");
+    }
     if (!args.energy_model.empty()) {
       if (!cfg.model.mhsb) {
         throw CLI::ValidationError("--energy-model", cfg.model.name +

@@ -49,6 +49,11 @@ std::vector<double> parse_numbers(const std::string& option, const std::string& 
 planner::PtpWeights parse_weights(const std::string& option, const std::string& text);
 double parse_grid_spacing(const std::string& option, const std::string& text);
 
+// A grid spacing whose table would take hours (planner::kMaxGridCells) is a CLI::ValidationError
+// naming the option and the finest spacing allowed.
+void check_grid_size(const planner::PlanarArm& arm, const std::string& crane, double spacing_m,
+                     const std::string& option);
+
 // Each (option, point) must have a reachable grid node within half a diagonal, else a
 // CLI::ValidationError naming the option.
 void check_in_workspace(const planner::WorkspaceGrid& grid, const std::string& crane,

@@ -338,6 +338,7 @@ int run_sim_command(const SimArgs& args) {
     planner::PostureTableSettings table_settings;
     if (!args.goal_grid.empty()) {
       table_settings.spacing_m = parse_grid_spacing("--goal-grid", args.goal_grid);
+      check_grid_size(*goal_arm, cfg.model.name, table_settings.spacing_m, "--goal-grid");
     }
     std::vector<std::pair<std::string, Eigen::Vector2d>> points;
     for (const auto& g : goals)

@@ -130,6 +130,10 @@ expect ptp_bad_velocity "--velocity-limit: unit 'bar' is not a velocity unit" \
   ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --velocity-limit "3 bar"
 expect ptp_bad_grid "--grid: must be between 5 mm and 5 m" \
   ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --grid "1 mm"
+expect ptp_grid_too_fine "--grid: 10 mm gives up to 2.3e+06 grid cells for K70M forestry loader (reference crane) (reach 7.58 m): its table would take hours; at most 1e+06 cells, 16 mm or coarser" \
+  ptp --table "$nt" --from 4,1 --to 7,4 --grid "1 cm"
+expect sim_goal_grid_too_fine "--goal-grid: 5 mm gives up to 9.19e+06 grid cells" \
+  sim --input goal --goal 5,1 --goal-grid "5 mm" --no-telemetry
 expect ptp_bad_continuity "--continuity-tolerance: '2' is not a finite number in [0, 0.99]" \
   ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --continuity-tolerance 2
 expect ptp_bad_posture "--posture: 'fixed-j3': expected optimal or fixed-last:ANGLE" \

@@ -224,14 +224,24 @@ dynamics::ModePattern full_pattern(const PlanarArm& arm, const dynamics::ModePat
   return p;
 }
 
-double default_spacing(const PlanarArm& arm) {
-  double reach = 0.0;  // the DH lengths of the moving joints, extensions at full stroke
+double arm_reach_m(const PlanarArm& arm) {
+  double reach = 0.0;
   for (int k = 0; k < arm.moving(); ++k) {
     const auto& j = arm.model().joints[at(arm.joint(k))];
     reach += std::abs(j.a_m) + (j.type == dynamics::JointType::kPrismatic
                                     ? std::max(std::abs(j.q_min), std::abs(j.q_max))
                                     : 0.0);
   }
+  return reach;
+}
+
+double grid_cells(const PlanarArm& arm, double spacing_m) {
+  const double side = 2.0 * arm_reach_m(arm) / spacing_m;
+  return side * side;
+}
+
+double default_spacing(const PlanarArm& arm) {
+  const double reach = arm_reach_m(arm);
   if (reach <= 2.0) return 0.05;
   return std::ceil(reach / 40.0 / 0.05 - 1e-9) * 0.05;
 }

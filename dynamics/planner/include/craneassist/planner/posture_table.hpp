@@ -72,9 +72,16 @@ std::vector<dynamics::ModePattern> planner_patterns(const PlanarArm& arm);
 // A pattern over the moving joints as one over all the crane's joints (held joints N).
 dynamics::ModePattern full_pattern(const PlanarArm& arm, const dynamics::ModePattern& moving);
 
+// The arm's reach: the DH lengths of the moving joints, extensions at full stroke.
+double arm_reach_m(const PlanarArm& arm);
 // The default grid spacing: 5 cm (the paper's), or for an arm reaching further than 2 m its
 // reach / 40 rounded up to 5 cm (the K70M: 0.2 m).
 double default_spacing(const PlanarArm& arm);
+// The cells of the square around the arm's reach at this spacing ((2 reach / h)^2): what a table
+// of that grid costs at most. Above kMaxGridCells a table would take hours and gigabytes (the
+// K70M at 1 cm: 4 million); the commands refuse such a grid.
+double grid_cells(const PlanarArm& arm, double spacing_m);
+inline constexpr double kMaxGridCells = 1.0e6;
 
 struct PostureTableSettings {
   double spacing_m = 0.0;  // 0: default_spacing()
