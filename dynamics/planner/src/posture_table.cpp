@@ -1,6 +1,7 @@
 #include "craneassist/planner/posture_table.hpp"
 
 #include <nlopt.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -702,7 +703,9 @@ void PostureTable::write(std::ostream& out) const {
 
 void PostureTable::save(const std::filesystem::path& file) const {
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-  const auto tmp = file.string() + ".tmp";
+  // A temporary file of this process's own (two runs may build the same table at once), then
+  // a rename: a reader sees the old file or the whole new one.
+  const auto tmp = file.string() + ".tmp." + std::to_string(::getpid());
   {
     std::ofstream out(tmp, std::ios::binary);
     write(out);
