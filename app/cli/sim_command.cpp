@@ -285,6 +285,7 @@ int run_sim_command(const SimArgs& args) {
     spdlog::error("--pump: only with --drive (the wheeled base)");
     return kExitUsage;
   }
+  const bool pad = kind == "evdev" || kind == "sdl";  // a gamepad (not the page, not keys)
   std::optional<config::BaseConfig> base;
   config::CraneConfig cfg;
   config::JoystickConfig jcfg;
@@ -297,7 +298,6 @@ int run_sim_command(const SimArgs& args) {
                               !uses_can_backend(args.machine, cfg)});
     // In the drive mode a pad's and the page's right stick drive the base (a mapping with a
     // drive stick); the keyboard has its own drive keys.
-    const bool pad = kind == "evdev" || kind == "sdl";
     jcfg = !args.joystick_file.empty() ? config::load_joystick_config(args.joystick_file)
            : kind == "web" && drive    ? config::web_drive_joystick_config()
            : kind == "web"             ? config::web_joystick_config()
@@ -444,8 +444,8 @@ int run_sim_command(const SimArgs& args) {
                  options.realtime ? ", real time" : ", as fast as possible");
     if (keyboard != nullptr) print_keys(drive);
     if (base) {
-      const bool stick = kind == "evdev" || kind == "sdl" || kind == "web";
-      if (stick && !(jcfg.mapping.drive[0].enabled || jcfg.mapping.drive[1].enabled)) {
+      if ((pad || kind == "web") &&
+          !(jcfg.mapping.drive[0].enabled || jcfg.mapping.drive[1].enabled)) {
         spdlog::warn(
             "--drive: the joystick mapping ({}) has no drive stick (joystick.drive): the base "
             "does not move; config/joysticks/gamepad_drive.yaml and web_drive.yaml have one",

@@ -94,17 +94,9 @@ class LatestSamples {
       case Topic::kCommandPath:
         take_into<msg::CommandPath>(reader, &Snapshot::command_path, topic);
         break;
-      case Topic::kBase: {
-        msg::BaseState sample;
-        fdds::SampleInfo info;
-        std::uint64_t malformed = 0;
-        while (take_next_valid(reader, &sample, info, malformed)) {
-          std::lock_guard<std::mutex> lock(mutex_);
-          latest_.base = sample;
-          latest_.base_received_ns = monotonic_ns();
-        }
+      case Topic::kBase:
+        take_into<msg::BaseState>(reader, &Snapshot::base, topic);
         break;
-      }
       case Topic::kOperatorCommand:
         break;
     }
@@ -116,19 +108,22 @@ class LatestSamples {
   }
 
  private:
+  // The base (index -1: not one of the telemetry topics) has its own arrival time and no
+  // malformed count.
   template <typename T>
   void take_into(fdds::DataReader& reader, T Snapshot::*field, Topic topic) {
+    const int i = index_of(topic);
     T sample;
     fdds::SampleInfo info;
     std::uint64_t malformed = 0;
     while (take_next_valid(reader, &sample, info, malformed)) {
       std::lock_guard<std::mutex> lock(mutex_);
       latest_.*field = sample;
-      latest_.received_ns[index_of(topic)] = monotonic_ns();
+      (i >= 0 ? latest_.received_ns[i] : latest_.base_received_ns) = monotonic_ns();
     }
-    if (malformed > 0) {
+    if (malformed > 0 && i >= 0) {
       std::lock_guard<std::mutex> lock(mutex_);
-      latest_.malformed[index_of(topic)] += malformed;
+      latest_.malformed[i] += malformed;
     }
   }
 
