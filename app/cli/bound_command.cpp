@@ -125,7 +125,7 @@ int run_bound_command(const BoundArgs& args) {
     if (header == "t,x,y,z") {
       format = "path";
       path = input::PrescribedPath::parse(text, args.file);
-    } else if (header == "t,v_x,v_y,v_z" || header == "t,v_x,v_y,v_z,stop") {
+    } else if (header.rfind("t,v_x,v_y,v_z", 0) == 0) {
       replay = input::Replay::parse(text, args.file);
     } else {
       spdlog::error("{}: header '{}': expected a tip path (t,x,y,z) or a replay (t,v_x,v_y,v_z)",

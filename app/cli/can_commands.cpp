@@ -15,6 +15,7 @@
 #include "craneassist/can/heartbeat.hpp"
 #include "craneassist/can/valve_frames.hpp"
 #include "craneassist/config/crane_config.hpp"
+#include "craneassist/offline/sim_setup.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
 #include "embedded_replays.hpp"
 #include "exit_codes.hpp"
@@ -147,7 +148,7 @@ int run_emulate_command(const EmulateArgs& args) {
   const int n = cfg.model.dof();
   try {
     can::SocketCanTransport bus(args.iface);
-    sim_backend::SimBackend sim(cfg.model, {cfg.simulation.step_s, cfg.simulation.q_initial});
+    sim_backend::SimBackend sim(cfg.model, offline::sim_settings(cfg));
     std::vector<can::CanFrame> frames;
     std::vector<FeedbackSignal> signals;
     auto add = [&](int joint, int kind, const can::SignalSpec& spec) {
@@ -202,7 +203,7 @@ int run_emulate_command(const EmulateArgs& args) {
     std::printf(
         "craneassist emulate: %s on %s, mapping %s, payload %.0f kg, feedback every %.0f ms\n",
         cfg.model.name.c_str(), args.iface.c_str(), mapping.source.c_str(),
-        cfg.model.bodies.back().mass_kg, args.feedback_period_s * 1e3);
+        dynamics::payload_mass_kg(cfg.model), args.feedback_period_s * 1e3);
     std::fflush(stdout);
     while (!g_stop.load()) {
       const std::int64_t now = mono_ns() - start;
@@ -286,12 +287,10 @@ int run_emulate_command(const EmulateArgs& args) {
         for (auto& f : frames) f.data.fill(0);
         for (const auto& s : signals) {
           double value = state.q[s.joint];
-          const auto& cyl = cfg.model.cylinders[static_cast<std::size_t>(s.joint)];
-          const double lp = state.load_pressure_pa[s.joint];
-          if (s.kind == 1) value = std::max(lp, 0.0);
-          if (s.kind == 2) {
-            value = cyl.area_b_m2 > 0.0 ? std::max(-lp, 0.0) * cyl.area_a_m2 / cyl.area_b_m2 : 0.0;
-          }
+          // The emulated machine's chamber pressure transmitters (with the simulator's sensor
+          // noise and resolution, then the mapping's scaling).
+          if (s.kind == 1) value = state.pressure_a_pa[s.joint];
+          if (s.kind == 2) value = state.pressure_b_pa[s.joint];
           if (s.kind == 3) value = state.pump.pressure_pa;
           if (s.kind == 4) value = state.pump.flow_m3_s;
           can::encode(*s.spec, value, frames[s.frame]);

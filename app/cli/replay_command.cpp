@@ -70,6 +70,14 @@ void print_pump_line(double energy_j, double peak_power_w, double peak_flow_m3_s
       peak_flow_m3_s * 60e3, saturated_cycles);
 }
 
+// The payload as the run starts: the simulated load and whether the controller is told.
+std::string payload_text(const config::CraneConfig& cfg, bool known) {
+  char text[160];
+  std::snprintf(text, sizeof text, "%.0f kg (%s)", dynamics::payload_mass_kg(cfg.model),
+                known ? "told to the controller" : "unannounced: the crane scale weighs it");
+  return text;
+}
+
 // Stall events and, on a one-line replay, the lateral tip speed (docs/scaling.md#operator-feel).
 void print_feel_line(const control::MotionQualityResult& f) {
   if (f.one_line) {
@@ -83,20 +91,52 @@ void print_feel_line(const control::MotionQualityResult& f) {
   }
 }
 
+}  // namespace
+
+void print_load_line(const control::LoadSummary& l, bool known, bool chart) {
+  std::printf("  load: %s %.1f kg", known ? "told" : "estimated", l.estimate_kg);
+  if (!known) std::printf(" (+-%.1f kg%s)", l.sigma_kg, l.converged ? "" : ", not converged");
+  if (l.truth_known) {
+    std::printf(", simulated %.1f kg", l.truth_kg);
+    if (!known) {
+      std::printf("; error at rest max %.1f kg over %ld cycles, moving max %.1f kg over %ld cycles",
+                  l.max_error_rest_kg, l.rest_samples, l.max_error_moving_kg, l.moving_samples);
+    }
+  }
+  std::printf("\n");
+  if (chart) {
+    std::printf(
+        "  load moment: peak %.0f %% of the chart, warning (90 %%) in %ld cycles, overload in %ld "
+        "(motion refused in %ld)",
+        l.peak_moment_ratio * 100.0, l.warning_cycles, l.overload_cycles, l.refused_cycles);
+    if (l.overload_cycles > 0) std::printf(": OVERLOADED");
+    std::printf("\n");
+  }
+  if (l.relief_cycles > 0) {
+    std::printf(
+        "  LOAD ABOVE A PORT RELIEF in %ld cycles: the boom sank at the load-holding valve's "
+        "relief flow\n",
+        l.relief_cycles);
+  }
+}
+
+namespace {
+
 void print_summary(const control::RunSummary& s, const config::CraneConfig& cfg,
-                   const std::string& replay_name, control::ScalingMode mode,
+                   const std::string& replay_name, const control::ControllerOptions& controller,
                    const control::CsvLog* log, const char* backend) {
+  const control::ScalingMode mode = controller.mode;
   const double speedup = s.wall_time_s > 0.0 ? s.duration_s / s.wall_time_s : 0.0;
   std::printf("craneassist replay: %s on %s\n", replay_name.c_str(), cfg.model.name.c_str());
-  std::printf("  backend %s, resolution %s, scaling %s, control %.0f Hz, payload %.0f kg\n",
-              backend, config::resolution_description(cfg).c_str(),
+  std::printf("  backend %s, resolution %s, scaling %s, control %.0f Hz, payload %s\n", backend,
+              config::resolution_description(cfg).c_str(),
               mode == control::ScalingMode::kFull
                   ? (std::string("full (power bound: ") +
                      power_bound_name(cfg.scaling.power_bound, cfg.model.pump.mode) + ")")
                         .c_str()
               : mode == control::ScalingMode::kFlowOnly ? "flow prescaling only"
                                                         : "none",
-              cfg.control.rate_hz, cfg.model.bodies.back().mass_kg);
+              cfg.control.rate_hz, payload_text(cfg, controller.payload_known).c_str());
   std::printf("  ran %.2f s of machine time in %.3f s (%.0fx real time), %ld cycles\n",
               s.duration_s, s.wall_time_s, speedup, s.cycles);
   std::printf("  tip: path %.2f m, peak speed %.2f m/s\n", s.tip_path_m, s.peak_tip_speed_m_s);
@@ -125,6 +165,7 @@ void print_summary(const control::RunSummary& s, const config::CraneConfig& cfg,
                 cfg.scaling.jerk_max_m_s3);
   }
   print_feel_line(s.feel);
+  print_load_line(s.load, controller.payload_known, !cfg.load_chart.empty());
   std::printf("  active limit (cycles):");
   for (std::size_t i = 0; i < s.limit_cycles.size(); ++i) {
     if (s.limit_cycles[i] > 0) {
@@ -272,6 +313,7 @@ int run_replay_command(const ReplayArgs& args) {
     if (control::CycleObserver* o = telemetry.observer()) options.observers.push_back(o);
     options.controller.mode = args.no_scaling ? control::ScalingMode::kNone
                                               : control::parse_scaling_mode(args.scaling).value();
+    options.controller.payload_known = args.payload_known;
     options.realtime = args.realtime || machine.real_time();
     options.settle_s = args.settle_s;
     options.freeze_at_s = args.freeze_at_s;
@@ -281,7 +323,7 @@ int run_replay_command(const ReplayArgs& args) {
                  options.realtime ? ", paced at real time" : "");
     const control::RunSummary summary =
         control::run_replay(cfg, replay, machine, options, log ? &*log : nullptr);
-    print_summary(summary, cfg, replay_name, options.controller.mode, log ? &*log : nullptr,
+    print_summary(summary, cfg, replay_name, options.controller, log ? &*log : nullptr,
                   machine.name());
     telemetry.finish();
     if (summary.log_rows_dropped > 0) {
@@ -336,6 +378,9 @@ CLI::App* add_replay_command(CLI::App& cli, ReplayArgs& args) {
       ->check(FiniteRange(0.0, 600.0))
       ->capture_default_str();
   add_payload_option(*replay, args.payload_kg);
+  replay->add_flag("--payload-known", args.payload_known,
+                   "Tell the controller the payload (--payload, the config's, and the replay's "
+                   "load_kg) instead of letting the crane scale estimate it (docs/loads.md)");
   add_initial_option(*replay, args.initial);
   replay->add_option("--pump-max-flow", args.pump_max_flow,
                      "Override the pump's maximum flow, e.g. \"120 L/min\"");

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "craneassist/control/controller.hpp"
+#include "craneassist/control/run_statistics.hpp"
 #include "machine_setup.hpp"
 #include "telemetry_setup.hpp"
 
@@ -30,6 +31,7 @@ struct ReplayArgs {
   bool realtime = false;
   double settle_s = 1.0;
   std::optional<double> payload_kg;
+  bool payload_known = false;     // tell the controller the payload (else the crane scale finds it)
   std::string initial;            // start pose, "NAME=VALUE UNIT, ..."; empty: the config's
   std::string pump_max_flow;      // quantity text, e.g. "120 L/min"
   std::string prime_mover_power;  // quantity text, e.g. "60 kW"
@@ -38,6 +40,9 @@ struct ReplayArgs {
 };
 
 CLI::App* add_replay_command(CLI::App& cli, ReplayArgs& args);
+// The summary's load lines (docs/loads.md): the crane scale against the simulated load, the load
+// moment against the chart, a load above a port relief. Shared by replay and sim.
+void print_load_line(const control::LoadSummary& load, bool known, bool chart);
 int run_replay_command(const ReplayArgs& args);
 
 }  // namespace craneassist::cli

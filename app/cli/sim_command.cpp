@@ -29,6 +29,7 @@
 #include "option_checks.hpp"
 #include "ptp_command.hpp"
 #include "remote_input.hpp"
+#include "replay_command.hpp"
 
 namespace craneassist::cli {
 namespace {
@@ -219,6 +220,9 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
   sim->add_option("--goal-table", args.goal_table,
                   "--input goal: the posture table file (default: the cache, as ptp)");
   add_payload_option(*sim, args.payload_kg);
+  sim->add_flag("--payload-known", args.payload_known,
+                "Tell the controller the payload instead of letting the crane scale estimate it "
+                "(docs/loads.md)");
   add_initial_option(*sim, args.initial);
   add_resolution_option(*sim, args.resolution, "for the run");
   add_backend_options(*sim, args.machine);
@@ -419,6 +423,7 @@ int run_sim_command(const SimArgs& args) {
     control::LiveStatusBoard board;
     control::LiveOptions options;
     options.monitor = jcfg.monitor;
+    options.controller.payload_known = args.payload_known;
     if (base) options.base = &base->model;
     options.realtime = !args.no_realtime;  // always on the can backend (checked above)
     options.duration_s = args.duration_s > 0.0 ? args.duration_s
@@ -502,6 +507,7 @@ int run_sim_command(const SimArgs& args) {
     std::printf("  tip: path %.2f m, peak speed %.2f m/s; operator command passed in %ld cycles\n",
                 s.tip_path_m, s.peak_tip_speed_m_s, s.enabled_cycles);
     std::printf("  cycle timing: %s\n", control::describe(s.timing).c_str());
+    print_load_line(s.load, args.payload_known, !cfg.load_chart.empty());
     if (s.stop_cycles > 0) {
       std::printf("  %s: stopped jerk-limited in %.2f s, then valves neutral\n",
                   s.end_stop ? "end of run" : "stop",

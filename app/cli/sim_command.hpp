@@ -29,6 +29,7 @@ struct SimArgs {
   int rt_priority = 0;             // --rt-priority N (SCHED_FIFO); 0: none
   int cpu = -1;                    // --cpu N: pin the loop thread; -1: none
   std::optional<double> payload_kg;
+  bool payload_known = false;
   std::string resolution;  // empty: the config's
   std::string initial;     // start pose "NAME=VALUE UNIT, ..." (sim backend); empty: the config's
   BackendArgs machine;     // empty values: the config's backend: and can:

@@ -159,7 +159,7 @@ dynamics::Cylinder read_cylinder(Reader& r, const YAML::Node& node, const std::s
   r.check_keys(node, path,
                {"name", "linkage", "arm", "length_at_zero", "l1", "l2", "angle_offset",
                 "coefficients", "bore", "rod", "area_a", "area_b", "differential_spool", "stroke",
-                "max_speed", "max_acceleration"});
+                "max_speed", "max_acceleration", "friction"});
   dynamics::Cylinder c;
   c.name = node["name"].IsDefined() ? node["name"].Scalar() : joint.name;
   const std::string linkage = r.text(node, "linkage", path);
@@ -209,6 +209,19 @@ dynamics::Cylinder read_cylinder(Reader& r, const YAML::Node& node, const std::s
                            "positive and at most 10 m/s");
   c.a_max_m_s2 = r.value_in(node, "max_acceleration", path, Dimension::kAcceleration, 1e-6, 100.0,
                             "positive and at most 100 m/s^2");
+  // Optional seal and guide friction (docs/loads.md).
+  if (node["friction"].IsDefined() && !node["friction"].IsNull()) {
+    const YAML::Node f = node["friction"];
+    const std::string fp = path + ".friction";
+    if (!f.IsMap()) r.fail(f, fp, "expected coulomb_extend, coulomb_retract and viscous");
+    r.check_keys(f, fp, {"coulomb_extend", "coulomb_retract", "viscous"});
+    c.friction.coulomb_extend_n =
+        r.value_in(f, "coulomb_extend", fp, Dimension::kForce, 0.0, 1e7, "between 0 and 10000 kN");
+    c.friction.coulomb_retract_n =
+        r.value_in(f, "coulomb_retract", fp, Dimension::kForce, 0.0, 1e7, "between 0 and 10000 kN");
+    c.friction.viscous_n_s_m =
+        r.value_in(f, "viscous", fp, Dimension::kDamping, 0.0, 1e8, "between 0 and 100000 kN*s/m");
+  }
 
   // The joint range must fit the stroke, and the torque arm must keep its sign over it.
   constexpr int kSamples = 64;
@@ -444,7 +457,7 @@ void read_mhsb(Reader& r, const YAML::Node& node, dynamics::CraneModel& model) {
 
 void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& model) {
   const YAML::Node h = r.child(root, "hydraulics", "");
-  r.check_keys(h, "hydraulics", {"pump", "valves", "mhsb"});
+  r.check_keys(h, "hydraulics", {"pump", "valves", "mhsb", "load_holding"});
   const YAML::Node pump = r.child(h, "pump", "hydraulics");
   const std::string pp = "hydraulics.pump";
   r.check_keys(pump, pp,
@@ -484,6 +497,44 @@ void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& mo
   v.delay_s = r.value_in(valves, "delay", vp, Dimension::kTime, 0.0, 2.0, "between 0 and 2 s");
   if (valves["tables"].IsDefined()) read_valve_tables(r, valves["tables"], vp + ".tables", model);
   if (h["mhsb"].IsDefined() && !h["mhsb"].IsNull()) read_mhsb(r, h["mhsb"], model);
+  // Optional load-holding valves (docs/loads.md); left out: held up to the pump's relief,
+  // nothing passes beyond it.
+  if (h["load_holding"].IsDefined() && !h["load_holding"].IsNull()) {
+    const YAML::Node lh = h["load_holding"];
+    const std::string lp = "hydraulics.load_holding";
+    if (!lh.IsMap()) r.fail(lh, lp, "expected relief and relief_flow");
+    r.check_keys(lh, lp, {"relief", "relief_flow"});
+    model.load_holding.relief_pa =
+        r.value_in(lh, "relief", lp, Dimension::kPressure, p.max_pressure_pa, 1e8,
+                   "at least the pump's max_pressure and at most 1000 bar");
+    model.load_holding.relief_flow_m3_s =
+        r.value_in(lh, "relief_flow", lp, Dimension::kFlow, 0.0, 1e-2, "between 0 and 600 L/min");
+  }
+}
+
+// Optional rated load against reach (docs/loads.md).
+void read_load_chart(Reader& r, const YAML::Node& root, LoadChart& chart) {
+  const YAML::Node node = root["load_chart"];
+  if (!node.IsDefined() || node.IsNull()) return;
+  if (!node.IsMap()) r.fail(node, "load_chart", "expected reach and rated_load");
+  r.check_keys(node, "load_chart", {"reach", "rated_load"});
+  chart.reach_m = r.values(node, "reach", "load_chart", Dimension::kLength, 0);
+  chart.rated_kg = r.values(node, "rated_load", "load_chart", Dimension::kMass, 0);
+  if (chart.reach_m.size() != chart.rated_kg.size()) {
+    r.fail(node["rated_load"], "load_chart.rated_load",
+           "needs one value per reach (" + std::to_string(chart.reach_m.size()) + "), got " +
+               std::to_string(chart.rated_kg.size()));
+  }
+  for (std::size_t k = 0; k < chart.reach_m.size(); ++k) {
+    if (!(chart.reach_m[k] > 0.0 && chart.reach_m[k] <= 100.0) ||
+        (k > 0 && !(chart.reach_m[k] > chart.reach_m[k - 1]))) {
+      r.fail(node["reach"], "load_chart.reach", "must be positive, increasing and at most 100 m");
+    }
+    if (!(chart.rated_kg[k] > 0.0 && chart.rated_kg[k] <= 1e5)) {
+      r.fail(node["rated_load"], "load_chart.rated_load",
+             "each must be positive and at most 100000 kg");
+    }
+  }
 }
 
 // `backend: sim | can` and the optional `can:` section; both may be left out (sim).
@@ -529,7 +580,7 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   if (!root.IsMap()) r.fail(root, "", "expected a mapping at the top level");
   r.check_keys(root, "",
                {"format", "name", "frames", "joints", "bodies", "payload", "hydraulics", "control",
-                "scaling", "redundancy", "simulation", "backend", "can"});
+                "scaling", "redundancy", "simulation", "backend", "can", "load_chart"});
   const std::string format = r.text(root, "format", "");
   if (format != kFormat) {
     r.fail(root["format"], "format",
@@ -600,7 +651,7 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   }
 
   const YAML::Node sim = r.child(root, "simulation", "");
-  r.check_keys(sim, "simulation", {"step", "initial"});
+  r.check_keys(sim, "simulation", {"step", "initial", "pressure_sensors", "return_pressure"});
   cfg.simulation.step_s =
       r.value_in(sim, "step", "simulation", Dimension::kTime, 1e-5, 1e-2, "between 0.01 and 10 ms");
   const double period = 1.0 / cfg.control.rate_hz;
@@ -628,12 +679,38 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
     if (!known)
       r.fail(kv.first, "simulation.initial." + kv.first.Scalar(), "no joint of that name");
   }
+  if (sim["pressure_sensors"].IsDefined() && !sim["pressure_sensors"].IsNull()) {
+    const YAML::Node ps = sim["pressure_sensors"];
+    const std::string pp = "simulation.pressure_sensors";
+    if (!ps.IsMap()) r.fail(ps, pp, "expected noise and resolution");
+    r.check_keys(ps, pp, {"noise", "resolution"});
+    cfg.simulation.pressure_noise_pa =
+        r.value_in(ps, "noise", pp, Dimension::kPressure, 0.0, 1e7, "between 0 and 100 bar");
+    cfg.simulation.pressure_resolution_pa =
+        r.value_in(ps, "resolution", pp, Dimension::kPressure, 0.0, 1e7, "between 0 and 100 bar");
+  }
+  if (sim["return_pressure"].IsDefined()) {
+    cfg.simulation.return_pressure_pa =
+        r.value_in(sim, "return_pressure", "simulation", Dimension::kPressure, 0.0,
+                   model.pump.max_pressure_pa, "between 0 and the pump's max_pressure");
+  }
+  read_load_chart(r, root, cfg.load_chart);
   read_backend(r, root, cfg.backend);
   cfg.unsourced_quantities = r.unsourced();
   return cfg;
 }
 
 }  // namespace
+
+double LoadChart::rated_kg_at(double reach) const {
+  if (reach_m.empty() || !std::isfinite(reach)) return 0.0;
+  if (reach <= reach_m.front()) return rated_kg.front();
+  if (reach >= reach_m.back()) return rated_kg.back() * reach_m.back() / reach;
+  std::size_t k = 1;
+  while (reach_m[k] < reach) ++k;
+  const double w = (reach - reach_m[k - 1]) / (reach_m[k] - reach_m[k - 1]);
+  return rated_kg[k - 1] + w * (rated_kg[k] - rated_kg[k - 1]);
+}
 
 const char* to_string(BackendKind kind) {
   return kind == BackendKind::kCan ? "can" : "sim";

@@ -50,6 +50,10 @@ constexpr UnitDef kUnits[] = {
     {"L", Dimension::kVolume, 1e-3},
     {"cm^3", Dimension::kVolume, 1e-6},
     {"1/m", Dimension::kInverseLength, 1.0},
+    {"N", Dimension::kForce, 1.0},
+    {"kN", Dimension::kForce, 1e3},
+    {"N*s/m", Dimension::kDamping, 1.0},
+    {"kN*s/m", Dimension::kDamping, 1e3},
 };
 
 std::string_view trim(std::string_view s) {
@@ -123,6 +127,10 @@ const char* to_string(Dimension d) {
       return "volume";
     case Dimension::kInverseLength:
       return "inverse length";
+    case Dimension::kForce:
+      return "force";
+    case Dimension::kDamping:
+      return "damping (force per speed)";
   }
   return "?";
 }

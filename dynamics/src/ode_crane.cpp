@@ -256,6 +256,24 @@ void OdeCrane::add_joint_efforts(const JointVector& tau) {
   }
 }
 
+void OdeCrane::set_payload_mass(double mass_kg) noexcept {
+  if (!(mass_kg >= 0.0)) return;
+  for (Body& b : model_.bodies) {
+    if (b.name != "payload") continue;
+    b.mass_kg = mass_kg;
+    const int i = b.frame;
+    const MergedMass merged = merge_bodies(model_, i);
+    com_local_[static_cast<size_t>(i)] = merged.com;
+    mass_[static_cast<size_t>(i)] = merged.mass;
+    dMass m;
+    dMassSetParameters(&m, merged.mass, 0.0, 0.0, 0.0, merged.inertia(0, 0), merged.inertia(1, 1),
+                       merged.inertia(2, 2), merged.inertia(0, 1), merged.inertia(0, 2),
+                       merged.inertia(1, 2));
+    dBodySetMass(bodies_[static_cast<size_t>(i)], &m);
+    return;
+  }
+}
+
 void OdeCrane::enable_end_stops(bool on) {
   constexpr double kPi = std::numbers::pi;
   for (int i = 1; i <= n_; ++i) {

@@ -66,8 +66,25 @@ struct RigidBodyTerms::Impl {
   Impl& operator=(const Impl&) = delete;
 };
 
+void RigidBodyTerms::set_payload_mass(double mass_kg) noexcept {
+  if (!(mass_kg >= 0.0) || mass_kg == payload_mass_kg_) return;
+  OdeCrane& crane = *impl_->crane;
+  crane.set_payload_mass(mass_kg);
+  payload_mass_kg_ = mass_kg;
+  for (int i = 1; i <= n_; ++i) {
+    dMass mass;
+    dBodyGetMass(crane.body(i), &mass);
+    for (int row = 0; row < 3; ++row) {
+      for (int col = 0; col < 3; ++col) inertia_body_[i](row, col) = mass.I[4 * row + col];
+    }
+  }
+}
+
 RigidBodyTerms::RigidBodyTerms(const CraneModel& model)
-    : impl_(std::make_unique<Impl>()), n_(model.dof()), gravity_m_s2_(model.gravity_m_s2) {
+    : impl_(std::make_unique<Impl>()),
+      n_(model.dof()),
+      gravity_m_s2_(model.gravity_m_s2),
+      payload_mass_kg_(payload_mass_kg(model)) {
   // impl_ is a member: should anything below throw, its destructor releases the world.
   dWorldID world = impl_->world;
   // The probe's own settings, independent of the simulator's: exact constraints (CFM = 0) and no

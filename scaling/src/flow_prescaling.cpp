@@ -28,6 +28,8 @@ const char* to_string(ActiveLimit limit) {
       return "singularity";
     case ActiveLimit::kPressure:
       return "pressure";
+    case ActiveLimit::kOverload:
+      return "overload";
     case ActiveLimit::kDynamicsFailed:
       return "dynamics_failed";
   }

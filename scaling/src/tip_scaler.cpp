@@ -115,6 +115,7 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
   if (ahead < cap.value) {
     cap = {ahead, in.near_singular ? ActiveLimit::kSingularity : ActiveLimit::kCylinderSpeed};
   }
+  if (in.overload_refused) cap = {0.0, ActiveLimit::kOverload};
   double target = stop ? 0.0 : std::clamp(cap.value, 0.0, request);
   // Braking trigger at a joint end: the end damping cap assumes braking from zero acceleration;
   // while the path still accelerates, braking must begin earlier.

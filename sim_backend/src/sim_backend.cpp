@@ -2,7 +2,10 @@
 
 #include <ode/ode.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <random>
 #include <stdexcept>
 #include <vector>
 
@@ -17,6 +20,41 @@ namespace {
 constexpr double kLoadPressureTimeConstantS = 0.005;  // stands in for oil compressibility
 constexpr double kWorldErp = 0.2;
 constexpr double kWorldCfm = 1e-10;
+// A body closer than this to the tip point travels with the load body (the grapple and rotator).
+constexpr double kAtTipM = 1e-3;
+constexpr double kMinLoadBodyKg = 1e-3;  // the load body of a crane with nothing at its tip
+// Cylinder speed over which the Coulomb friction builds up (tanh), m/s.
+constexpr double kFrictionSmoothingM_S = 1e-3;
+// The load-holding valve's hysteresis: it closes again when the load falls below this share of
+// its setting; a stalled section tries to move again below this share of the pump's force.
+constexpr double kReseatShare = 0.98;
+constexpr double kSaturatedShare = 0.999;    // a motor force at this share of its cap is saturated
+constexpr double kFlowThroughValve = 100.0;  // creeping: the oil column is stiff (x the setting)
+// How fast a creeping cylinder's speed changes, m/s^2.
+constexpr double kCreepAccelerationM_S2 = 0.05;
+
+// The crane's bodies without the load body's: the payload and every body at the tip point.
+dynamics::CraneModel without_tip_load(const dynamics::CraneModel& m) {
+  dynamics::CraneModel out = m;
+  out.bodies.clear();
+  for (const auto& b : m.bodies) {
+    const bool tip = b.frame == m.dof() && b.com_m.norm() < kAtTipM;
+    if (!(tip || b.name == "payload")) out.bodies.push_back(b);
+  }
+  return out;
+}
+
+// Mass and inertia (about the tip point) of the bodies at the tip other than the payload.
+void tip_bodies(const dynamics::CraneModel& m, double& mass_kg, Eigen::Vector3d& inertia) {
+  mass_kg = 0.0;
+  inertia.setZero();
+  for (const auto& b : m.bodies) {
+    if (b.frame == m.dof() && b.com_m.norm() < kAtTipM && b.name != "payload") {
+      mass_kg += b.mass_kg;
+      inertia += b.inertia_diag_kgm2;
+    }
+  }
+}
 
 }  // namespace
 
@@ -28,8 +66,10 @@ struct SimBackend::Impl {
     threading = dThreadingAllocateSelfThreadedImplementation();
     dWorldSetStepThreadingImplementation(world, dThreadingImplementationGetFunctions(threading),
                                          threading);
-    crane = std::make_unique<dynamics::OdeCrane>(model, world, s.q_initial);
+    crane = std::make_unique<dynamics::OdeCrane>(without_tip_load(model), world, s.q_initial);
     crane->enable_end_stops(true);
+    make_load_body(s.q_initial);
+    rng.seed(s.noise_seed);
     const int n = model.dof();
     feedback.resize(static_cast<std::size_t>(n) + 1);
     for (int i = 1; i <= n; ++i) {
@@ -45,6 +85,11 @@ struct SimBackend::Impl {
     q.setZero(n);
     qdot.setZero(n);
     pump_result.delivered_fraction.setZero(n);
+    force_filtered.setZero(n);
+    pressure_a.setZero(n);
+    pressure_b.setZero(n);
+    creep.fill(false);
+    stall.fill(false);
     load_alpha = 1.0 - std::exp(-s.step_s / kLoadPressureTimeConstantS);
     crane->read_state(q, qdot);
     // Start from the static holding loads so the first steps see the right pump pressure.
@@ -67,10 +112,44 @@ struct SimBackend::Impl {
     return w;
   }
 
+  // The grapple, rotator and payload as one body welded to the tip (a fixed joint), so that the
+  // payload can change while the crane moves.
+  void make_load_body(const JointVector& q0) {
+    tip_bodies(model, tip_mass_kg, tip_inertia);
+    dynamics::KinematicsData kin;
+    dynamics::forward_kinematics(model, kin, q0);
+    const Eigen::Isometry3d& tip = kin.frames[static_cast<std::size_t>(model.dof())];
+    load_body = dBodyCreate(world);
+    dMatrix3 r;
+    for (int row = 0; row < 3; ++row) {
+      for (int col = 0; col < 3; ++col) r[4 * row + col] = tip.linear()(row, col);
+      r[4 * row + 3] = 0.0;
+    }
+    dBodySetPosition(load_body, tip.translation().x(), tip.translation().y(),
+                     tip.translation().z());
+    dBodySetRotation(load_body, r);
+    payload_kg = dynamics::payload_mass_kg(model);
+    apply_load_mass();
+    load_joint = dJointCreateFixed(world, nullptr);
+    dJointAttach(load_joint, load_body, crane->body(model.dof()));
+    dJointSetFixed(load_joint);
+  }
+
+  void apply_load_mass() {
+    const double m = std::max(tip_mass_kg + payload_kg, kMinLoadBodyKg);
+    // A point payload adds no inertia of its own; a small floor keeps ODE's inverse defined.
+    const Eigen::Vector3d inertia = tip_inertia.cwiseMax(1e-3 * m);
+    dMass mass;
+    dMassSetParameters(&mass, m, 0.0, 0.0, 0.0, inertia.x(), inertia.y(), inertia.z(), 0.0, 0.0,
+                       0.0);
+    dBodySetMass(load_body, &mass);
+  }
+
   // Holds every joint for a few steps so feedback carries the static loads.
   void settle_loads() {
     for (int k = 0; k < 3; ++k) step_physics(true);
     load_pressure.setZero();
+    force_filtered.setZero();
     update_loads(1.0);
   }
 
@@ -110,6 +189,7 @@ struct SimBackend::Impl {
         if (q[i] >= joint.q_max - kAtStop) effort = std::max(effort, 0.0);
       }
       force[i] = effort / arm;
+      force_filtered[i] += alpha * (force[i] - force_filtered[i]);
       // Direction of the requested motion decides which chamber is pressurised; a closed
       // section reports the chamber that holds the load.
       const double dir = requested_velocity[i] != 0.0 ? requested_velocity[i] : force[i];
@@ -120,33 +200,95 @@ struct SimBackend::Impl {
 
   void step_physics(bool hold) {
     const int n = model.dof();
+    const double hold_relief_pa = dynamics::load_holding_relief_pa(model);
     for (int i = 0; i < n; ++i) {
       const auto& cyl = model.cylinders[static_cast<std::size_t>(i)];
       const double arm = dynamics::cylinder_arm(cyl, q[i]);
       const double v = hold ? 0.0 : requested_velocity[i] * pump_result.delivered_fraction[i];
-      // Relief pressure caps the force. A resistive load (force along the motion) is pushed by
-      // the pump on the pressurised chamber; an over-running load (force against the motion,
-      // e.g. a boom being lowered) and a held one are carried by the opposite chamber through
-      // its load-holding valve, set at relief too.
-      const bool resistive = v * force[i] > 0.0;
-      const double area = v > 0.0 ? (resistive ? cyl.area_a_m2 : cyl.area_b_m2)
-                                  : (v < 0.0 ? (resistive ? cyl.area_b_m2 : cyl.area_a_m2)
-                                             : std::max(cyl.area_a_m2, cyl.area_b_m2));
-      // The pump pushes at most at its pressure ceiling (relief; p_s for a constant-pressure
-      // pump); the load-holding valves hold up to relief.
-      const double p_cap = resistive ? supply_ceiling_pa : model.pump.max_pressure_pa;
-      const double f_max = p_cap * area * std::abs(arm);
-      const dJointID j = crane->joint(i + 1);
-      if (model.joints[static_cast<std::size_t>(i)].type == dynamics::JointType::kPrismatic) {
-        dJointSetSliderParam(j, dParamVel, v / arm);
-        dJointSetSliderParam(j, dParamFMax, f_max);
+      // The last step's cylinder force (positive pushing the cylinder out) says which chamber
+      // carries the load and how hard the load pushes: the load moves the cylinder the other way.
+      const double f = force[i];
+      const double hold_area = f >= 0.0 ? cyl.area_a_m2 : cyl.area_b_m2;
+      const double load_dir = f >= 0.0 ? -1.0 : 1.0;
+      // The load-holding valve carries up to its port relief setting; a load beyond it opens the
+      // valve, and the cylinder creeps in the load's direction at the valve's relief flow (or as
+      // fast as its section lowers it), never falls freely. Creeping, the oil column through the
+      // valve is stiff, so the force read is the load's.
+      const double f_hold = hold_relief_pa * hold_area;
+      creep[i] = !hold && std::abs(f) >= (creep[i] ? kReseatShare : kSaturatedShare) * f_hold;
+      double v_target = v;
+      double f_max = 0.0;
+      const double v_now = qdot[i] * arm;  // the cylinder's present speed
+      if (creep[i]) {
+        // The cylinder's speed moves towards the creep speed at a bounded rate: the oil column
+        // does not jump, and neither does the force read.
+        stall[i] = false;
+        const double v_creep = model.load_holding.relief_flow_m3_s / hold_area;
+        const double v_goal = load_dir * std::max(v * load_dir, v_creep);
+        const double dv = kCreepAccelerationM_S2 * settings.step_s;
+        v_target = std::clamp(v_goal, v_now - dv, v_now + dv);
+        f_max = kFlowThroughValve * f_hold;
+      } else if (v * f > 0.0) {
+        // A resistive load is pushed by the pump, at most at its pressure ceiling (relief; p_s for
+        // a constant-pressure pump). A load it cannot move (the pump at its ceiling, the cylinder
+        // not moving the commanded way) stalls the section: the load-holding valve (a check
+        // valve towards the pump) keeps it from going back.
+        const double f_push = supply_ceiling_pa * (v > 0.0 ? cyl.area_a_m2 : cyl.area_b_m2);
+        stall[i] = stall[i] ? std::abs(f) >= kReseatShare * f_push
+                            : std::abs(f) >= kSaturatedShare * f_push && v_now * v <= 0.0;
+        v_target = stall[i] ? 0.0 : v;
+        f_max = stall[i] ? f_hold : f_push;
       } else {
-        dJointSetHingeParam(j, dParamVel, v / arm);
+        // An over-running load (force against the motion, e.g. a boom being lowered) and a held
+        // one are carried by the chamber that holds the load, through its load-holding valve.
+        stall[i] = false;
+        f_max = f_hold;
+      }
+      f_max *= std::abs(arm);
+      const dJointID j = crane->joint(i + 1);
+      // Seal and guide friction against the cylinder's motion.
+      const auto& fr = cyl.friction;
+      const double vc = qdot[i] * arm;
+      const double fc = vc >= 0.0 ? fr.coulomb_extend_n : fr.coulomb_retract_n;
+      const double friction_effort =
+          -(fc * std::tanh(vc / kFrictionSmoothingM_S) + fr.viscous_n_s_m * vc) * arm;
+      if (model.joints[static_cast<std::size_t>(i)].type == dynamics::JointType::kPrismatic) {
+        dJointSetSliderParam(j, dParamVel, v_target / arm);
+        dJointSetSliderParam(j, dParamFMax, f_max);
+        if (friction_effort != 0.0) dJointAddSliderForce(j, friction_effort);
+      } else {
+        dJointSetHingeParam(j, dParamVel, v_target / arm);
         dJointSetHingeParam(j, dParamFMax, f_max);
+        if (friction_effort != 0.0) dJointAddHingeTorque(j, friction_effort);
       }
     }
     dWorldStep(world, settings.step_s);
     crane->read_state(q, qdot);
+  }
+
+  // Both chambers from the (filtered) cylinder force: the one that returns to tank at the return
+  // pressure, the other carrying the force; then the sensors' noise and resolution.
+  void measure_chambers() {
+    const double p_ret = settings.return_pressure_pa;
+    for (int i = 0; i < model.dof(); ++i) {
+      const auto& cyl = model.cylinders[static_cast<std::size_t>(i)];
+      const double f = force_filtered[i];
+      double pa = p_ret, pb = p_ret;
+      if (f >= 0.0) {
+        pa = (f + p_ret * cyl.area_b_m2) / cyl.area_a_m2;
+      } else {
+        pb = (p_ret * cyl.area_a_m2 - f) / cyl.area_b_m2;
+      }
+      pressure_a[i] = sensor(pa);
+      pressure_b[i] = sensor(pb);
+    }
+  }
+
+  double sensor(double p) {
+    if (settings.pressure_noise_pa > 0.0) p += settings.pressure_noise_pa * normal(rng);
+    const double res = settings.pressure_resolution_pa;
+    if (res > 0.0) p = res * std::round(p / res);
+    return std::max(p, 0.0);
   }
 
   void step() {
@@ -173,6 +315,15 @@ struct SimBackend::Impl {
   std::vector<dJointFeedback> feedback;
   std::vector<ValveSection> sections;
   JointVector spool_command, requested_velocity, demand, load_pressure, force, q, qdot;
+  JointVector force_filtered, pressure_a, pressure_b;
+  std::array<bool, dynamics::kMaxJoints> creep{}, stall{};
+  dBodyID load_body = nullptr;
+  dJointID load_joint = nullptr;
+  double tip_mass_kg = 0.0;
+  Eigen::Vector3d tip_inertia = Eigen::Vector3d::Zero();
+  double payload_kg = 0.0;
+  std::mt19937 rng{1};
+  std::normal_distribution<double> normal{0.0, 1.0};
   bool active = true;  // inactive: the spools are commanded neutral
   PumpResult pump_result;
   double load_alpha = 1.0;
@@ -198,11 +349,16 @@ SimBackend::SimBackend(const dynamics::CraneModel& model, const SimSettings& set
 SimBackend::~SimBackend() = default;
 
 valves::BackendStatus SimBackend::read(valves::MachineState& state) {
-  const Impl& s = *impl_;
+  Impl& s = *impl_;
   state.t_s = s.t_s;
   state.q = s.q;
   state.qdot = s.qdot;
   state.load_pressure_pa = s.load_pressure;
+  impl_->measure_chambers();
+  state.pressure_a_pa = s.pressure_a;
+  state.pressure_b_pa = s.pressure_b;
+  state.chamber_pressures = true;
+  state.payload_truth_kg = s.payload_kg;
   state.pump.flow_m3_s = s.pump_result.flow_m3_s;
   state.pump.pressure_pa = s.pump_result.supply_pressure_pa;
   state.pump.power_w = s.pump_result.power_w;
@@ -214,6 +370,7 @@ valves::BackendStatus SimBackend::read(valves::MachineState& state) {
 
 valves::BackendStatus SimBackend::write(const valves::ValveCommand& command) {
   if (command.spool.size() != impl_->model.dof()) return valves::BackendStatus::kFault;
+  if (std::isfinite(command.simulated_load_kg)) set_payload_mass(command.simulated_load_kg);
   if (!impl_->active) return valves::BackendStatus::kOk;  // held neutral until activate()
   impl_->spool_command = command.spool;
   return valves::BackendStatus::kOk;
@@ -240,6 +397,24 @@ void SimBackend::set_pump_flow_limit(double flow_m3_s) noexcept {
 
 double SimBackend::pump_flow_limit() const noexcept {
   return impl_->pump.flow_limit();
+}
+
+void SimBackend::set_payload_mass(double mass_kg) noexcept {
+  if (!(mass_kg >= 0.0 && mass_kg <= 1e5) || mass_kg == impl_->payload_kg) return;
+  impl_->payload_kg = mass_kg;
+  impl_->apply_load_mass();
+}
+
+double SimBackend::payload_mass() const noexcept {
+  return impl_->payload_kg;
+}
+
+bool SimBackend::relief_passing(int joint) const noexcept {
+  return joint >= 0 && joint < impl_->model.dof() && impl_->creep[static_cast<std::size_t>(joint)];
+}
+
+bool SimBackend::stalled(int joint) const noexcept {
+  return joint >= 0 && joint < impl_->model.dof() && impl_->stall[static_cast<std::size_t>(joint)];
 }
 
 double SimBackend::time_s() const {

@@ -6,6 +6,20 @@
 #include "craneassist/dynamics/cylinders.hpp"
 
 namespace craneassist::control {
+namespace {
+
+// The rated capacity limiter's thresholds on the load-moment ratio (docs/loads.md).
+constexpr double kOverloadWarning = 0.9;
+constexpr double kOverloadTrip = 1.0;
+constexpr double kOverloadRelease = 0.95;
+// Overloaded, a motion whose radial share (d reach / d path) is above this raises the moment.
+constexpr double kOutwardShare = 0.02;
+// The dynamics' payload follows the scale in steps of this (kg).
+constexpr double kPayloadModelStepKg = 0.5;
+// A chamber at this share of the load-holding valves' setting is at their port relief.
+constexpr double kReliefShare = 0.99;
+
+}  // namespace
 
 const char* to_string(ScalingMode mode) {
   switch (mode) {
@@ -81,8 +95,19 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
   dc_dq_.setZero(n);
   qddot_max_.setZero(n);
   polytope_arms_.setZero(n);
+  chart_ = config.load_chart;
+  known_payload_kg_ = dynamics::payload_mass_kg(model_);
+  dynamics::PayloadEstimatorSettings scale;
+  scale.period_s = period_s_;
+  estimator_ = std::make_unique<dynamics::PayloadEstimator>(model_, scale);
   if (options_.mode == ScalingMode::kFull) {
     terms_ = std::make_unique<dynamics::RigidBodyTerms>(model_);
+    // Unannounced: until the scale has weighed the load, the rated load at the start pose.
+    if (!options_.payload_known) {
+      const Eigen::Vector3d tip = dynamics::tip_position(model_, kin_, q_ref_);
+      const double reach = std::hypot(tip.x(), tip.z());
+      terms_->set_payload_mass(chart_.empty() ? known_payload_kg_ : chart_.rated_kg_at(reach));
+    }
     tip_path_ = std::make_unique<scaling::TipPath>(model_, tip_path_config(config));
     scaler_ = std::make_unique<scaling::TipScaler>(model_, tip_scaler_config(config), *terms_);
   }
@@ -104,6 +129,50 @@ void Controller::reset(const valves::MachineState& state) {
   if (scaler_) scaler_->reset();
 }
 
+void Controller::update_load(const valves::MachineState& state, ControllerOutput& out) noexcept {
+  LoadOutput& load = out.load;
+  const int n = model_.dof();
+  const bool state_ok =
+      state.valid && state.q.size() == n && state.q.allFinite() && state.qdot.allFinite();
+  const auto& est = estimator_->update(state_ok, state.q, state.qdot, state.chamber_pressures,
+                                       state.pressure_a_pa, state.pressure_b_pa);
+  if (state_ok) {
+    const Eigen::Vector3d tip = dynamics::tip_position(model_, kin_, state.q);
+    load.reach_m = std::hypot(tip.x(), tip.z());
+  }
+  load.rated_kg = chart_.empty() ? 0.0 : chart_.rated_kg_at(load.reach_m);
+  if (options_.payload_known) {
+    load.estimate_kg = known_payload_kg_;
+    load.sigma_kg = 0.0;
+    load.converged = true;
+    load.model_kg = known_payload_kg_;
+  } else {
+    load.estimate_kg = est.mass_kg;
+    load.sigma_kg = est.sigma_kg;
+    load.converged = est.converged;
+    load.model_kg = chart_.empty() ? est.mass_kg : est.conservative_kg(load.rated_kg);
+  }
+  if (terms_ && std::abs(load.model_kg - terms_->payload_mass()) > kPayloadModelStepKg) {
+    terms_->set_payload_mass(load.model_kg);
+  }
+  // The rated capacity limiter, on the scale's estimate.
+  load.moment_ratio = load.rated_kg > 0.0 ? load.estimate_kg / load.rated_kg : 0.0;
+  if (load.moment_ratio >= kOverloadTrip) overload_ = true;
+  if (load.moment_ratio < kOverloadRelease) overload_ = false;
+  load.overload = overload_;
+  load.warning = load.moment_ratio >= kOverloadWarning;
+  load.relief = false;
+  if (state_ok && state.chamber_pressures && state.pressure_a_pa.size() == n &&
+      state.pressure_b_pa.size() == n) {
+    const double relief = kReliefShare * dynamics::load_holding_relief_pa(model_);
+    for (int i = 0; i < n; ++i) {
+      load.relief =
+          load.relief || state.pressure_a_pa[i] >= relief || state.pressure_b_pa[i] >= relief;
+    }
+  }
+  load.refused = false;
+}
+
 ControllerStatus Controller::update(const valves::MachineState& state, const Eigen::Vector3d& v_cmd,
                                     ControllerOutput& out) noexcept {
   const int n = model_.dof();
@@ -116,6 +185,7 @@ ControllerStatus Controller::update(const valves::MachineState& state, const Eig
   // reference starts again from where it is measured (no P-feedback jump towards the old one).
   if (neutral_ && !stale) reset(state);
 
+  update_load(state, out);
   const JointVector q_resolved = q_ref_;  // the cycle resolves here, then integrates q_ref_
   if (options_.mode == ScalingMode::kFull) {
     update_full(state, command_ok ? v_cmd : Eigen::Vector3d::Zero(), stale, out);
@@ -203,6 +273,15 @@ void Controller::update_full(const valves::MachineState& state, const Eigen::Vec
   tip_path_->update(q_ref_, path_in, tip_out_);
   scaling::TipScalerInput in = tip_scaler_input(v_cmd, u, tip_out_, stale);
   in.tracking_factor = scaling::tracking_factor(tip_error_filtered_m_, tracking_error_ok_m_);
+  // Overloaded, a motion that takes the load further out (raises the load moment) slows to rest;
+  // one that brings it in, or keeps its reach, stays free.
+  if (out.load.overload) {
+    const Eigen::Vector3d tip = dynamics::tip_position(model_, kin_, q_ref_);
+    const double reach = std::hypot(tip.x(), tip.z());
+    const double outwards = reach > 0.0 ? (tip.x() * u.x() + tip.z() * u.z()) / reach : 0.0;
+    in.overload_refused = outwards > kOutwardShare && v_cmd.norm() > 0.0;
+    out.load.refused = in.overload_refused;
+  }
   scaler_->update(q_ref_, tip_out_.geometry, in, scaler_out_);
 
   // The reference moves along u by the tip displacement of this cycle.

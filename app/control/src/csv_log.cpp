@@ -1,6 +1,7 @@
 #include "craneassist/control/csv_log.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 namespace craneassist::control {
@@ -16,6 +17,7 @@ std::string CsvLog::header(int dof, bool base) {
   h += ",avail_speed_m_s,avail_speed_resolved_m_s,polytope_volume_m3s3";
   for (int i = 1; i <= dof; ++i) h += ",spool" + std::to_string(i);
   for (int i = 1; i <= dof; ++i) h += ",p_load" + std::to_string(i) + "_pa";
+  h += ",load_kg,payload_estimate_kg,load_moment_ratio";
   if (base) {
     h += ",base_x,base_y,base_phi,base_v,base_omega,base_v_cmd,base_omega_cmd,base_flow_fl_m3s,"
          "base_flow_fr_m3s,base_flow_rl_m3s,base_flow_rr_m3s,base_flow_sum_m3s,base_flow_max_m3s";
@@ -66,6 +68,13 @@ void CsvLog::write_row(const LogRow& r) {
   for (int i = 0; i < dof_; ++i) {
     std::fprintf(file_, ",%.6g", r.load_pressure[static_cast<std::size_t>(i)]);
   }
+  // The simulator's truth is empty on a machine (NaN).
+  if (std::isfinite(r.load_kg)) {
+    std::fprintf(file_, ",%.6g", r.load_kg);
+  } else {
+    std::fputc(',', file_);
+  }
+  std::fprintf(file_, ",%.6g,%.6g", r.payload_estimate_kg, r.load_moment_ratio);
   if (base_) {
     std::fprintf(file_, ",%.6f,%.6f,%.7f,%.6g,%.6g,%.6g,%.6g", r.base_pose[0], r.base_pose[1],
                  r.base_pose[2], r.base_velocity[0], r.base_velocity[1], r.base_command[0],

@@ -118,6 +118,7 @@ LiveSummary run_live(const config::CraneConfig& config, input::CommandSource& so
   const RunSummary stats = statistics.summary(ran);
   LiveSummary summary;
   summary.cycles = ran.cycles;
+  summary.load = stats.load;
   summary.duration_s = ran.duration_s;
   summary.wall_time_s = ran.wall_time_s;
   summary.max_late_s = ran.max_late_s();

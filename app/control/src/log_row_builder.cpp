@@ -61,6 +61,9 @@ void LogRowBuilder::fill(LogRow& row, double t, const Eigen::Vector3d& cmd,
   row.tip_error_m = out.tip_error_m;
   row.ref_power_w = out.ref_power_w;
   row.flow_demand_m3s = out.flow_demand_m3_s;
+  row.load_kg = state.payload_truth_kg;
+  row.payload_estimate_kg = out.load.estimate_kg;
+  row.load_moment_ratio = out.load.moment_ratio;
   row.avail_speed_m_s = out.avail_speed_m_s;
   row.avail_speed_resolved_m_s = out.avail_speed_resolved_m_s;
   row.polytope_volume_m3s3 = out.polytope_volume_m3_s3;

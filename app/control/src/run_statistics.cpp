@@ -55,6 +55,7 @@ void RunStatistics::on_cycle(const CycleRecord& c) noexcept {
   const ControllerOutput* out = c.controller;
   if (out == nullptr) return;
   s_.peak_path_jerk = std::max(s_.peak_path_jerk, std::abs(out->sdddot));
+  add_load(t, speed, c.state, *out);
   ++s_.limit_cycles[static_cast<std::size_t>(out->limit)];
   if (!(cmd == last_cmd_ || (input_stop && !last_cmd_.allFinite()))) {
     last_cmd_ = cmd;
@@ -83,6 +84,43 @@ void RunStatistics::on_cycle(const CycleRecord& c) noexcept {
   if (moving_cmd && out->ref_tip_velocity_m_s.norm() > 1e-9) {
     s_.max_reference_direction_error_deg =
         std::max(s_.max_reference_direction_error_deg, angle_deg(cmd, out->ref_tip_velocity_m_s));
+  }
+}
+
+void RunStatistics::add_load(double t, double tip_speed, const valves::MachineState& state,
+                             const ControllerOutput& out) noexcept {
+  constexpr double kSettledAfterS = 1.0;
+  constexpr double kRestSpeed = 0.01, kMovingSpeed = 0.05;
+  LoadSummary& l = s_.load;
+  const LoadOutput& est = out.load;
+  const bool truth = std::isfinite(state.payload_truth_kg);
+  if (truth) {
+    if (!l.truth_known || state.payload_truth_kg != l.truth_kg) {
+      if (l.truth_known) ++l.truth_changes;
+      truth_since_s_ = t;
+    }
+    l.truth_known = true;
+    l.truth_kg = state.payload_truth_kg;
+  }
+  l.estimate_kg = est.estimate_kg;
+  l.sigma_kg = est.sigma_kg;
+  l.converged = est.converged;
+  l.peak_moment_ratio = std::max(l.peak_moment_ratio, est.moment_ratio);
+  l.warning_cycles += est.warning;
+  l.overload_cycles += est.overload;
+  l.refused_cycles += est.refused;
+  l.relief_cycles += est.relief;
+  if (truth && est.converged && t - truth_since_s_ >= kSettledAfterS && state.valid) {
+    const double err = std::abs(est.estimate_kg - state.payload_truth_kg);
+    if (tip_speed < kRestSpeed) {
+      l.max_error_rest_kg = std::max(l.max_error_rest_kg, err);
+      l.sum_sq_error_rest += err * err;
+      ++l.rest_samples;
+    } else if (tip_speed > kMovingSpeed) {
+      l.max_error_moving_kg = std::max(l.max_error_moving_kg, err);
+      l.sum_sq_error_moving += err * err;
+      ++l.moving_samples;
+    }
   }
 }
 

@@ -16,6 +16,7 @@ void ReplayInput::next(const CycleTime& time, const Eigen::Vector3d&, TipCommand
   out.reason = finite ? "" : "replay stop row";
   out.deadman = finite;
   out.drive.setZero();
+  out.simulated_load_kg = cursor_.load_at(time.t_s);
 }
 
 void MonitoredInput::next(const CycleTime& time, const Eigen::Vector3d& tip_m,
@@ -55,6 +56,7 @@ CycleStatus TipCommandTask::step(const CycleTime& time, const valves::MachineSta
   }
   command.drive_v_m_s = drive_.v_m_s;
   command.drive_omega_rad_s = drive_.omega_rad_s;
+  command.simulated_load_kg = command_.simulated_load_kg;
 
   builder_.fill(row, time.t_s, v, out_, state);
   row.status = status_word(status);

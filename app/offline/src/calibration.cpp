@@ -10,6 +10,7 @@
 #include "craneassist/control/control_loop.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/valve_table.hpp"
+#include "craneassist/offline/sim_setup.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
 #include "craneassist/valves/proportional_valves.hpp"
 
@@ -392,7 +393,7 @@ SectionCalibration calibrate_section(const config::CraneConfig& config, int sect
   const auto& model = config.model;
   check_section(model, section);
   const double period = 1.0 / config.control.rate_hz;
-  sim_backend::SimSettings settings{config.simulation.step_s, config.simulation.q_initial};
+  sim_backend::SimSettings settings = sim_settings(config);
   settings.q_initial[section] = mid_stroke_q(model, section);
 
   std::vector<SweepPoint> points;

@@ -111,7 +111,7 @@ Suite parse_suite(std::string_view yaml_text, std::string_view source_name,
     for (std::size_t k = 0; k < runs.size(); ++k) {
       const YAML::Node node = runs[k];
       const std::string path = "runs[" + std::to_string(k) + "]";
-      r.check_keys(node, path, {"replay", "poses", "payload", "targets"});
+      r.check_keys(node, path, {"replay", "poses", "payload", "payload_known", "targets"});
       SuiteRun run;
       run.line = node.Mark().line + 1;
       run.replay_text = r.text(node, "replay", path);
@@ -128,6 +128,14 @@ Suite parse_suite(std::string_view yaml_text, std::string_view source_name,
       }
       if (node["payload"].IsDefined()) {
         run.payload_kg = r.quantity(node, "payload", path, config::Dimension::kMass, 0.0, 1e5);
+      }
+      if (node["payload_known"].IsDefined()) {
+        const std::string known = r.text(node, "payload_known", path);
+        if (known != "true" && known != "false") {
+          r.fail(node["payload_known"], path + ".payload_known",
+                 "expected true or false, got '" + known + "'");
+        }
+        run.payload_known = known == "true";
       }
       run.targets = defaults;
       if (node["targets"].IsDefined()) {
@@ -196,6 +204,7 @@ SuiteOutcome run_suite_run(const config::CraneConfig& base, const SuiteRun& run,
   std::optional<control::CsvLog> log;
   if (!log_file.empty()) log.emplace(log_file, cfg.model.dof());
   control::RunOptions options;
+  options.controller.payload_known = run.payload_known;
   SuiteOutcome out;
   out.summary = control::run_replay(cfg, replay, machine, options, log ? &*log : nullptr);
   out.p_max_w = cfg.model.pump.prime_mover_power_w;

@@ -49,6 +49,23 @@ struct RedundancySettings {
 struct SimulationSettings {
   double step_s = 1e-3;
   dynamics::JointVector q_initial;
+  // The simulated machine's chamber pressure sensors (docs/loads.md): white noise of this
+  // standard deviation, then rounded to the resolution. Zero: exact.
+  double pressure_noise_pa = 0.0;
+  double pressure_resolution_pa = 0.0;
+  // Pressure in the chamber that returns to tank.
+  double return_pressure_pa = 0.0;
+};
+
+// Rated load against reach, the horizontal distance from the slew axis to the tip (EN 12999's
+// load chart; docs/loads.md). Empty: no rated capacity limiter.
+struct LoadChart {
+  std::vector<double> reach_m;   // increasing
+  std::vector<double> rated_kg;  // one per reach
+  bool empty() const { return reach_m.empty(); }
+  // Linear between the points; inside the first point the first value; beyond the last the last
+  // point's load moment (rated * reach) held. No allocation.
+  double rated_kg_at(double reach) const;
 };
 
 // Which machine the loop drives (`backend: sim | can`) and, for can, where it is.
@@ -79,6 +96,7 @@ struct CraneConfig {
   RedundancySettings redundancy;
   SimulationSettings simulation;
   BackendSettings backend;  // optional in the file: sim
+  LoadChart load_chart;     // optional in the file
   std::string source_name;  // file the config came from, or "<embedded k70m.yaml>"
   // Number of quantities in the file that do not state where they come from.
   int unsourced_quantities = 0;

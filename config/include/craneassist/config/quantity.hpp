@@ -30,6 +30,8 @@ enum class Dimension {
   kAngularVelocity,
   kVolume,         // a displacement per revolution (hub motors)
   kInverseLength,  // a gain per metre (path-following gains)
+  kForce,          // cylinder friction
+  kDamping,        // viscous friction, force per speed
 };
 
 const char* to_string(Dimension dimension);

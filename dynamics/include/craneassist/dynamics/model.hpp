@@ -57,6 +57,19 @@ enum class LinkageType {
   kPolynomial,   // c = sum coeffs[k] q^(N-k), highest power first (tilt four-bar fit)
 };
 
+// Friction of a cylinder's seals and guides (docs/loads.md): a Coulomb force against the motion,
+// of its own size each way, and a viscous force growing with the speed. The simulator applies it
+// (docs/simulator.md); the payload estimator subtracts it from the pressure force while a cylinder
+// moves. Zero: none.
+struct CylinderFriction {
+  double coulomb_extend_n = 0.0;   // while extending
+  double coulomb_retract_n = 0.0;  // while retracting
+  double viscous_n_s_m = 0.0;      // per m/s of cylinder speed
+  bool any() const {
+    return coulomb_extend_n > 0.0 || coulomb_retract_n > 0.0 || viscous_n_s_m > 0.0;
+  }
+};
+
 struct Cylinder {
   std::string name;
   LinkageType linkage = LinkageType::kConstantArm;
@@ -71,6 +84,7 @@ struct Cylinder {
   double stroke_m = 0.0;
   double v_max_m_s = 0.0;
   double a_max_m_s2 = 0.0;
+  CylinderFriction friction;
 };
 
 // How the variable pump sets its supply pressure (paper 000 section 2.1, fig. 3).
@@ -142,6 +156,15 @@ struct ValveTable {
   bool empty() const { return command.empty(); }
 };
 
+// The load-holding (counterbalance) valves on the cylinders that carry a load (docs/loads.md): a
+// cylinder whose load the pump cannot move is held; a load pressure above the valve's port relief
+// setting opens it, and the cylinder creeps in the load's direction at the valve's relief flow,
+// never faster (the section's own lowering excepted). relief_pa 0: the pump's relief.
+struct LoadHolding {
+  double relief_pa = 0.0;
+  double relief_flow_m3_s = 0.0;
+};
+
 struct ValveSections {
   double dead_zone = 0.0;  // fraction of the spool (current) range with no flow
   double time_constant_s = 0.0;
@@ -192,12 +215,26 @@ struct CraneModel {
   Eigen::Matrix3d task_from_base = Eigen::Matrix3d::Identity();
   Pump pump;
   ValveSections valves;
+  LoadHolding load_holding;
   // An MHSB circuit (hydraulics.mhsb); absent: valve sections on a load-sensing or
   // constant-pressure pump.
   std::optional<Mhsb> mhsb;
 
   int dof() const { return static_cast<int>(joints.size()); }
 };
+
+// The load-holding valves' port relief setting (the pump's relief when the model gives none).
+inline double load_holding_relief_pa(const CraneModel& m) {
+  return m.load_holding.relief_pa > 0.0 ? m.load_holding.relief_pa : m.pump.max_pressure_pa;
+}
+
+// The payload body's mass (the body named "payload"; 0 when the model has none).
+inline double payload_mass_kg(const CraneModel& m) {
+  for (const Body& b : m.bodies) {
+    if (b.name == "payload") return b.mass_kg;
+  }
+  return 0.0;
+}
 
 // Effective area the pump must fill for cylinder velocity v (algorithms.md section 2).
 inline double flow_area_m2(const Cylinder& c, double v_m_s) {

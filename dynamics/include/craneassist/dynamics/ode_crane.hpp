@@ -76,6 +76,13 @@ class OdeCrane {
   // the accumulators after each step. No allocation.
   void add_joint_efforts(const JointVector& tau);
 
+  // Sets the mass of the model's body named "payload" (kg, >= 0; no such body: nothing happens)
+  // and re-merges the bodies of its frame: the body's mass and inertia, its centre of mass. The
+  // body keeps its position, so this is for a crane that set_state() places before each use (the
+  // dynamics probe), not for one being stepped (the simulator carries its load on a body of its
+  // own). No allocation.
+  void set_payload_mass(double mass_kg) noexcept;
+
   // End stops at model.joints[i].q_min / q_max (joints with q_max <= q_min get none). ODE's hinge
   // stops must lie inside [-pi, pi] relative to the creation pose and its angle wraps at +-pi, so
   // a revolute range of (nearly) a full turn is shrunk to +-(pi - kHingeStopMargin) around the

@@ -102,6 +102,11 @@ class RigidBodyTerms {
 
   int dof() const { return n_; }
 
+  // The payload mass the probe uses from now on (the model's body named "payload"; the crane
+  // scale's estimate in the control loop). Cycle-safe: no allocation, no exception.
+  void set_payload_mass(double mass_kg) noexcept;
+  double payload_mass() const noexcept { return payload_mass_kg_; }
+
   // Test hook, nothing else sets it: while on, every probe step fails as dWorldStep does when
   // ODE runs out of memory (the step is not taken), so tests can reach the failure paths that a
   // real machine reaches only on memory exhaustion. Off by default.
@@ -155,6 +160,7 @@ class RigidBodyTerms {
   int n_ = 0;
   Eigen::Vector3d gravity_m_s2_;
   bool fail_steps_for_testing_ = false;
+  double payload_mass_kg_ = 0.0;
 
   // Preallocated work space (bounded-size Eigen types live inline: no heap).
   JointVector zero_, effort_, qddot_, q_work_, hdot_qdot_, d_qdot_;

@@ -16,8 +16,9 @@ enum class ActiveLimit {
   kSingularity,           // a near-singular pose: the direction needs very fast joints
   kPressure,              // a load pressure at the pump's ceiling (relief; p_s with a CP pump)
   kDynamicsFailed,        // the ODE dynamics step failed (out of memory): stopping without it
+  kOverload,              // the rated capacity limiter: the motion would raise the load moment
 };
-inline constexpr int kActiveLimitCount = static_cast<int>(ActiveLimit::kDynamicsFailed) + 1;
+inline constexpr int kActiveLimitCount = static_cast<int>(ActiveLimit::kOverload) + 1;
 
 const char* to_string(ActiveLimit limit);
 

@@ -66,6 +66,10 @@ struct TipScalerInput {
   double stop_jerk_m_s3 = 1.0;
   bool near_singular = false;
   bool stale_input = false;
+  // The rated capacity limiter refuses motion along u (it would raise the load moment of an
+  // overloaded crane): the target is rest, reached within the jerk and deceleration bounds
+  // (limit kOverload).
+  bool overload_refused = false;
 };
 
 struct TipScalerOutput {

@@ -12,6 +12,11 @@
 //   4. the joint stops are the cylinder end stops;
 //   5. the motor reaction gives the cylinder force and, through a 5 ms first-order filter standing
 //      in for oil compressibility, the load pressures for the next step.
+// What the controller's model lacks (docs/loads.md): the load hangs on a body of its own, welded
+// to the tip, whose mass may change during a run (set_payload_mass: a log grabbed or lost);
+// load-holding valves hold a load the pump cannot move and let one beyond their port relief
+// creep at the valve's relief flow, never fall; cylinder friction (Coulomb each way, viscous);
+// both chambers' pressures measured with sensor noise and resolution.
 // Pump flow, pressure, power and integrated energy are measured on the way.
 #pragma once
 
@@ -27,6 +32,12 @@ using dynamics::JointVector;
 struct SimSettings {
   double step_s = 1e-3;
   JointVector q_initial;
+  // Chamber pressure sensors: white noise of this standard deviation, then rounded to the
+  // resolution (0: exact); the seed makes a run repeatable.
+  double pressure_noise_pa = 0.0;
+  double pressure_resolution_pa = 0.0;
+  unsigned noise_seed = 1;
+  double return_pressure_pa = 0.0;  // in the chamber that returns to tank
 };
 
 class SimBackend final : public valves::MachineInterface {
@@ -51,6 +62,16 @@ class SimBackend final : public valves::MachineInterface {
   // a wheeled base's hub motors, docs/mobile.md). No allocation.
   void set_pump_flow_limit(double flow_m3_s) noexcept;
   double pump_flow_limit() const noexcept;
+
+  // The mass in the grapple from the next step on (kg, 0 to 100000; anything else is ignored):
+  // a log grabbed, released or slipping out. The controller is not told. No allocation.
+  void set_payload_mass(double mass_kg) noexcept;
+  double payload_mass() const noexcept;
+  // Whether a cylinder's load passed its load-holding valve's port relief in the last step (it
+  // creeps at the valve's relief flow), and whether the pump could not move its load (stalled,
+  // held by the valve).
+  bool relief_passing(int joint) const noexcept;
+  bool stalled(int joint) const noexcept;
 
   double time_s() const;
   // Cylinder forces of the last step (N, positive pushing the cylinder out).

@@ -3,6 +3,7 @@
 // measured state, write valve commands. No caller asks which backend it drives.
 #pragma once
 
+#include <limits>
 #include <string>
 
 #include "craneassist/dynamics/model.hpp"
@@ -42,6 +43,13 @@ struct MachineState {
   JointVector q;                 // joint positions, rad or m
   JointVector qdot;              // joint rates
   JointVector load_pressure_pa;  // per cylinder; positive: resistive load (paper 004 sign)
+  // Each cylinder's piston-side (A) and rod-side (B) chamber pressures, where the machine
+  // measures both (chamber_pressures true); the crane scale weighs the load from them
+  // (dynamics::PayloadEstimator).
+  JointVector pressure_a_pa, pressure_b_pa;
+  bool chamber_pressures = false;
+  // The simulator's truth: the mass in the grapple (NaN on a machine, which does not know it).
+  double payload_truth_kg = std::numeric_limits<double>::quiet_NaN();
   PumpMeasurement pump;
   BaseMeasurement base;
   bool valid = false;
@@ -55,6 +63,9 @@ struct ValveCommand {
   // (sim --base); ignored by a crane on a fixed base. Zero: stand still.
   double drive_v_m_s = 0.0;
   double drive_omega_rad_s = 0.0;
+  // The load a replay puts in a simulated crane's grapple from this cycle on (its load_kg column;
+  // docs/replay-format.md); NaN: unchanged. A real machine ignores it.
+  double simulated_load_kg = std::numeric_limits<double>::quiet_NaN();
 };
 
 enum class BackendStatus { kOk, kNoData, kFault };

@@ -30,6 +30,7 @@
 #include "craneassist/dynamics/enum_names.hpp"
 #include "craneassist/dynamics/flow_polytope.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
+#include "craneassist/dynamics/payload_estimator.hpp"
 #include "craneassist/dynamics/redundancy.hpp"
 #include "craneassist/dynamics/rigid_body_terms.hpp"
 #include "craneassist/scaling/active_limit.hpp"
@@ -59,6 +60,25 @@ struct ControllerOptions {
   ScalingMode mode = ScalingMode::kFull;
   // How often a command reaches the valves (MachineInterface::command_period_s; 0: every cycle).
   double valve_command_period_s = 0.0;
+  // true: the config's payload is the load in the grapple (the papers' comparisons, replay
+  // --payload-known); false: nobody says, the crane scale finds it out (docs/loads.md).
+  bool payload_known = false;
+};
+
+// The load in the grapple as the controller sees it (docs/loads.md).
+struct LoadOutput {
+  double estimate_kg = 0.0;   // the crane scale (the config's payload when it is known)
+  double sigma_kg = 0.0;      // its standard error (0 when known)
+  bool converged = false;     // true when known
+  double model_kg = 0.0;      // what the dynamics use: the estimate, or the rated load before it
+                              // has converged (never less)
+  double reach_m = 0.0;       // measured tip's horizontal distance from the slew axis
+  double rated_kg = 0.0;      // the load chart's rated load at that reach (0: no chart)
+  double moment_ratio = 0.0;  // estimate / rated: the load moment against the chart (0: no chart)
+  bool warning = false;       // moment_ratio at or above 90 %
+  bool overload = false;      // the limiter has tripped (100 %; released below 95 %)
+  bool refused = false;       // this cycle's motion would raise the load moment: slowed to rest
+  bool relief = false;        // a chamber at the load-holding valves' port relief: it creeps
 };
 
 struct ControllerOutput {
@@ -94,6 +114,7 @@ struct ControllerOutput {
   int polytope_dim = 0;
   double polytope_volume_m3_s3 = 0.0;
   double polytope_area_m2_s2 = 0.0;
+  LoadOutput load;
 };
 
 // The controller's status is the cycle status of the loop (control_loop.hpp).
@@ -130,6 +151,7 @@ class Controller {
   // The ODE dynamics probe of kFull (nullptr in the other modes). For tests: its
   // fail_steps_for_testing() hook makes the cycle's dynamics step fail.
   dynamics::RigidBodyTerms* dynamics_for_testing() noexcept { return terms_.get(); }
+  const dynamics::PayloadEstimator& payload_estimator() const noexcept { return *estimator_; }
   // How often a command reaches the valves (ControllerOptions::valve_command_period_s).
   void set_valve_command_period(double period_s);
 
@@ -172,6 +194,12 @@ class Controller {
   Eigen::Vector3d stick_direction_ = Eigen::Vector3d::UnitX();
   double tip_error_filtered_m_ = 0.0;
   bool neutral_ = false;  // the last update returned kStopped (valves neutral)
+  // The crane scale and the rated capacity limiter (docs/loads.md).
+  void update_load(const valves::MachineState& state, ControllerOutput& out) noexcept;
+  config::LoadChart chart_;
+  double known_payload_kg_ = 0.0;
+  std::unique_ptr<dynamics::PayloadEstimator> estimator_;
+  bool overload_ = false;
 };
 
 }  // namespace craneassist::control

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <string>
 #include <thread>
@@ -32,6 +33,10 @@ struct LogRow {
   double ref_power_w = 0.0;  // pump power the model predicts for the reference
   // The flow manipulability polytope (ControllerOutput).
   double avail_speed_m_s = 0.0, avail_speed_resolved_m_s = 0.0, polytope_volume_m3s3 = 0.0;
+  // The load (docs/loads.md): the simulator's truth (NaN on a machine), the crane scale's
+  // estimate, the load moment against the chart (ControllerOutput::load).
+  double load_kg = std::numeric_limits<double>::quiet_NaN();
+  double payload_estimate_kg = 0.0, load_moment_ratio = 0.0;
   const char* active_limit = "";  // static strings only (to_string of the enums)
   const char* pump_limit = "";
   // Live-loop fields (the live loop and telemetry fill them; the CSV writer does not write them):

@@ -14,6 +14,7 @@
 #include "craneassist/control/control_loop.hpp"
 #include "craneassist/control/controller.hpp"
 #include "craneassist/control/csv_log.hpp"
+#include "craneassist/control/run_statistics.hpp"
 #include "craneassist/dynamics/mobile_base.hpp"
 #include "craneassist/input/command_source.hpp"
 #include "craneassist/input/input_monitor.hpp"
@@ -83,6 +84,7 @@ struct LiveOptions {
 };
 
 struct LiveSummary {
+  LoadSummary load;  // the crane scale and the load moment (docs/loads.md)
   long cycles = 0;
   double duration_s = 0.0;   // machine time
   double wall_time_s = 0.0;  // computer time

@@ -8,6 +8,7 @@
 #include <array>
 
 #include "craneassist/control/control_loop.hpp"
+#include "craneassist/control/controller.hpp"
 #include "craneassist/control/motion_quality.hpp"
 #include "craneassist/scaling/active_limit.hpp"
 
@@ -27,6 +28,27 @@ struct RunStatisticsOptions {
 };
 
 inline constexpr int kMaxPositionWindow = 64;
+
+// The load over a run (docs/loads.md): the crane scale against the simulator's truth, and the
+// rated capacity limiter.
+struct LoadSummary {
+  bool truth_known = false;  // a simulated machine (its load is known to the statistics only)
+  double truth_kg = 0.0;     // the last cycle's
+  double estimate_kg = 0.0;  // the last cycle's
+  double sigma_kg = 0.0;
+  bool converged = false;
+  // |estimate - truth| once the scale has converged and the load has not changed for
+  // settled_after_s: at rest (tip slower than 0.01 m/s) and moving (faster than 0.05 m/s).
+  double max_error_rest_kg = 0.0, max_error_moving_kg = 0.0;
+  double sum_sq_error_rest = 0.0, sum_sq_error_moving = 0.0;
+  long rest_samples = 0, moving_samples = 0;
+  double peak_moment_ratio = 0.0;
+  long warning_cycles = 0;   // load moment at 90 % of the chart or more
+  long overload_cycles = 0;  // the limiter tripped
+  long refused_cycles = 0;   // a motion raising the load moment slowed to rest
+  long relief_cycles = 0;    // a chamber at the load-holding valves' port relief (creeping)
+  long truth_changes = 0;
+};
 
 struct RunSummary {
   long cycles = 0;
@@ -61,6 +83,7 @@ struct RunSummary {
   long stop_cycles = 0;
   std::size_t log_rows_dropped = 0;
   MotionQualityResult feel;  // stall events and lateral speed (motion_quality.hpp)
+  LoadSummary load;
 };
 
 class RunStatistics final : public CycleObserver {
@@ -73,6 +96,8 @@ class RunStatistics final : public CycleObserver {
   RunSummary summary(const LoopSummary& loop) const;
 
  private:
+  void add_load(double t, double tip_speed, const valves::MachineState& state,
+                const ControllerOutput& out) noexcept;
   double period_s_;
   RunStatisticsOptions options_;
   RunSummary s_;
@@ -89,6 +114,7 @@ class RunStatistics final : public CycleObserver {
   long tip_count_ = 0;
   double sum_sq_position_direction_ = 0.0;
   long position_samples_ = 0;
+  double truth_since_s_ = 0.0;  // the simulated load unchanged since
 };
 
 // Angle between two vectors in degrees (0 when either is zero).

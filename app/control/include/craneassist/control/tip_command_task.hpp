@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 
 #include "craneassist/control/control_loop.hpp"
 #include "craneassist/control/controller.hpp"
@@ -27,6 +28,8 @@ struct TipCommand {
   // The drive stick (speed, curvature fractions in [-1, 1]; input::OperatorCommand::drive),
   // zero when the command does not pass.
   Eigen::Vector2d drive = Eigen::Vector2d::Zero();
+  // The load a replay puts in the simulated crane's grapple (NaN: unchanged; ValveCommand).
+  double simulated_load_kg = std::numeric_limits<double>::quiet_NaN();
 };
 
 class TipCommandInput {

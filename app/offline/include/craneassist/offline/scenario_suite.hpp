@@ -29,6 +29,7 @@ struct SuiteRun {
   std::string pose;              // "default" or a name from poses:
   std::string pose_text;         // NAME=VALUE UNIT, ...; empty for default
   double payload_kg = 0.0;
+  bool payload_known = false;  // tell the controller (else the crane scale weighs the load)
   SuiteTargets targets;
   int line = 0;       // of the run in the manifest
   int pose_line = 0;  // of its pose

@@ -8,7 +8,13 @@
 namespace craneassist::offline {
 
 inline sim_backend::SimSettings sim_settings(const config::CraneConfig& cfg) {
-  return sim_backend::SimSettings{cfg.simulation.step_s, cfg.simulation.q_initial};
+  sim_backend::SimSettings s;
+  s.step_s = cfg.simulation.step_s;
+  s.q_initial = cfg.simulation.q_initial;
+  s.pressure_noise_pa = cfg.simulation.pressure_noise_pa;
+  s.pressure_resolution_pa = cfg.simulation.pressure_resolution_pa;
+  s.return_pressure_pa = cfg.simulation.return_pressure_pa;
+  return s;
 }
 
 }  // namespace craneassist::offline
