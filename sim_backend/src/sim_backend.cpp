@@ -235,7 +235,7 @@ struct SimBackend::Impl {
         // valve towards the pump) keeps it from going back.
         const double f_push = supply_ceiling_pa * (v > 0.0 ? cyl.area_a_m2 : cyl.area_b_m2);
         stall[i] = stall[i] ? std::abs(f) >= kReseatShare * f_push
-                            : std::abs(f) >= kSaturatedShare * f_push && v_now * v <= 0.0;
+                            : std::abs(f) >= kSaturatedShare * f_push && v_now * v < 0.0;
         v_target = stall[i] ? 0.0 : v;
         f_max = stall[i] ? f_hold : f_push;
       } else {
