@@ -68,6 +68,14 @@ inline dds::TelemetryFrame test_frame(std::uint64_t cycle) {
   f.avail_speed_resolved_m_s = 1.0;
   f.polytope_dim = 3;
   f.polytope_volume_m3_s3 = 51.51;
+  f.load_truth_kg = 450.0;
+  f.payload_estimate_kg = 448.5;
+  f.payload_converged = true;
+  f.load_moment_ratio = 0.5;
+  f.rated_load_kg = 897.0;
+  f.load_reach_m = 5.5;
+  f.load_warning = false;
+  f.load_overload = false;
   return f;
 }
 

@@ -204,6 +204,12 @@ TEST(CanBackend, DecodesFeedbackInSiAndDisabledSendsBlock) {
   EXPECT_NEAR(state.q[3], 1.0, 1e-4);   // m, 0.1 mm resolution
   const auto& cyl = r.cfg.model.cylinders[1];
   EXPECT_NEAR(state.load_pressure_pa[1], 100e5 - 10e5 * cyl.area_b_m2 / cyl.area_a_m2, 1.0);
+  // Both chambers, for the crane scale (docs/loads.md); the simulator's truth is not known.
+  EXPECT_TRUE(state.chamber_pressures);
+  EXPECT_NEAR(state.pressure_a_pa[1], 100e5, 1.0);
+  EXPECT_NEAR(state.pressure_b_pa[1], 10e5, 1.0);
+  EXPECT_TRUE(std::isnan(state.pressure_b_pa[3]));  // the extension's rod side has no signal
+  EXPECT_TRUE(std::isnan(state.payload_truth_kg));
 
   r.bus.clear_log();
   valves::ValveCommand cmd;

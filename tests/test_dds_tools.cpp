@@ -371,6 +371,8 @@ void expect_test_frame_snapshot(const std::string& out) {
         "pressure 12.5 MPa",
         "stick     [###############...............]  0.62 /  1.25 m/s available   50 %",
         "polytope  volume 51.51 m^3/s^3        along the chosen joint motion 1.00 m/s",
+        "scale       448.5 kg weighed                  at 5.50 m reach  (simulated 450 kg)",
+        "moment    [###############...............]   50 % of 897 kg rated",
         "command   x  +0.375  y  +0.500  z  +0.000 m/s",
         "joint       position     reference      cylinder",
         "slew            30.0 deg      30.5 deg     0.500 m",

@@ -67,7 +67,7 @@ Totals run_suite(const std::string& resolution, bool expect_every_target) {
 
 TEST(OperatorFeel, DefaultResolutionMeetsEveryTarget) {
   const Totals t = run_suite("", true);
-  EXPECT_EQ(t.runs, 25);
+  EXPECT_EQ(t.runs, 27);
 }
 
 TEST(OperatorFeel, MinFlowMeetsEveryTarget) {

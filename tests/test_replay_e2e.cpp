@@ -94,8 +94,7 @@ TEST(ReplayEndToEnd, FlowPrescalingKeepsTheTipDirectionWhenThePumpSaturates) {
   EXPECT_LT(scaled.summary.max_reference_direction_error_deg, 0.01);
   EXPECT_LT(scaled.summary.pump_saturated_cycles, 20);
   EXPECT_LT(scaled.summary.max_direction_error_deg, 8.0);
-  // The plant's cylinder friction and sensor noise (docs/loads.md) cost a little here (2.2 deg).
-  EXPECT_LT(scaled.summary.rms_direction_error_deg, 2.5);
+  EXPECT_LT(scaled.summary.rms_direction_error_deg, 2.0);
   EXPECT_GT(scaled.min_elevation_deg, commanded_elevation - 8.0);
   EXPECT_GT(scaled.summary.limit_cycles[static_cast<std::size_t>(scaling::ActiveLimit::kFlow)], 50);
 }

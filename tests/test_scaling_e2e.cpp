@@ -277,7 +277,7 @@ TEST(ScalingEndToEnd, EndDampingStopsBeforeTheEndAndLetsTheOperatorBackOff) {
 }
 
 TEST(ScalingEndToEnd, HeavyLoadStopsWhenTheStickIsReleasedAndNeverComesBack) {
-  // 650 kg moved out-and-down and straight out at full speed, then the stick let go. Stopping a
+  // A heavy load moved out-and-down and straight out at full speed, then the stick let go. Stopping a
   // falling load raises its holding pressure; the power bound once forbade any deceleration
   // there (sddot_min > 0) and the reference ran on at 1 m/s into the joint ends with the stick
   // released. Reaching out, the bound asked for more deceleration than the path allows all the
@@ -290,7 +290,10 @@ TEST(ScalingEndToEnd, HeavyLoadStopsWhenTheStickIsReleasedAndNeverComesBack) {
   for (const char* text : replays) {
     for (const char* r : {"energy-optimal", "pinv-joint"}) {
       auto cfg = config::default_crane_config();
-      config::set_payload_mass(cfg.model, 650.0);
+      // 450 kg: reaching out and down takes the tip to about 8 m, where 650 kg needs more than
+      // the load-holding valves' setting on the K70M's assumed linkage, and the boom would sink
+      // through them (docs/loads.md).
+      config::set_payload_mass(cfg.model, 450.0);
       config::set_resolution(cfg, r);
       // The stop on release, not the rated capacity limiter: 650 kg reaching out passes the
       // K70M's load chart, which would refuse the motion (tests/test_loads.cpp).
@@ -313,13 +316,10 @@ TEST(ScalingEndToEnd, HeavyLoadStopsWhenTheStickIsReleasedAndNeverComesBack) {
       const double tip_speed =
           std::hypot(log["tip_vx"][last], log["tip_vy"][last], log["tip_vz"][last]);
       std::printf(
-          "[ figures  ] 650 kg along (%.2f, %.2f, %.2f) released, %s: %.2f m/s at the release, "
+          "[ figures  ] 450 kg along (%.2f, %.2f, %.2f) released, %s: %.2f m/s at the release, "
           "reference at rest %.2f s later, backwards at most %.4f m/s, tip %.3f m/s at the end\n",
           line.x(), line.y(), line.z(), r, release_speed, rest_at - 3.5, backwards, tip_speed);
-      // Moving when released. With the simulator's cylinder friction and load-holding valves
-      // (docs/loads.md) pinv-joint reaches only 0.13 m/s out and down (0.26 m/s before them);
-      // why is not yet understood.
-      EXPECT_GT(release_speed, 0.1) << r;
+      EXPECT_GT(release_speed, 0.2) << r;
       ASSERT_GT(rest_at, 0.0) << r << ": the reference never stopped";
       // From about 1 m/s at 1 m/s^2 and 4 m/s^3: a little over 1.25 s; the margin covers a
       // cylinder-acceleration bound that brakes more gently.

@@ -29,14 +29,19 @@ config::ConfigError error_of(const std::string& yaml) {
 TEST(ScenarioSuite, TheShippedSuiteExpandsEveryPose) {
   const auto suite = offline::load_suite(kReplays / "suite.yaml");
   offline::check_suite(suite, config::default_crane_config());
-  ASSERT_EQ(suite.runs.size(), 25u);
+  ASSERT_EQ(suite.runs.size(), 27u);
   EXPECT_EQ(suite.runs[0].name(), "suite/push_x_plus.csv @default");
   EXPECT_EQ(suite.runs[1].name(), "suite/push_x_plus.csv @folded");
   EXPECT_EQ(suite.runs[1].pose_text, "lift=0 deg, tilt=-125 deg, extension=0.2 m");
   ASSERT_TRUE(suite.runs[0].targets.lateral_speed_m_s);
   EXPECT_DOUBLE_EQ(*suite.runs[0].targets.lateral_speed_m_s, 0.03);
-  const auto& heavy = suite.runs.back();
+  const auto& heavy = suite.runs[suite.runs.size() - 3];
+  EXPECT_EQ(heavy.name(), "heavy_lift.csv @default");
   EXPECT_EQ(heavy.payload_kg, 650.0);
+  EXPECT_FALSE(heavy.payload_known);  // unannounced: the crane scale weighs it
+  // The loading cycles with a log nobody announces (docs/loads.md).
+  EXPECT_EQ(suite.runs[suite.runs.size() - 2].name(), "work_cycle.csv @default");
+  EXPECT_EQ(suite.runs.back().name(), "work_cycle_slip.csv @default");
   ASSERT_TRUE(heavy.targets.peak_power_share && heavy.targets.direction_error_rad &&
               heavy.targets.stall_events);
   EXPECT_DOUBLE_EQ(*heavy.targets.peak_power_share, 1.02);
@@ -57,6 +62,10 @@ TEST(ScenarioSuite, MistakesNameFileLineAndField) {
   e = error_of(head + "runs:\n  - replay: " + std::string(300, 'a') + ".csv\n");
   EXPECT_EQ(e.field(), "runs[0].replay");
   EXPECT_NE(e.reason().find("cannot use"), std::string::npos) << e.reason();
+  e = error_of(head + "runs:\n  - replay: demo.csv\n    payload_known: maybe\n");
+  EXPECT_EQ(e.field(), "runs[0].payload_known");
+  EXPECT_EQ(e.line(), 4);
+  EXPECT_NE(e.reason().find("expected true or false, got 'maybe'"), std::string::npos);
   e = error_of(head + "runs:\n  - replay: demo.csv\n    poses: [folded]\n");
   EXPECT_EQ(e.field(), "runs[0].poses");
   EXPECT_NE(e.reason().find("no pose named 'folded'"), std::string::npos);

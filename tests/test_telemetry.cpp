@@ -233,6 +233,14 @@ cdds::TelemetryFrame frame(std::uint64_t k) {
   f.polytope_dim = 2;
   f.polytope_volume_m3_s3 = 0.0;
   f.polytope_area_m2_s2 = 3.5;
+  f.load_truth_kg = 1200.0;
+  f.payload_estimate_kg = 1198.25;
+  f.payload_converged = true;
+  f.load_moment_ratio = 1.375;
+  f.rated_load_kg = 871.5;
+  f.load_reach_m = 5.25;
+  f.load_warning = true;
+  f.load_overload = true;
   return f;
 }
 
@@ -274,6 +282,14 @@ TEST(Telemetry, EveryTopicRoundTripsEveryField) {
   EXPECT_EQ(s.polytope_dim(), 2u);
   EXPECT_EQ(s.polytope_volume_m3_s3(), 0.0);
   EXPECT_EQ(s.polytope_area_m2_s2(), 3.5);
+  EXPECT_EQ(s.payload_estimate_kg(), 1198.25);
+  EXPECT_TRUE(s.payload_converged());
+  EXPECT_EQ(s.load_moment_ratio(), 1.375);
+  EXPECT_EQ(s.rated_load_kg(), 871.5);
+  EXPECT_EQ(s.load_reach_m(), 5.25);
+  EXPECT_TRUE(s.load_warning());
+  EXPECT_TRUE(s.overload());
+  EXPECT_EQ(s.load_truth_kg(), 1200.0);
 
   const auto j = sub.joints.samples().front();
   EXPECT_EQ(j.header().cycle(), 0u);
@@ -432,6 +448,14 @@ TEST(Telemetry, TheWatchAssemblesThePublishedFrame) {
   EXPECT_EQ(got.polytope_dim, want.polytope_dim);
   EXPECT_EQ(got.polytope_volume_m3_s3, want.polytope_volume_m3_s3);
   EXPECT_EQ(got.polytope_area_m2_s2, want.polytope_area_m2_s2);
+  EXPECT_EQ(got.payload_estimate_kg, want.payload_estimate_kg);
+  EXPECT_EQ(got.payload_converged, want.payload_converged);
+  EXPECT_EQ(got.load_moment_ratio, want.load_moment_ratio);
+  EXPECT_EQ(got.rated_load_kg, want.rated_load_kg);
+  EXPECT_EQ(got.load_reach_m, want.load_reach_m);
+  EXPECT_EQ(got.load_warning, want.load_warning);
+  EXPECT_EQ(got.load_overload, want.load_overload);
+  EXPECT_EQ(got.load_truth_kg, want.load_truth_kg);
   const cdds::WatchedRun run = watch.run();
   EXPECT_EQ(run.crane, "test crane");
   EXPECT_EQ(run.backend, "sim");
@@ -611,6 +635,46 @@ TEST(Dashboard, ShowsTheStickAgainstTheAvailableSpeedAndThePolytopeMeasure) {
   const auto lines = cdds::dashboard_view(nullptr, nullptr, nullptr, &path);
   EXPECT_NE(std::find(lines.begin(), lines.end(), "stick     -"), lines.end());
   EXPECT_NE(std::find(lines.begin(), lines.end(), "polytope  -"), lines.end());
+}
+
+// The load's lines (docs/loads.md): the crane scale's estimate, whether it has weighed the load,
+// the reach and the simulated truth; the load moment against the chart, its warning and trip.
+TEST(Dashboard, ShowsTheCraneScaleAndTheLoadMoment) {
+  craneassist::msg::Status status;
+  status.payload_estimate_kg(1198.25);
+  status.payload_converged(true);
+  status.load_moment_ratio(1.375);
+  status.rated_load_kg(871.5);
+  status.load_reach_m(5.25);
+  status.load_warning(true);
+  status.overload(true);
+  status.load_truth_kg(1200.0);
+  auto all = [&] {
+    std::string text;
+    for (const auto& line : cdds::dashboard_view(&status, nullptr, nullptr, nullptr)) {
+      text += line + "\n";
+    }
+    return text;
+  };
+  std::string text = all();
+  for (const char* want :
+       {"scale      1198.2 kg weighed                  at 5.25 m reach  (simulated 1200 kg)",
+        "moment    [##############################]  138 % of 872 kg rated  OVERLOAD"}) {
+    EXPECT_NE(text.find(want), std::string::npos) << "missing: " << want << "\n" << text;
+  }
+  // Not yet weighed, on a machine (no truth), under the warning: no flags.
+  status.payload_converged(false);
+  status.load_truth_kg(NAN);
+  status.load_moment_ratio(0.5);
+  status.load_warning(false);
+  status.overload(false);
+  text = all();
+  EXPECT_NE(text.find("weighing (rated assumed) at 5.25 m reach\n"), std::string::npos) << text;
+  EXPECT_EQ(text.find("simulated"), std::string::npos) << text;
+  EXPECT_EQ(text.find("WARNING"), std::string::npos) << text;
+  // No chart: no gauge.
+  status.rated_load_kg(0.0);
+  EXPECT_NE(all().find("moment    no load chart"), std::string::npos);
 }
 
 // The wheeled base's lines (sim --drive): only when the base topic has a sample.

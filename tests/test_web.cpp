@@ -120,6 +120,12 @@ TEST(WebServer, StreamsTheCyclesWithTheCraneDrawnAsPoints) {
   row.avail_speed_resolved_m_s = 0.875;
   row.polytope_dim = 3;
   row.polytope_volume_m3s3 = 51.51;
+  row.payload_estimate_kg = 448.5;
+  row.payload_converged = true;
+  row.load_moment_ratio = 0.5;
+  row.rated_load_kg = 897.0;
+  row.load_reach_m = 5.5;
+  row.load_kg = 450.0;
   control::CycleTime time{};
   valves::MachineState state;
   valves::ValveCommand command;
@@ -137,6 +143,17 @@ TEST(WebServer, StreamsTheCyclesWithTheCraneDrawnAsPoints) {
   EXPECT_EQ(frame["polytope"]["dim"], 3);
   EXPECT_EQ(frame["polytope"]["volume"], 51.51);
   EXPECT_EQ(frame["polytope"]["area"], 0.0);
+  // The crane scale and the load moment (docs/loads.md); the truth is null on a machine.
+  EXPECT_EQ(frame["load"]["estimate"], 448.5);
+  EXPECT_EQ(frame["load"]["converged"], true);
+  EXPECT_EQ(frame["load"]["ratio"], 0.5);
+  EXPECT_EQ(frame["load"]["rated"], 897.0);
+  EXPECT_EQ(frame["load"]["reach"], 5.5);
+  EXPECT_EQ(frame["load"]["overload"], false);
+  EXPECT_EQ(frame["load"]["truth"], 450.0);
+  row.load_kg = std::numeric_limits<double>::quiet_NaN();
+  s.server->observer().on_cycle(rec);
+  EXPECT_TRUE(page.read("frame")["load"]["truth"].is_null());
 }
 
 // The crane on the wheeled base (sim --drive): the frame carries the base and places the crane's

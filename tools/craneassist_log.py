@@ -12,7 +12,9 @@ def load(path):
         rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
     if not rows:
         raise SystemExit(f"{path}: no rows")
-    cols = {k: [float(r[k]) for r in rows] for k in rows[0] if k not in TEXT_COLUMNS}
+    # An empty cell is a value the run does not have (load_kg on a machine): NaN.
+    cols = {k: [float(r[k]) if r[k] != "" else float("nan") for r in rows]
+            for k in rows[0] if k not in TEXT_COLUMNS}
     for k in TEXT_COLUMNS:
         if k in rows[0]:
             cols[k] = [r[k] for r in rows]

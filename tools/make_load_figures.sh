@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates the figures of docs/loads.md from fresh runs of the simulator (build first:
 # cmake --build build): the crane scale on a work cycle, on a log slipping out of the grapple,
-# and the rated capacity limiter on a 1200 kg load pushed out (and, without a figure, 1000 kg
+# and the rated capacity limiter on a 1200 kg load pushed out (and, without a figure, 700 kg
 # pushed out, which trips the limiter on the way). Prints each run's load lines of the summary and
 # keeps them in docs/data/loads_summary.txt. Needs python3-matplotlib.
 set -euo pipefail
@@ -48,5 +48,5 @@ run slip "work_cycle_slip.csv: the log slips out of the grapple at 7.5 s" \
   examples/replays/work_cycle_slip.csv
 run overload "1200 kg pushed straight out at 0.4 m/s (the controller is not told)" \
   "$out/replays/push_out.csv" --payload 1200
-run push_out_1000 "" "$out/replays/push_out.csv" --payload 1000
+run push_out_700 "" "$out/replays/push_out.csv" --payload 700
 echo "figures written to docs/img/loads_*.png, the load lines to $summary"

@@ -167,9 +167,10 @@ def main():
         mass.step(t, truth, where="post", color="black", linestyle="--", linewidth=1.2,
                   label="simulated load")
     mass.plot(t, estimate, color="tab:blue", linewidth=1.2, label="crane scale estimate")
-    # Room for the loads and for the rated line where it is lowest (the chart's loads near the
-    # pillar would squash a small load).
-    top = max([v for v in truth + estimate if not math.isnan(v)] + [min(rated, default=0.0), 1.0])
+    # Room for the loads and the rated line, unless the chart's loads near the pillar would
+    # squash a small load (then the rated line shows where it is lowest).
+    base = max([v for v in truth + estimate if not math.isnan(v)] + [min(rated, default=0.0), 1.0])
+    top = max(base, min(max(rated, default=0.0), 2.5 * base))
     mass.set_ylim(-0.05 * top, 1.25 * top)
     title = f"Payload: estimate at the end {estimate[-1]:.1f} kg"
     if not math.isnan(truth[-1]):

@@ -94,6 +94,13 @@ void print_feel_line(const control::MotionQualityResult& f) {
 }  // namespace
 
 void print_load_line(const control::LoadSummary& l, bool known, bool chart) {
+  if (!known && !l.weighed) {
+    std::printf(
+        "  load: NOT WEIGHED: the machine gave no chamber pressures (both chambers of every "
+        "cylinder); the dynamics assumed the chart's rated load and the rated capacity limiter "
+        "could not act (--payload-known tells the controller)\n");
+    return;
+  }
   std::printf("  load: %s %.1f kg", known ? "told" : "estimated", l.estimate_kg);
   if (!known) std::printf(" (+-%.1f kg%s)", l.sigma_kg, l.converged ? "" : ", not converged");
   if (l.truth_known) {

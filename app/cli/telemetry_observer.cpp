@@ -54,6 +54,14 @@ void each_field(Row& row, Frame& f, int n, Copy copy) {
   copy(row.polytope_dim, f.polytope_dim);
   copy(row.polytope_volume_m3s3, f.polytope_volume_m3_s3);
   copy(row.polytope_area_m2s2, f.polytope_area_m2_s2);
+  copy(row.load_kg, f.load_truth_kg);
+  copy(row.payload_estimate_kg, f.payload_estimate_kg);
+  copy(row.load_moment_ratio, f.load_moment_ratio);
+  copy(row.rated_load_kg, f.rated_load_kg);
+  copy(row.load_reach_m, f.load_reach_m);
+  copy(row.payload_converged, f.payload_converged);
+  copy(row.load_warning, f.load_warning);
+  copy(row.load_overload, f.load_overload);
   copy(row.base_present, f.base_present);
   copy(row.base_shared_pump, f.base_shared_pump);
   copy(row.base_pose, f.base_pose);

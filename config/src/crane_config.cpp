@@ -210,11 +210,10 @@ dynamics::Cylinder read_cylinder(Reader& r, const YAML::Node& node, const std::s
   c.a_max_m_s2 = r.value_in(node, "max_acceleration", path, Dimension::kAcceleration, 1e-6, 100.0,
                             "positive and at most 100 m/s^2");
   // Optional seal and guide friction (docs/loads.md).
-  if (node["friction"].IsDefined() && !node["friction"].IsNull()) {
-    const YAML::Node f = node["friction"];
+  if (const auto friction = r.optional_section(node, "friction", path,
+                                               {"coulomb_extend", "coulomb_retract", "viscous"})) {
+    const YAML::Node& f = *friction;
     const std::string fp = path + ".friction";
-    if (!f.IsMap()) r.fail(f, fp, "expected coulomb_extend, coulomb_retract and viscous");
-    r.check_keys(f, fp, {"coulomb_extend", "coulomb_retract", "viscous"});
     c.friction.coulomb_extend_n =
         r.value_in(f, "coulomb_extend", fp, Dimension::kForce, 0.0, 1e7, "between 0 and 10000 kN");
     c.friction.coulomb_retract_n =
@@ -497,13 +496,12 @@ void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& mo
   v.delay_s = r.value_in(valves, "delay", vp, Dimension::kTime, 0.0, 2.0, "between 0 and 2 s");
   if (valves["tables"].IsDefined()) read_valve_tables(r, valves["tables"], vp + ".tables", model);
   if (h["mhsb"].IsDefined() && !h["mhsb"].IsNull()) read_mhsb(r, h["mhsb"], model);
-  // Optional load-holding valves (docs/loads.md); left out: held up to the pump's relief,
-  // nothing passes beyond it.
-  if (h["load_holding"].IsDefined() && !h["load_holding"].IsNull()) {
-    const YAML::Node lh = h["load_holding"];
+  // Optional load-holding valves (docs/loads.md); left out: loads are held up to the pump's
+  // relief, and a load beyond it runs ahead of its section (no valve bounds it).
+  if (const auto holding =
+          r.optional_section(h, "load_holding", "hydraulics", {"relief", "relief_flow"})) {
+    const YAML::Node& lh = *holding;
     const std::string lp = "hydraulics.load_holding";
-    if (!lh.IsMap()) r.fail(lh, lp, "expected relief and relief_flow");
-    r.check_keys(lh, lp, {"relief", "relief_flow"});
     model.load_holding.relief_pa =
         r.value_in(lh, "relief", lp, Dimension::kPressure, p.max_pressure_pa, 1e8,
                    "at least the pump's max_pressure and at most 1000 bar");
@@ -514,10 +512,9 @@ void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& mo
 
 // Optional rated load against reach (docs/loads.md).
 void read_load_chart(Reader& r, const YAML::Node& root, LoadChart& chart) {
-  const YAML::Node node = root["load_chart"];
-  if (!node.IsDefined() || node.IsNull()) return;
-  if (!node.IsMap()) r.fail(node, "load_chart", "expected reach and rated_load");
-  r.check_keys(node, "load_chart", {"reach", "rated_load"});
+  const auto section = r.optional_section(root, "load_chart", "", {"reach", "rated_load"});
+  if (!section) return;
+  const YAML::Node& node = *section;
   chart.reach_m = r.values(node, "reach", "load_chart", Dimension::kLength, 0);
   chart.rated_kg = r.values(node, "rated_load", "load_chart", Dimension::kMass, 0);
   if (chart.reach_m.size() != chart.rated_kg.size()) {
@@ -679,11 +676,10 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
     if (!known)
       r.fail(kv.first, "simulation.initial." + kv.first.Scalar(), "no joint of that name");
   }
-  if (sim["pressure_sensors"].IsDefined() && !sim["pressure_sensors"].IsNull()) {
-    const YAML::Node ps = sim["pressure_sensors"];
+  if (const auto sensors =
+          r.optional_section(sim, "pressure_sensors", "simulation", {"noise", "resolution"})) {
+    const YAML::Node& ps = *sensors;
     const std::string pp = "simulation.pressure_sensors";
-    if (!ps.IsMap()) r.fail(ps, pp, "expected noise and resolution");
-    r.check_keys(ps, pp, {"noise", "resolution"});
     cfg.simulation.pressure_noise_pa =
         r.value_in(ps, "noise", pp, Dimension::kPressure, 0.0, 1e7, "between 0 and 100 bar");
     cfg.simulation.pressure_resolution_pa =

@@ -81,12 +81,14 @@ const PayloadEstimate& PayloadEstimator::update(bool valid, const JointVector& q
     return out_;  // holds
   }
   cylinder_arms(model_, q, arms_);
-  bool pressures_ok = pressure_a_pa.allFinite() && pressure_b_pa.allFinite();
-  for (int i = 0; i < n && pressures_ok; ++i) {
+  // A cylinder whose chambers are not both measured (NaN) gives no row; its filtered effort is
+  // kept at zero.
+  for (int i = 0; i < n; ++i) {
     const auto& c = model_.cylinders[static_cast<std::size_t>(i)];
     effort_[i] = (pressure_a_pa[i] * c.area_a_m2 - pressure_b_pa[i] * c.area_b_m2) * arms_[i];
+    measured_[static_cast<std::size_t>(i)] = std::isfinite(effort_[i]);
+    if (!measured_[static_cast<std::size_t>(i)]) effort_[i] = 0.0;
   }
-  if (!pressures_ok || !effort_.allFinite()) return out_;
 
   // The second-order low-pass (critically damped) on the rates and on the efforts alike.
   const double w = 2.0 * 3.14159265358979 * settings_.filter_hz;
@@ -128,6 +130,7 @@ const PayloadEstimate& PayloadEstimator::update(bool valid, const JointVector& q
   for (int i = 0; i < n; ++i) {
     const auto& c = model_.cylinders[static_cast<std::size_t>(i)];
     const auto& j = model_.joints[static_cast<std::size_t>(i)];
+    if (!measured_[static_cast<std::size_t>(i)]) continue;
     const double range = j.q_max - j.q_min;
     if (range > 0.0 && (q[i] <= j.q_min + settings_.end_share * range ||
                         q[i] >= j.q_max - settings_.end_share * range)) {
@@ -148,14 +151,16 @@ const PayloadEstimate& PayloadEstimator::update(bool valid, const JointVector& q
     const double r = effort_f_[i] - tau0[i] - friction;
     const double noise =
         settings_.pressure_noise_pa * std::hypot(c.area_a_m2, c.area_b_m2) * std::abs(arms_[i]);
-    double var = noise * noise;
+    // The dynamics' share of the error whenever the crane accelerates (a stop's last
+    // centimetres too), the friction's while the cylinder moves.
+    const double d_err = settings_.dynamics_uncertainty *
+                         (std::abs(inertial_[i]) + std::abs(theta_ * payload_inertial_[i]));
+    double var = noise * noise + d_err * d_err;
     if (row_moving) {
       moving = true;
       const double f_err = settings_.friction_uncertainty * (fc + fr.viscous_n_s_m * std::abs(vc)) *
                            std::abs(arms_[i]);
-      const double d_err = settings_.dynamics_uncertainty *
-                           (std::abs(inertial_[i]) + std::abs(theta_ * payload_inertial_[i]));
-      var += f_err * f_err + d_err * d_err;
+      var += f_err * f_err;
     }
     if (!(var > 0.0) || !std::isfinite(r) || !std::isfinite(y)) continue;
     info += y * y / var;

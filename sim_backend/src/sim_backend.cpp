@@ -28,10 +28,12 @@ constexpr double kFrictionSmoothingM_S = 1e-3;
 // The load-holding valve's hysteresis: it closes again when the load falls below this share of
 // its setting; a stalled section tries to move again below this share of the pump's force.
 constexpr double kReseatShare = 0.98;
-constexpr double kSaturatedShare = 0.999;    // a motor force at this share of its cap is saturated
-constexpr double kFlowThroughValve = 100.0;  // creeping: the oil column is stiff (x the setting)
-// How fast a creeping cylinder's speed changes, m/s^2.
-constexpr double kCreepAccelerationM_S2 = 0.05;
+constexpr double kSaturatedShare = 0.999;  // a motor force at this share of its cap is saturated
+constexpr double kReliefOverride =
+    2.0;  // a load-holding valve's pressure at most this x its setting
+// A cylinder faster than the load-holding valve lets it in the load's direction by this much is
+// creeping (m/s).
+constexpr double kCreepSlackM_S = 1e-4;
 
 // The crane's bodies without the load body's: the payload and every body at the tip point.
 dynamics::CraneModel without_tip_load(const dynamics::CraneModel& m) {
@@ -133,6 +135,8 @@ struct SimBackend::Impl {
     load_joint = dJointCreateFixed(world, nullptr);
     dJointAttach(load_joint, load_body, crane->body(model.dof()));
     dJointSetFixed(load_joint);
+    dJointSetFixedParam(load_joint, dParamCFM, 0.0);
+    dJointSetFixedParam(load_joint, dParamERP, 0.0);
   }
 
   void apply_load_mass() {
@@ -210,28 +214,34 @@ struct SimBackend::Impl {
       const double f = force[i];
       const double hold_area = f >= 0.0 ? cyl.area_a_m2 : cyl.area_b_m2;
       const double load_dir = f >= 0.0 ? -1.0 : 1.0;
-      // The load-holding valve carries up to its port relief setting; a load beyond it opens the
-      // valve, and the cylinder creeps in the load's direction at the valve's relief flow (or as
-      // fast as its section lowers it), never falls freely. Creeping, the oil column through the
-      // valve is stiff, so the force read is the load's.
+      // The load-holding valve carries up to its port relief setting; beyond it the valve opens
+      // and the load runs ahead of what the section meters by at most the valve's relief flow:
+      // the cylinder never falls freely. Creeping, the cylinder's speed moves towards that bound
+      // within its acceleration limit, the valve's pressure rising up to twice its setting (its
+      // override); the valve closes again when the load falls below its setting.
       const double f_hold = hold_relief_pa * hold_area;
-      creep[i] = !hold && std::abs(f) >= (creep[i] ? kReseatShare : kSaturatedShare) * f_hold;
+      const double v_now = qdot[i] * arm;  // the cylinder's present speed
+      const double v_allowed =
+          std::max(v * load_dir, 0.0) + model.load_holding.relief_flow_m3_s / hold_area;
+      if (hold || (creep[i] && std::abs(f) < kReseatShare * f_hold)) creep[i] = false;
+      if (!hold && model.load_holding.relief_flow_m3_s > 0.0 &&
+          v_now * load_dir > v_allowed + kCreepSlackM_S) {
+        creep[i] = true;
+      }
+      // The pump pushes a motion whose force is along it (a resistive load, or the inertia of a
+      // start); a held or over-running cylinder rests on its load-holding valve.
+      const bool pushing = v != 0.0 && v * f >= 0.0;
       double v_target = v;
       double f_max = 0.0;
-      const double v_now = qdot[i] * arm;  // the cylinder's present speed
       if (creep[i]) {
-        // The cylinder's speed moves towards the creep speed at a bounded rate: the oil column
-        // does not jump, and neither does the force read.
         stall[i] = false;
-        const double v_creep = model.load_holding.relief_flow_m3_s / hold_area;
-        const double v_goal = load_dir * std::max(v * load_dir, v_creep);
-        const double dv = kCreepAccelerationM_S2 * settings.step_s;
-        v_target = std::clamp(v_goal, v_now - dv, v_now + dv);
-        f_max = kFlowThroughValve * f_hold;
-      } else if (v * f > 0.0) {
+        const double dv = cyl.a_max_m_s2 * settings.step_s;
+        v_target = std::clamp(load_dir * v_allowed, v_now - dv, v_now + dv);
+        f_max = kReliefOverride * f_hold;
+      } else if (pushing) {
         // A resistive load is pushed by the pump, at most at its pressure ceiling (relief; p_s for
         // a constant-pressure pump). A load it cannot move (the pump at its ceiling, the cylinder
-        // not moving the commanded way) stalls the section: the load-holding valve (a check
+        // going back against the command) stalls the section: the load-holding valve (a check
         // valve towards the pump) keeps it from going back.
         const double f_push = supply_ceiling_pa * (v > 0.0 ? cyl.area_a_m2 : cyl.area_b_m2);
         stall[i] = stall[i] ? std::abs(f) >= kReseatShare * f_push

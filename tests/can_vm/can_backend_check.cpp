@@ -15,6 +15,9 @@
 //   claim CAPTURE lost|won RIVAL_NAME   the J1939 address claim against j1939_rival (hex NAME)
 //   wait-motion IFACE TIMEOUT_S         waits until a command that is not block is on the bus:
 //                                       the run is moving
+//   p95 LOG                             the 95th percentile of the angle between the command and
+//                                       the tip's displacement over 100 ms (steady command, tip
+//                                       faster than 0.05 m/s)
 //   tables SIM.yaml CAN.yaml TOL        valve tables of `craneassist calibrate` on the two
 //                                       backends: each section's velocity at every command of the
 //                                       sim table, within TOL of the sim table's top speed
@@ -180,6 +183,56 @@ int compare(const char* sim_path, const char* can_path, double tol, bool with_pu
 // frames) and from the logged tip positions, the displacement over +-window_s (what the tip did,
 // with the estimator's noise averaged out). Rows count once the command has been the same for
 // 0.5 s and the tip moves faster than 0.05 m/s, as in the summary.
+// The 95th percentile of the angle between the command and the tip's displacement over the last
+// 100 ms (as the summary's second direction figure: over the bus the velocity is differentiated
+// from quantised encoder frames, and its noise is not the tip's motion), over the rows whose
+// command was the same through that window and whose tip moves faster than 0.05 m/s; printed
+// alone (deg), -1 without such rows.
+int p95(const char* path) {
+  std::vector<std::string> h;
+  const auto rows = read_csv(path, h);
+  std::size_t t = h.size(), cx = h.size(), tx = h.size(), vx = h.size();
+  for (std::size_t i = 0; i < h.size(); ++i) {
+    if (h[i] == "t") t = i;
+    if (h[i] == "cmd_vx") cx = i;
+    if (h[i] == "tip_x") tx = i;
+    if (h[i] == "tip_vx") vx = i;
+  }
+  if (t == h.size() || cx == h.size() || tx == h.size() || vx == h.size() || rows.size() < 3) {
+    std::printf("-1\n");
+    return 1;
+  }
+  const double dt = rows[1][t] - rows[0][t];
+  const auto w = static_cast<std::size_t>(std::max(1.0, std::round(0.1 / dt)));
+  const std::size_t need = std::max({cx, tx, vx}) + 3;
+  std::vector<double> angles;
+  for (std::size_t k = w; k < rows.size(); ++k) {
+    const auto& r = rows[k];
+    const auto& p = rows[k - w];
+    if (r.size() < need || p.size() < need) continue;
+    bool steady = true;
+    for (std::size_t j = k - w; j < k && steady; ++j) {
+      for (int a = 0; a < 3; ++a) steady = steady && rows[j][cx + a] == r[cx + a];
+    }
+    const double c[3] = {r[cx], r[cx + 1], r[cx + 2]};
+    const double d[3] = {r[tx] - p[tx], r[tx + 1] - p[tx + 1], r[tx + 2] - p[tx + 2]};
+    const double v = std::sqrt(r[vx] * r[vx] + r[vx + 1] * r[vx + 1] + r[vx + 2] * r[vx + 2]);
+    const double nc = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    const double nd = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (!steady || !(nc > 0.0) || !(v > 0.05) || !(nd > 0.0)) continue;
+    const double dot = (c[0] * d[0] + c[1] * d[1] + c[2] * d[2]) / (nc * nd);
+    angles.push_back(std::acos(std::clamp(dot, -1.0, 1.0)) * 180.0 / std::numbers::pi);
+  }
+  if (angles.empty()) {
+    std::printf("-1\n");
+    return 1;
+  }
+  std::sort(angles.begin(), angles.end());
+  const auto at = static_cast<std::size_t>(0.95 * static_cast<double>(angles.size() - 1));
+  std::printf("%.3f\n", angles[at]);
+  return 0;
+}
+
 int direction(const char* path, double window_s) {
   std::vector<std::string> h;
   const auto rows = read_csv(path, h);
@@ -682,6 +735,7 @@ int main(int argc, char** argv) {
                    argc == 6 && std::string(argv[5]) == "pump");
   }
   if (mode == "traffic" && argc == 3) return traffic(argv[2]);
+  if (mode == "p95" && argc == 3) return p95(argv[2]);
   if (mode == "direction" && argc == 4) return direction(argv[2], std::strtod(argv[3], nullptr));
   if (mode == "summary" && argc == 6) {
     return summary(argv[2], argv[3], std::strtod(argv[4], nullptr), std::strtod(argv[5], nullptr));

@@ -117,6 +117,13 @@ static void check_status(const craneassist_msg_Status* m) {
             m->avail_speed_resolved_m_s < 20.0,
         kStatus, "avail_speed_resolved_m_s %g", m->avail_speed_resolved_m_s);
   CHECK(m->polytope_dim == 3, kStatus, "polytope_dim %u", (unsigned)m->polytope_dim);
+  /* The load: the crane scale's estimate and the load moment (docs/loads.md). */
+  CHECK(isfinite(m->payload_estimate_kg) && m->payload_estimate_kg >= 0.0, kStatus,
+        "payload_estimate_kg %g", m->payload_estimate_kg);
+  CHECK(isfinite(m->load_moment_ratio) && m->load_moment_ratio >= 0.0, kStatus,
+        "load_moment_ratio %g", m->load_moment_ratio);
+  CHECK(m->rated_load_kg > 0.0 && m->load_reach_m > 0.0, kStatus, "rated_load_kg %g at %g m",
+        m->rated_load_kg, m->load_reach_m);
   CHECK(isfinite(m->polytope_volume_m3_s3) && m->polytope_volume_m3_s3 > 0.0 &&
             m->polytope_volume_m3_s3 < 1e4,
         kStatus, "polytope_volume_m3_s3 %g", m->polytope_volume_m3_s3);

@@ -71,6 +71,14 @@ int main(int argc, char** argv) {
   status.polytope_dim = 2; /* flat: a planar arm's area */
   status.polytope_volume_m3_s3 = 0.0;
   status.polytope_area_m2_s2 = 3.5;
+  status.payload_estimate_kg = 450.5;
+  status.payload_converged = true;
+  status.load_moment_ratio = 0.625;
+  status.rated_load_kg = 720.8;
+  status.load_reach_m = 6.25;
+  status.load_warning = false;
+  status.overload = false;
+  status.load_truth_kg = 450.0;
 
   char* names[4] = {"slew", "lift", "tilt", "extension"};
   bool prismatic[4] = {false, false, false, true};

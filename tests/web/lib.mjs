@@ -58,6 +58,28 @@ export function polytopeShown(page) {
   }));
 }
 
+// What the page shows of the load, with the frame it shows: the crane scale's line and the load
+// moment gauge (docs/loads.md).
+export function loadShown(page) {
+  return page.evaluate(() => ({
+    frame: window.craneassist.shown,
+    scale: document.getElementById('scale-load')?.textContent,
+    moment: document.getElementById('moment-text')?.textContent,
+  }));
+}
+
+// Checks that `shown` (loadShown) displays its frame's load: the estimate in kg and the load
+// moment as a share of the chart's rated load.
+export function checkLoadShown(shown, what) {
+  const l = shown.frame && shown.frame.load;
+  if (!l) { check(false, `${what}: no load in the frame`); return; }
+  check(shown.scale && shown.scale.startsWith(`${l.estimate.toFixed(0)} kg`),
+    `${what}: the crane scale shows '${shown.scale}' (frame: ${l.estimate} kg)`);
+  const want = `${(l.ratio * 100).toFixed(0)} % of ${l.rated.toFixed(0)} kg`;
+  check(l.rated > 0 && shown.moment && shown.moment.startsWith(want),
+    `${what}: the load moment shows '${shown.moment}' (frame: ${want})`);
+}
+
 // Checks that `shown` (polytopeShown) displays its frame's figures: the stick's speed against
 // the available speed along it, the volume of a solid polytope, the arrow along the stick.
 export function checkPolytopeShown(shown, what) {

@@ -6,8 +6,8 @@
 //
 // Prints the figures (frames per second the page received, stick-to-drawing latency) and exits
 // 0 when every check holds. docs/web.md#tests.
-import { check, checkPolytopeShown, failed, launchChromium, openPage, polytopeShown, printedUrl, run,
-  sleep } from './lib.mjs';
+import { check, checkLoadShown, checkPolytopeShown, failed, launchChromium, loadShown, openPage,
+  polytopeShown, printedUrl, run, sleep } from './lib.mjs';
 
 const [craneassist, nodeModules, screenshot] = process.argv.slice(2);
 if (!craneassist || !nodeModules) {
@@ -59,6 +59,7 @@ try {
   // crane moves.
   const going = await polytopeShown(page);
   checkPolytopeShown(going, 'stick forward');
+  checkLoadShown(await loadShown(page), 'stick forward');
   check(going.frame.avail > 0 && going.frame.avail >= Math.hypot(...going.frame.ref) - 1e-9,
     `available along the stick ${going.frame.avail.toFixed(2)} m/s, the reference ${Math.hypot(...going.frame.ref).toFixed(2)} m/s within it`);
   check(going.polytope !== idle.polytope && going.gauge !== idle.gauge,

@@ -9,7 +9,8 @@
 import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { check, checkPolytopeShown, failed, launchChromium, openPage, polytopeShown, printedUrl, run }
+import { check, checkLoadShown, checkPolytopeShown, failed, launchChromium, loadShown, openPage,
+  polytopeShown, printedUrl, run }
   from './lib.mjs';
 
 const [craneassist, nodeModules, domain] = process.argv.slice(2);
@@ -63,6 +64,8 @@ try {
   // The polytope's figures came over DDS (the status topic): shown as in sim --web.
   const shown = await polytopeShown(page);
   checkPolytopeShown(shown, 'watched run');
+  // The crane scale and the load moment came over DDS too.
+  checkLoadShown(await loadShown(page), 'watched run');
   check(shown.frame.avail > 0, `available along the stick: ${shown.frame.avail.toFixed(2)} m/s`);
   const rate = await page.evaluate(() => window.craneassist.rate_hz);
   check(rate >= 20 && rate <= 40, `frames received: ${rate} per second (30 streamed)`);

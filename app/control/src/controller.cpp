@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "craneassist/dynamics/cylinders.hpp"
+#include "craneassist/scaling/scaling_filter.hpp"
 
 namespace craneassist::control {
 namespace {
@@ -96,6 +97,8 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
   qddot_max_.setZero(n);
   polytope_arms_.setZero(n);
   chart_ = config.load_chart;
+  deceleration_max_ = config.scaling.deceleration_max_m_s2;
+  jerk_max_ = config.scaling.jerk_max_m_s3;
   known_payload_kg_ = dynamics::payload_mass_kg(model_);
   dynamics::PayloadEstimatorSettings scale;
   scale.period_s = period_s_;
@@ -125,6 +128,7 @@ void Controller::reset(const valves::MachineState& state) {
   follower_.reset(q_ref_);
   tip_error_filtered_m_ = 0.0;
   neutral_ = false;
+  refusing_ = false;
   if (tip_path_) tip_path_->reset();
   if (scaler_) scaler_->reset();
 }
@@ -141,10 +145,15 @@ void Controller::update_load(const valves::MachineState& state, ControllerOutput
     load.reach_m = std::hypot(tip.x(), tip.z());
   }
   load.rated_kg = chart_.empty() ? 0.0 : chart_.rated_kg_at(load.reach_m);
+  load.weighed = std::isfinite(est.sigma_kg);
   if (options_.payload_known) {
+    // Told: the config's payload, and on a simulator every change the run makes to it (a
+    // replay's load_kg rows).
+    if (std::isfinite(state.payload_truth_kg)) known_payload_kg_ = state.payload_truth_kg;
     load.estimate_kg = known_payload_kg_;
     load.sigma_kg = 0.0;
     load.converged = true;
+    load.weighed = true;
     load.model_kg = known_payload_kg_;
   } else {
     load.estimate_kg = est.mass_kg;
@@ -273,14 +282,24 @@ void Controller::update_full(const valves::MachineState& state, const Eigen::Vec
   tip_path_->update(q_ref_, path_in, tip_out_);
   scaling::TipScalerInput in = tip_scaler_input(v_cmd, u, tip_out_, stale);
   in.tracking_factor = scaling::tracking_factor(tip_error_filtered_m_, tracking_error_ok_m_);
-  // Overloaded, a motion that takes the load further out (raises the load moment) slows to rest;
-  // one that brings it in, or keeps its reach, stays free.
-  if (out.load.overload) {
+  // The rated capacity limiter: a motion that takes the load further out (raises the load
+  // moment) slows to rest when the crane is overloaded, or when the moment would pass the chart
+  // where a stop from the present speed ends (braking ahead of the chart); once refused it stays
+  // refused while the stick keeps pushing out and the moment is within 5 % of the chart. A
+  // motion that brings the load in, or keeps its reach, stays free.
+  if (!chart_.empty()) {
     const Eigen::Vector3d tip = dynamics::tip_position(model_, kin_, q_ref_);
     const double reach = std::hypot(tip.x(), tip.z());
     const double outwards = reach > 0.0 ? (tip.x() * u.x() + tip.z() * u.z()) / reach : 0.0;
-    in.overload_refused = outwards > kOutwardShare && v_cmd.norm() > 0.0;
-    out.load.refused = in.overload_refused;
+    const bool out_bound = outwards > kOutwardShare && v_cmd.norm() > 0.0;
+    const double stop = scaling::braking_distance(
+        scaler_->speed(), std::max(scaler_out_.sddot, 0.0), deceleration_max_, jerk_max_);
+    const double rated_ahead = chart_.rated_kg_at(reach + std::max(outwards, 0.0) * stop);
+    const double ratio_ahead = rated_ahead > 0.0 ? out.load.estimate_kg / rated_ahead : 0.0;
+    refusing_ = out_bound && (out.load.overload || ratio_ahead >= kOverloadTrip ||
+                              (refusing_ && out.load.moment_ratio >= kOverloadRelease));
+    in.overload_refused = refusing_;
+    out.load.refused = refusing_;
   }
   scaler_->update(q_ref_, tip_out_.geometry, in, scaler_out_);
 

@@ -64,6 +64,11 @@ void LogRowBuilder::fill(LogRow& row, double t, const Eigen::Vector3d& cmd,
   row.load_kg = state.payload_truth_kg;
   row.payload_estimate_kg = out.load.estimate_kg;
   row.load_moment_ratio = out.load.moment_ratio;
+  row.rated_load_kg = out.load.rated_kg;
+  row.load_reach_m = out.load.reach_m;
+  row.payload_converged = out.load.converged;
+  row.load_warning = out.load.warning;
+  row.load_overload = out.load.overload;
   row.avail_speed_m_s = out.avail_speed_m_s;
   row.avail_speed_resolved_m_s = out.avail_speed_resolved_m_s;
   row.polytope_volume_m3s3 = out.polytope_volume_m3_s3;

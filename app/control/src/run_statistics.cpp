@@ -105,6 +105,7 @@ void RunStatistics::add_load(double t, double tip_speed, const valves::MachineSt
   l.estimate_kg = est.estimate_kg;
   l.sigma_kg = est.sigma_kg;
   l.converged = est.converged;
+  l.weighed = l.weighed || est.weighed;
   l.peak_moment_ratio = std::max(l.peak_moment_ratio, est.moment_ratio);
   l.warning_cycles += est.warning;
   l.overload_cycles += est.overload;

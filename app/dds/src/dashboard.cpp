@@ -282,6 +282,30 @@ std::vector<std::string> render(const Snapshot& s, const DashboardOptions& o, st
     lines.push_back(fmt("%-10s-", "polytope"));
   }
 
+  // The load in the grapple (status): the crane scale and the load moment against the chart.
+  if (st) {
+    const auto& m = s.status;
+    const bool chart = m.rated_load_kg() > 0.0;
+    std::string truth;
+    if (std::isfinite(m.load_truth_kg())) truth = fmt("  (simulated %.0f kg)", m.load_truth_kg());
+    lines.push_back(fmt("%-10s%7.1f kg %-24s at %.2f m reach%s", "scale", m.payload_estimate_kg(),
+                        m.payload_converged() ? "weighed" : "weighing (rated assumed)",
+                        m.load_reach_m(), truth.c_str()));
+    if (chart) {
+      lines.push_back(fmt("%-10s%s %4.0f %% of %.0f kg rated  %s", "moment",
+                          bar(m.load_moment_ratio(), 1.0, kBar).c_str(),
+                          m.load_moment_ratio() * 100.0, m.rated_load_kg(),
+                          m.overload()       ? "OVERLOAD: motions raising it stop"
+                          : m.load_warning() ? "WARNING: 90 % of the chart"
+                                             : ""));
+    } else {
+      lines.push_back(fmt("%-10sno load chart", "moment"));
+    }
+  } else {
+    lines.push_back(fmt("%-10s-", "scale"));
+    lines.push_back(fmt("%-10s-", "moment"));
+  }
+
   // Operator command and scaled reference (command_path topic).
   lines.push_back(fmt("%-10s%s", "command",
                       cp ? xyz(s.command_path.command_m_s(), "%+7.3f", "m/s").c_str() : "-"));

@@ -74,6 +74,14 @@ void describe(const msg::Status& m, FieldVisitor& v) {
   v.integer("polytope_dim", m.polytope_dim(), "");
   v.number("polytope_volume_m3_s3", m.polytope_volume_m3_s3(), "m^3/s^3");
   v.number("polytope_area_m2_s2", m.polytope_area_m2_s2(), "m^2/s^2");
+  v.number("payload_estimate_kg", m.payload_estimate_kg(), "kg");
+  v.flag("payload_converged", m.payload_converged());
+  v.number("load_moment_ratio", m.load_moment_ratio(), "");
+  v.number("rated_load_kg", m.rated_load_kg(), "kg");
+  v.number("load_reach_m", m.load_reach_m(), "m");
+  v.flag("load_warning", m.load_warning());
+  v.flag("overload", m.overload());
+  v.number("load_truth_kg", m.load_truth_kg(), "kg");
 }
 
 void describe(const msg::JointState& m, FieldVisitor& v) {

@@ -227,6 +227,14 @@ struct TelemetryPublisher::Impl {
     status.polytope_dim(static_cast<std::uint16_t>(std::clamp(f.polytope_dim, 0, 3)));
     status.polytope_volume_m3_s3(f.polytope_volume_m3_s3);
     status.polytope_area_m2_s2(f.polytope_area_m2_s2);
+    status.payload_estimate_kg(f.payload_estimate_kg);
+    status.payload_converged(f.payload_converged);
+    status.load_moment_ratio(f.load_moment_ratio);
+    status.rated_load_kg(f.rated_load_kg);
+    status.load_reach_m(f.load_reach_m);
+    status.load_warning(f.load_warning);
+    status.overload(f.load_overload);
+    status.load_truth_kg(f.load_truth_kg);
     return writers[0]->write(&status);
   }
 

@@ -114,6 +114,14 @@ struct TelemetryWatch::Impl {
     frame.polytope_dim = s.polytope_dim();
     frame.polytope_volume_m3_s3 = s.polytope_volume_m3_s3();
     frame.polytope_area_m2_s2 = s.polytope_area_m2_s2();
+    frame.payload_estimate_kg = s.payload_estimate_kg();
+    frame.payload_converged = s.payload_converged();
+    frame.load_moment_ratio = s.load_moment_ratio();
+    frame.rated_load_kg = s.rated_load_kg();
+    frame.load_reach_m = s.load_reach_m();
+    frame.load_warning = s.load_warning();
+    frame.load_overload = s.overload();
+    frame.load_truth_kg = s.load_truth_kg();
     updated();
   }
 

@@ -125,7 +125,8 @@ FollowResult run_follow(const config::CraneConfig& crane, const config::BaseConf
 
   // The crane on the base; with a shared pump the crane gets what the motors leave each step.
   sim_backend::MobileCraneBackend machine(crane.model, settings, bm, start, base.shared_with_crane);
-  control::Controller controller(crane, {});
+  // Paper 003's study: the controller is told the payload, as the paper's was.
+  control::Controller controller(crane, {.payload_known = true});
   valves::MachineState state;
   machine.read(state);
   controller.reset(state);

@@ -134,7 +134,9 @@ DriveResult drive_path(const config::CraneConfig& cfg, const dynamics::JointVect
   const double length = kDriveStep * static_cast<double>(points.size() - 1);
   auto drive_cfg = cfg;
   drive_cfg.simulation.q_initial = q;
-  control::Controller controller(drive_cfg, {control::ScalingMode::kFull});
+  // The drive has no pressures to weigh with: the controller is told the payload.
+  control::Controller controller(drive_cfg,
+                                 {.mode = control::ScalingMode::kFull, .payload_known = true});
   valves::MachineState state;
   state.q = q;
   state.qdot = dynamics::JointVector::Zero(4);

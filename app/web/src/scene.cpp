@@ -245,6 +245,18 @@ void SceneBuilder::frame_json(const control::LogRow& row, std::uint64_t seq, std
       .number("volume", row.polytope_volume_m3s3)
       .number("area", row.polytope_area_m2s2)
       .close();
+  // The load (docs/loads.md): the crane scale, the load moment against the chart, the limiter;
+  // truth is the simulated load (null on a machine).
+  Object(f.nested("load"))
+      .number("estimate", row.payload_estimate_kg)
+      .flag("converged", row.payload_converged)
+      .number("ratio", row.load_moment_ratio)
+      .number("rated", row.rated_load_kg)
+      .number("reach", row.load_reach_m)
+      .flag("warning", row.load_warning)
+      .flag("overload", row.load_overload)
+      .number("truth", row.load_kg)
+      .close();
   if (row.base_present) base_json(row, f.nested("base"));
 
   // The drawing: joint frame origins, and each cylinder's ends.

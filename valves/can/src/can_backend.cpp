@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdarg>
+#include <limits>
 #include <mutex>
 #include <stdexcept>
 
@@ -317,7 +318,7 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
   state.load_pressure_pa.resize(n);
   state.pressure_a_pa.resize(n);
   state.pressure_b_pa.resize(n);
-  state.chamber_pressures = true;
+  state.chamber_pressures = false;
   for (int i = 0; i < n; ++i) {
     auto& j = m.joints[static_cast<std::size_t>(i)];
     const bool stale = !j.seen || now - j.last_position_mono_us > timeout_us;
@@ -333,11 +334,13 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
     state.q[i] = j.q;
     state.qdot[i] = j.qdot;
     state.load_pressure_pa[i] = j.pa - j.pb * j.area_ratio;
-    state.pressure_a_pa[i] = j.pa;
-    state.pressure_b_pa[i] = j.pb;
-    // Both chambers are measured only where the mapping has both signals.
+    // A chamber the mapping has no signal for is not measured (NaN); the crane scale uses the
+    // cylinders whose both chambers are.
+    constexpr double kNotMeasured = std::numeric_limits<double>::quiet_NaN();
+    state.pressure_a_pa[i] = j.map.pressure_a ? j.pa : kNotMeasured;
+    state.pressure_b_pa[i] = j.map.pressure_b ? j.pb : kNotMeasured;
     state.chamber_pressures =
-        state.chamber_pressures && j.map.pressure_a.has_value() && j.map.pressure_b.has_value();
+        state.chamber_pressures || (j.map.pressure_a.has_value() && j.map.pressure_b.has_value());
   }
   state.t_s = static_cast<double>(mono_us() - m.start_us) * 1e-6;
   read_pump(state.pump, now, timeout_us);

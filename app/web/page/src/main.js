@@ -285,6 +285,21 @@ function showFrame(f) {
   gauge('avail', stick, f.avail, `${fmt(stick)} / ${fmt(f.avail)} m/s`);
   $('avail-resolved').textContent = `${fmt(f.avail_resolved)} m/s`;
   $('polytope').textContent = polytopeText(f.polytope);
+  // The crane scale and the load moment against the chart (docs/loads.md).
+  if (f.load) {
+    const l = f.load;
+    const truth = l.truth === null || l.truth === undefined ? '' : ` (simulated ${fmt(l.truth, 0)} kg)`;
+    $('scale-load').textContent =
+      `${fmt(l.estimate, 0)} kg ${l.converged ? 'weighed' : 'weighing: rated load assumed'}${truth}`;
+    if (l.rated > 0) {
+      gauge('moment', l.ratio, 1.0, `${fmt(l.ratio * 100, 0)} % of ${fmt(l.rated, 0)} kg` +
+        (l.overload ? ' · OVERLOAD' : l.warning ? ' · WARNING' : ''));
+      $('moment-bar').className = 'fill' + (l.overload ? ' full' : l.warning ? ' high' : '');
+    } else {
+      $('moment-text').textContent = 'no load chart';
+    }
+    probe.load = l;
+  }
   probe.shown = f;
   plotSpeed.push(f.t, [norm(f.tip_v), norm(f.cmd), f.scale]);
 }

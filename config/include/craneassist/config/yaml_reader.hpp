@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <initializer_list>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -39,6 +40,17 @@ class YamlReader {
       }
       if (!ok) fail(kv.first, join(path, key), "unknown field (expected one of: " + list + ")");
     }
+  }
+
+  // An optional section: its node when the file gives it (a mapping with only `allowed` fields),
+  // nothing when it is left out or null.
+  std::optional<YAML::Node> optional_section(const YAML::Node& map, const std::string& key,
+                                             const std::string& path,
+                                             std::initializer_list<const char*> allowed) const {
+    const YAML::Node node = map[key];
+    if (!node.IsDefined() || node.IsNull()) return std::nullopt;
+    check_keys(node, join(path, key), allowed);
+    return node;
   }
 
   YAML::Node child(const YAML::Node& map, const std::string& key, const std::string& path) const {

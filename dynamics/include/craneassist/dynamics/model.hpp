@@ -159,7 +159,8 @@ struct ValveTable {
 // The load-holding (counterbalance) valves on the cylinders that carry a load (docs/loads.md): a
 // cylinder whose load the pump cannot move is held; a load pressure above the valve's port relief
 // setting opens it, and the cylinder creeps in the load's direction at the valve's relief flow,
-// never faster (the section's own lowering excepted). relief_pa 0: the pump's relief.
+// never faster (the section's own lowering excepted). relief_pa 0: the pump's relief;
+// relief_flow_m3_s 0 (no valves configured): nothing bounds a load beyond the relief.
 struct LoadHolding {
   double relief_pa = 0.0;
   double relief_flow_m3_s = 0.0;

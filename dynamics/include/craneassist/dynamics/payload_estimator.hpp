@@ -25,6 +25,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <memory>
 
 #include "craneassist/dynamics/kinematics.hpp"
@@ -50,9 +51,10 @@ struct PayloadEstimatorSettings {
   // A joint within this share of its range of an end is on or near its stop.
   double end_share = 0.01;
   // A new load: the cycle's own estimate this many standard errors from the running one, for
-  // change_time_s.
+  // change_time_s (longer than the pressure transient of a stop, which a machine's differentiated
+  // encoder rates do not show in step).
   double change_sigmas = 6.0;
-  double change_time_s = 0.08;
+  double change_time_s = 0.25;
 };
 
 struct PayloadEstimate {
@@ -82,7 +84,8 @@ class PayloadEstimator {
   void reset() noexcept;
 
   // One control period. valid: the measurement can be used at all; without chamber pressures
-  // (pressures false) the estimate holds. No allocation, no exception.
+  // (pressures false) the estimate holds, and a cylinder with a chamber not measured (NaN)
+  // gives no row. No allocation, no exception.
   const PayloadEstimate& update(bool valid, const JointVector& q, const JointVector& qdot,
                                 bool pressures, const JointVector& pressure_a_pa,
                                 const JointVector& pressure_b_pa) noexcept;
@@ -102,7 +105,8 @@ class PayloadEstimator {
   // Filter states: rates and their derivative; efforts and their derivative.
   JointVector rate_f_, acc_f_, effort_f_, effort_d_, arms_, effort_, row_y_;
   JointVector gravity_effort_, inertial_, payload_inertial_;
-  double theta_ = 0.0;        // the running estimate, kg
+  std::array<bool, kMaxJoints> measured_{};  // both chambers of the cylinder measured this cycle
+  double theta_ = 0.0;                       // the running estimate, kg
   double information_ = 0.0;  // sum of weights * y^2 (inverse variance), forgetting applied
   double since_restart_s_ = 0.0;
   double change_time_s_ = 0.0;

@@ -43,9 +43,9 @@ struct MachineState {
   JointVector q;                 // joint positions, rad or m
   JointVector qdot;              // joint rates
   JointVector load_pressure_pa;  // per cylinder; positive: resistive load (paper 004 sign)
-  // Each cylinder's piston-side (A) and rod-side (B) chamber pressures, where the machine
-  // measures both (chamber_pressures true); the crane scale weighs the load from them
-  // (dynamics::PayloadEstimator).
+  // Each cylinder's piston-side (A) and rod-side (B) chamber pressures, NaN for a chamber the
+  // machine does not measure; chamber_pressures: some cylinder has both measured. The crane
+  // scale weighs the load from the cylinders that have (dynamics::PayloadEstimator).
   JointVector pressure_a_pa, pressure_b_pa;
   bool chamber_pressures = false;
   // The simulator's truth: the mass in the grapple (NaN on a machine, which does not know it).

@@ -70,6 +70,7 @@ struct LoadOutput {
   double estimate_kg = 0.0;   // the crane scale (the config's payload when it is known)
   double sigma_kg = 0.0;      // its standard error (0 when known)
   bool converged = false;     // true when known
+  bool weighed = false;       // the scale has had a measurement (both chamber pressures) at all
   double model_kg = 0.0;      // what the dynamics use: the estimate, or the rated load before it
                               // has converged (never less)
   double reach_m = 0.0;       // measured tip's horizontal distance from the slew axis
@@ -200,6 +201,8 @@ class Controller {
   double known_payload_kg_ = 0.0;
   std::unique_ptr<dynamics::PayloadEstimator> estimator_;
   bool overload_ = false;
+  bool refusing_ = false;  // the limiter refuses the outward motion (held while pushed on)
+  double deceleration_max_ = 1.0, jerk_max_ = 1.0;  // the scaling's, for the stop ahead
 };
 
 }  // namespace craneassist::control

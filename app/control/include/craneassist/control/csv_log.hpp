@@ -37,6 +37,10 @@ struct LogRow {
   // estimate, the load moment against the chart (ControllerOutput::load).
   double load_kg = std::numeric_limits<double>::quiet_NaN();
   double payload_estimate_kg = 0.0, load_moment_ratio = 0.0;
+  // Live and telemetry only (not in the CSV): the chart's rated load at the reach, the reach,
+  // and the scale's and limiter's state.
+  double rated_load_kg = 0.0, load_reach_m = 0.0;
+  bool payload_converged = false, load_warning = false, load_overload = false;
   const char* active_limit = "";  // static strings only (to_string of the enums)
   const char* pump_limit = "";
   // Live-loop fields (the live loop and telemetry fill them; the CSV writer does not write them):

@@ -37,6 +37,7 @@ struct LoadSummary {
   double estimate_kg = 0.0;  // the last cycle's
   double sigma_kg = 0.0;
   bool converged = false;
+  bool weighed = false;  // the scale had a measurement at least once
   // |estimate - truth| once the scale has converged and the load has not changed for
   // settled_after_s: at rest (tip slower than 0.01 m/s) and moving (faster than 0.05 m/s).
   double max_error_rest_kg = 0.0, max_error_moving_kg = 0.0;

@@ -41,6 +41,12 @@ struct TelemetryFrame {
   double avail_speed_m_s = 0.0, avail_speed_resolved_m_s = 0.0;
   int polytope_dim = 0;
   double polytope_volume_m3_s3 = 0.0, polytope_area_m2_s2 = 0.0;
+  // The load (docs/loads.md): the simulator's truth (NaN on a machine), the crane scale's
+  // estimate and whether it has converged, the load moment against the chart, the chart's rated
+  // load at the reach, the reach, the limiter's warning and trip.
+  double load_truth_kg = 0.0, payload_estimate_kg = 0.0, load_moment_ratio = 0.0;
+  double rated_load_kg = 0.0, load_reach_m = 0.0;
+  bool payload_converged = false, load_warning = false, load_overload = false;
   // The wheeled base under the crane (sim --drive; topic craneassist/base): pose in the world
   // (x, y, heading), motion and drive command (forward speed, yaw rate), hub-motor flows (fl, fr,
   // rl, rr), their sum and the drive pump's Q_max. base_present false: a fixed base.
