@@ -277,12 +277,12 @@ TEST(ScalingEndToEnd, EndDampingStopsBeforeTheEndAndLetsTheOperatorBackOff) {
 }
 
 TEST(ScalingEndToEnd, HeavyLoadStopsWhenTheStickIsReleasedAndNeverComesBack) {
-  // A heavy load moved out-and-down and straight out at full speed, then the stick let go. Stopping a
-  // falling load raises its holding pressure; the power bound once forbade any deceleration
-  // there (sddot_min > 0) and the reference ran on at 1 m/s into the joint ends with the stick
-  // released. Reaching out, the bound asked for more deceleration than the path allows all the
-  // way to rest, and the reference overshot into a reversal of 0.1 m/s. A pump short of power
-  // never holds back a stop, and a stop never turns into a reversal.
+  // A heavy load moved out-and-down and straight out at full speed, then the stick let go. Stopping
+  // a falling load raises its holding pressure; the power bound once forbade any deceleration there
+  // (sddot_min > 0) and the reference ran on at 1 m/s into the joint ends with the stick released.
+  // Reaching out, the bound asked for more deceleration than the path allows all the way to rest,
+  // and the reference overshot into a reversal of 0.1 m/s. A pump short of power never holds back a
+  // stop, and a stop never turns into a reversal.
   const char* const replays[] = {
       "t,v_x,v_y,v_z\n0,0,0,0\n0.5,0.8,-0.8,0\n3.5,0.8,-0.8,0\n3.51,0,0,0\n12,0,0,0\n",
       "t,v_x,v_y,v_z\n0,0,0,0\n0.5,0.8,0,0\n3.5,0.8,0,0\n3.51,0,0,0\n12,0,0,0\n",
