@@ -373,6 +373,18 @@ TEST(LoadsEndToEnd, HeavyLiftUnannouncedStaysWithinPowerOnEveryResolution) {
   }
 }
 
+// Told, on the simulator the controller follows every load change of the replay too.
+TEST(LoadsEndToEnd, KnownPayloadFollowsTheReplaysLoadColumn) {
+  const auto cycle = input::Replay::load_file(kSource + "/examples/replays/work_cycle.csv");
+  const RunResult r = run(k70m(0.0), cycle, true);
+  int loaded = 0;
+  for (const auto& s : r.samples) {
+    ASSERT_EQ(s.load.model_kg, s.truth_kg) << s.t;
+    loaded += s.truth_kg == 450.0;
+  }
+  EXPECT_GT(loaded, 500);
+}
+
 TEST(LoadsEndToEnd, KnownPayloadKeepsTodaysBehaviour) {
   const auto replay = input::Replay::load_file(kSource + "/examples/replays/heavy_lift.csv");
   const RunResult r = run(k70m(650.0), replay, true);
