@@ -147,9 +147,14 @@ TEST(Controller, InvalidInputStopsWithNeutralValves) {
 TEST(Controller, CycleDoesNotAllocate) {
   Rig rig(control::ScalingMode::kFull);
   auto& [cfg, controller, state, out] = rig;
+  // Both chambers measured, changing: the crane scale runs and the dynamics' payload follows it.
+  state.chamber_pressures = true;
+  state.pressure_a_pa = dynamics::JointVector::Constant(4, 5e6);
+  state.pressure_b_pa = dynamics::JointVector::Constant(4, 0.3e6);
   controller.update(state, Eigen::Vector3d(0.1, 0.1, 0.1), out);  // first call sizes the output
   const long before = craneassist::test::heap_allocations();
   for (int k = 0; k < 200; ++k) {
+    state.pressure_a_pa.setConstant(5e6 + 2e4 * k);
     controller.update(state, Eigen::Vector3d(0.3, 0.2 * (k % 3), -0.4), out);
     state.q = out.q_ref;
   }
