@@ -22,6 +22,11 @@ valves::MachineState still_at_start(const config::CraneConfig& cfg) {
   s.q = cfg.simulation.q_initial;
   s.qdot = dynamics::JointVector::Zero(4);
   s.load_pressure_pa = dynamics::JointVector::Zero(4);
+  // Both chambers measured, as on the simulator and the K70M's bus: the crane scale runs every
+  // cycle (docs/loads.md).
+  s.chamber_pressures = true;
+  s.pressure_a_pa = dynamics::JointVector::Constant(4, 5e6);
+  s.pressure_b_pa = dynamics::JointVector::Constant(4, 0.3e6);
   s.valid = true;
   return s;
 }
