@@ -379,7 +379,7 @@ void read_bodies(Reader& r, const YAML::Node& root, dynamics::CraneModel& model)
   const YAML::Node payload = r.child(root, "payload", "");
   r.check_keys(payload, "payload", {"mass"});
   dynamics::Body p;
-  p.name = "payload";
+  p.name = dynamics::kPayloadBody;
   p.frame = model.dof();
   p.mass_kg = r.value_in(payload, "mass", "payload", Dimension::kMass, kPayloadMass);
   model.bodies.push_back(p);
@@ -853,9 +853,7 @@ void check_override(const FieldRange& range, double value) {
 
 void set_payload_mass(dynamics::CraneModel& model, double mass_kg) {
   check_override(kPayloadMass, mass_kg);
-  for (auto& body : model.bodies) {
-    if (body.name == "payload") body.mass_kg = mass_kg;
-  }
+  dynamics::set_payload_mass_kg(model, mass_kg);
 }
 
 void set_pump_max_flow(dynamics::CraneModel& model, double m3_s) {

@@ -259,7 +259,7 @@ void OdeCrane::add_joint_efforts(const JointVector& tau) {
 void OdeCrane::set_payload_mass(double mass_kg) noexcept {
   if (!(mass_kg >= 0.0)) return;
   for (Body& b : model_.bodies) {
-    if (b.name != "payload") continue;
+    if (!is_payload(b)) continue;
     b.mass_kg = mass_kg;
     const int i = b.frame;
     const MergedMass merged = merge_bodies(model_, i);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/static_gravity.hpp"
@@ -21,9 +22,7 @@ constexpr double kMemoryGrowth = 0.2;
 
 CraneModel with_empty_grapple(const CraneModel& model) {
   CraneModel m = model;
-  for (Body& b : m.bodies) {
-    if (b.name == "payload") b.mass_kg = 0.0;
-  }
+  set_payload_mass_kg(m, 0.0);
   return m;
 }
 
@@ -91,7 +90,7 @@ const PayloadEstimate& PayloadEstimator::update(bool valid, const JointVector& q
   }
 
   // The second-order low-pass (critically damped) on the rates and on the efforts alike.
-  const double w = 2.0 * 3.14159265358979 * settings_.filter_hz;
+  const double w = 2.0 * std::numbers::pi * settings_.filter_hz;
   if (!started_) {
     rate_f_ = qdot;
     acc_f_.setZero();
@@ -126,7 +125,6 @@ const PayloadEstimate& PayloadEstimator::update(bool valid, const JointVector& q
   // Correlated samples: the filter passes about 2 f_c independent values a second.
   const double kappa = std::min(1.0, 2.0 * settings_.filter_hz * settings_.period_s);
   double info = 0.0, moment = 0.0;  // this cycle's sum w y^2 and sum w y r
-  bool moving = false;
   for (int i = 0; i < n; ++i) {
     const auto& c = model_.cylinders[static_cast<std::size_t>(i)];
     const auto& j = model_.joints[static_cast<std::size_t>(i)];
@@ -145,8 +143,7 @@ const PayloadEstimate& PayloadEstimator::update(bool valid, const JointVector& q
     if (std::max(pressure_a_pa[i], pressure_b_pa[i]) >= settings_.relief_share * relief) continue;
     const auto& fr = c.friction;
     const double fc = vc >= 0.0 ? fr.coulomb_extend_n : fr.coulomb_retract_n;
-    const double friction =
-        (fc * std::tanh(vc / kFrictionSignSpeed) + fr.viscous_n_s_m * vc) * arms_[i];
+    const double friction = friction_force_n(fr, vc, kFrictionSignSpeed) * arms_[i];
     const double y = row_y_[i];
     const double r = effort_f_[i] - tau0[i] - friction;
     const double noise =
@@ -157,7 +154,6 @@ const PayloadEstimate& PayloadEstimator::update(bool valid, const JointVector& q
                          (std::abs(inertial_[i]) + std::abs(theta_ * payload_inertial_[i]));
     double var = noise * noise + d_err * d_err;
     if (row_moving) {
-      moving = true;
       const double f_err = settings_.friction_uncertainty * (fc + fr.viscous_n_s_m * std::abs(vc)) *
                            std::abs(arms_[i]);
       var += f_err * f_err;
@@ -167,7 +163,6 @@ const PayloadEstimate& PayloadEstimator::update(bool valid, const JointVector& q
     moment += y * r / var;
     ++out_.rows;
   }
-  out_.moving = moving;
   if (out_.rows == 0 || !(info > 0.0)) return out_;
 
   const double theta_cycle = moment / info;

@@ -41,7 +41,7 @@ dynamics::CraneModel without_tip_load(const dynamics::CraneModel& m) {
   out.bodies.clear();
   for (const auto& b : m.bodies) {
     const bool tip = b.frame == m.dof() && b.com_m.norm() < kAtTipM;
-    if (!(tip || b.name == "payload")) out.bodies.push_back(b);
+    if (!(tip || dynamics::is_payload(b))) out.bodies.push_back(b);
   }
   return out;
 }
@@ -51,7 +51,7 @@ void tip_bodies(const dynamics::CraneModel& m, double& mass_kg, Eigen::Vector3d&
   mass_kg = 0.0;
   inertia.setZero();
   for (const auto& b : m.bodies) {
-    if (b.frame == m.dof() && b.com_m.norm() < kAtTipM && b.name != "payload") {
+    if (b.frame == m.dof() && b.com_m.norm() < kAtTipM && !dynamics::is_payload(b)) {
       mass_kg += b.mass_kg;
       inertia += b.inertia_diag_kgm2;
     }
@@ -257,11 +257,8 @@ struct SimBackend::Impl {
       f_max *= std::abs(arm);
       const dJointID j = crane->joint(i + 1);
       // Seal and guide friction against the cylinder's motion.
-      const auto& fr = cyl.friction;
-      const double vc = qdot[i] * arm;
-      const double fc = vc >= 0.0 ? fr.coulomb_extend_n : fr.coulomb_retract_n;
       const double friction_effort =
-          -(fc * std::tanh(vc / kFrictionSmoothingM_S) + fr.viscous_n_s_m * vc) * arm;
+          -dynamics::friction_force_n(cyl.friction, v_now, kFrictionSmoothingM_S) * arm;
       if (model.joints[static_cast<std::size_t>(i)].type == dynamics::JointType::kPrismatic) {
         dJointSetSliderParam(j, dParamVel, v_target / arm);
         dJointSetSliderParam(j, dParamFMax, f_max);

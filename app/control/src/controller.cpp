@@ -20,6 +20,11 @@ constexpr double kPayloadModelStepKg = 0.5;
 // A chamber at this share of the load-holding valves' setting is at their port relief.
 constexpr double kReliefShare = 0.99;
 
+// A tip's horizontal distance from the slew axis (crane frame: y up), the load chart's reach.
+double reach_of(const Eigen::Vector3d& tip) {
+  return std::hypot(tip.x(), tip.z());
+}
+
 }  // namespace
 
 const char* to_string(ScalingMode mode) {
@@ -105,12 +110,6 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
   estimator_ = std::make_unique<dynamics::PayloadEstimator>(model_, scale);
   if (options_.mode == ScalingMode::kFull) {
     terms_ = std::make_unique<dynamics::RigidBodyTerms>(model_);
-    // Unannounced: until the scale has weighed the load, the rated load at the start pose.
-    if (!options_.payload_known) {
-      const Eigen::Vector3d tip = dynamics::tip_position(model_, kin_, q_ref_);
-      const double reach = std::hypot(tip.x(), tip.z());
-      terms_->set_payload_mass(chart_.empty() ? known_payload_kg_ : chart_.rated_kg_at(reach));
-    }
     tip_path_ = std::make_unique<scaling::TipPath>(model_, tip_path_config(config));
     scaler_ = std::make_unique<scaling::TipScaler>(model_, tip_scaler_config(config), *terms_);
   }
@@ -141,8 +140,7 @@ void Controller::update_load(const valves::MachineState& state, ControllerOutput
   const auto& est = estimator_->update(state_ok, state.q, state.qdot, state.chamber_pressures,
                                        state.pressure_a_pa, state.pressure_b_pa);
   if (state_ok) {
-    const Eigen::Vector3d tip = dynamics::tip_position(model_, kin_, state.q);
-    load.reach_m = std::hypot(tip.x(), tip.z());
+    load.reach_m = reach_of(dynamics::tip_position(model_, kin_, state.q));
   }
   load.rated_kg = chart_.empty() ? 0.0 : chart_.rated_kg_at(load.reach_m);
   load.weighed = std::isfinite(est.sigma_kg);
@@ -289,7 +287,7 @@ void Controller::update_full(const valves::MachineState& state, const Eigen::Vec
   // motion that brings the load in, or keeps its reach, stays free.
   if (!chart_.empty()) {
     const Eigen::Vector3d tip = dynamics::tip_position(model_, kin_, q_ref_);
-    const double reach = std::hypot(tip.x(), tip.z());
+    const double reach = reach_of(tip);
     const double outwards = reach > 0.0 ? (tip.x() * u.x() + tip.z() * u.z()) / reach : 0.0;
     const bool out_bound = outwards > kOutwardShare && v_cmd.norm() > 0.0;
     const double stop = scaling::braking_distance(

@@ -115,11 +115,9 @@ void RunStatistics::add_load(double t, double tip_speed, const valves::MachineSt
     const double err = std::abs(est.estimate_kg - state.payload_truth_kg);
     if (tip_speed < kRestSpeed) {
       l.max_error_rest_kg = std::max(l.max_error_rest_kg, err);
-      l.sum_sq_error_rest += err * err;
       ++l.rest_samples;
     } else if (tip_speed > kMovingSpeed) {
       l.max_error_moving_kg = std::max(l.max_error_moving_kg, err);
-      l.sum_sq_error_moving += err * err;
       ++l.moving_samples;
     }
   }

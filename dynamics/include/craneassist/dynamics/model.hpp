@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -65,10 +66,15 @@ struct CylinderFriction {
   double coulomb_extend_n = 0.0;   // while extending
   double coulomb_retract_n = 0.0;  // while retracting
   double viscous_n_s_m = 0.0;      // per m/s of cylinder speed
-  bool any() const {
-    return coulomb_extend_n > 0.0 || coulomb_retract_n > 0.0 || viscous_n_s_m > 0.0;
-  }
 };
+
+// The friction force at cylinder speed v (N, along v: the motion pays it), the Coulomb part
+// turning from one direction to the other over about sign_speed_m_s (tanh). The simulator and the
+// payload estimator each use it with their own sign_speed.
+inline double friction_force_n(const CylinderFriction& f, double v_m_s, double sign_speed_m_s) {
+  const double coulomb = v_m_s >= 0.0 ? f.coulomb_extend_n : f.coulomb_retract_n;
+  return coulomb * std::tanh(v_m_s / sign_speed_m_s) + f.viscous_n_s_m * v_m_s;
+}
 
 struct Cylinder {
   std::string name;
@@ -229,12 +235,26 @@ inline double load_holding_relief_pa(const CraneModel& m) {
   return m.load_holding.relief_pa > 0.0 ? m.load_holding.relief_pa : m.pump.max_pressure_pa;
 }
 
-// The payload body's mass (the body named "payload"; 0 when the model has none).
+// The payload in the grapple is the body of this name (the config's payload.mass).
+inline constexpr std::string_view kPayloadBody = "payload";
+inline bool is_payload(const Body& b) {
+  return b.name == kPayloadBody;
+}
+
+// The payload body's mass (0 when the model has none).
 inline double payload_mass_kg(const CraneModel& m) {
   for (const Body& b : m.bodies) {
-    if (b.name == "payload") return b.mass_kg;
+    if (is_payload(b)) return b.mass_kg;
   }
   return 0.0;
+}
+
+// Sets the payload body's mass (a model without one: nothing changes). No range check (config's
+// set_payload_mass checks the config field's range). No allocation.
+inline void set_payload_mass_kg(CraneModel& m, double mass_kg) {
+  for (Body& b : m.bodies) {
+    if (is_payload(b)) b.mass_kg = mass_kg;
+  }
 }
 
 // Effective area the pump must fill for cylinder velocity v (algorithms.md section 2).

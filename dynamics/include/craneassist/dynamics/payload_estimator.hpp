@@ -61,9 +61,8 @@ struct PayloadEstimate {
   double mass_kg = 0.0;   // the estimate (>= 0)
   double sigma_kg = 0.0;  // its standard error (infinite before any data)
   bool converged = false;
-  bool moving = false;  // the last update's rows came from a moving crane
-  int rows = 0;         // rows used in the last update
-  long restarts = 0;    // load changes detected
+  int rows = 0;       // rows used in the last update
+  long restarts = 0;  // load changes detected
   // What a caller that must not underestimate uses: the estimate once converged, else the larger
   // of it and the rated load.
   double conservative_kg(double rated_kg) const {

@@ -152,7 +152,6 @@ class Controller {
   // The ODE dynamics probe of kFull (nullptr in the other modes). For tests: its
   // fail_steps_for_testing() hook makes the cycle's dynamics step fail.
   dynamics::RigidBodyTerms* dynamics_for_testing() noexcept { return terms_.get(); }
-  const dynamics::PayloadEstimator& payload_estimator() const noexcept { return *estimator_; }
   // How often a command reaches the valves (ControllerOptions::valve_command_period_s).
   void set_valve_command_period(double period_s);
 

@@ -41,7 +41,6 @@ struct LoadSummary {
   // |estimate - truth| once the scale has converged and the load has not changed for
   // settled_after_s: at rest (tip slower than 0.01 m/s) and moving (faster than 0.05 m/s).
   double max_error_rest_kg = 0.0, max_error_moving_kg = 0.0;
-  double sum_sq_error_rest = 0.0, sum_sq_error_moving = 0.0;
   long rest_samples = 0, moving_samples = 0;
   double peak_moment_ratio = 0.0;
   long warning_cycles = 0;   // load moment at 90 % of the chart or more
