@@ -7,6 +7,7 @@
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/control/csv_log.hpp"
+#include "craneassist/offline/sim_setup.hpp"
 #include "craneassist/offline/sine_path_experiment.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
 #include "exit_codes.hpp"
@@ -36,8 +37,9 @@ int run_experiment_command(const ExperimentArgs& args) {
     dynamics::JointVector q0, f1, f2;
     offline::sine_path(0.0, q0, f1, f2);
     options.pump_power_limiter = args.pump_limiter;
-    sim_backend::SimBackend machine(offline::machine_model(cfg, options),
-                                    {cfg.simulation.step_s, q0});
+    sim_backend::SimSettings settings = offline::sim_settings(cfg);
+    settings.q_initial = q0;
+    sim_backend::SimBackend machine(offline::machine_model(cfg, options), settings);
     std::optional<control::CsvLog> log;
     if (!args.no_log) log.emplace(args.log_file, cfg.model.dof());
     const auto s = offline::run_sine_path(cfg, options, machine, log ? &*log : nullptr);

@@ -228,8 +228,9 @@ int run_trajectory_command(const ReplayArgs& args, const config::CraneConfig& cf
     return kExitUsage;
   }
   try {
-    sim_backend::SimBackend machine(cfg.model,
-                                    {cfg.simulation.step_s, dynamics::JointVector(traj->q(0))});
+    sim_backend::SimSettings settings = offline::sim_settings(cfg);
+    settings.q_initial = traj->q(0);
+    sim_backend::SimBackend machine(cfg.model, settings);
     std::optional<control::CsvLog> log;
     if (!args.no_log) log.emplace(args.log_file, cfg.model.dof());
     control::TrajectoryRunOptions options;

@@ -4,6 +4,7 @@
 #include <ostream>
 
 #include "craneassist/control/trajectory_runner.hpp"
+#include "craneassist/offline/sim_setup.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
 
 namespace craneassist::offline {
@@ -71,8 +72,9 @@ std::vector<EnergyRun> run_energy_experiment(const config::CraneConfig& config,
         if (mode == dynamics::PumpMode::kConstantPressure) {
           cfg.model.pump.supply_pressure_pa = options.cp_supply_pressure_pa;
         }
-        sim_backend::SimBackend machine(cfg.model,
-                                        {cfg.simulation.step_s, dynamics::JointVector(traj.q(0))});
+        sim_backend::SimSettings settings = sim_settings(cfg);
+        settings.q_initial = traj.q(0);
+        sim_backend::SimBackend machine(cfg.model, settings);
         const auto summary = control::run_trajectory(cfg, traj, machine, {}, nullptr);
         planner::Plan judged = p.plan;
         planner::evaluate_plan(mode == dynamics::PumpMode::kLoadSensing ? ls_model : cp_model,
