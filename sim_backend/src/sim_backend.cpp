@@ -135,8 +135,6 @@ struct SimBackend::Impl {
     load_joint = dJointCreateFixed(world, nullptr);
     dJointAttach(load_joint, load_body, crane->body(model.dof()));
     dJointSetFixed(load_joint);
-    dJointSetFixedParam(load_joint, dParamCFM, 0.0);
-    dJointSetFixedParam(load_joint, dParamERP, 0.0);
   }
 
   void apply_load_mass() {
