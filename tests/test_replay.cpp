@@ -23,6 +23,29 @@
 namespace craneassist::input {
 namespace {
 
+// The query times a cursor meets, 20000 of them: random jumps either way, exact row times, and
+// the small forward steps of a control loop. rows end before t_end.
+std::vector<double> cursor_queries(const std::vector<ReplayRow>& rows, double t_end,
+                                   std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> any_time(-1.0, t_end + 1.0);
+  std::uniform_int_distribution<std::size_t> any_row(0, rows.size() - 1);
+  std::uniform_real_distribution<double> step(0.0, 0.05);
+  std::vector<double> queries;
+  double q = -0.1;
+  for (int i = 0; i < 20000; ++i) {
+    const int kind = i % 7;
+    if (kind == 0) {
+      q = any_time(rng);  // random jump, either direction
+    } else if (kind == 1) {
+      q = rows[any_row(rng)].t_s;  // exactly on a row time
+    } else {
+      q += step(rng);  // typical control-loop progression
+    }
+    queries.push_back(q);
+  }
+  return queries;
+}
+
 namespace fs = std::filesystem;
 
 constexpr const char* kSource = "bad_replay.csv";
@@ -343,19 +366,7 @@ TEST(ReplayZeroOrderHold, MatchesLinearScanForRandomQueries) {
   };
 
   ReplayCursor c(r);
-  std::uniform_real_distribution<double> any_time(-1.0, t + 1.0);
-  std::uniform_int_distribution<std::size_t> any_row(0, rows.size() - 1);
-  std::uniform_real_distribution<double> step(0.0, 0.05);
-  double q = -0.1;
-  for (int i = 0; i < 20000; ++i) {
-    const int kind = i % 7;
-    if (kind == 0) {
-      q = any_time(rng);  // random jump, either direction
-    } else if (kind == 1) {
-      q = rows[any_row(rng)].t_s;  // exactly on a row time
-    } else {
-      q += step(rng);  // typical control-loop progression
-    }
+  for (const double q : cursor_queries(rows, t, rng)) {
     ASSERT_EQ(c.command_at(q), reference(q)) << "query " << q;
   }
 }
@@ -738,19 +749,7 @@ TEST(ReplayLoadColumn, CursorMatchesLinearScanForRandomQueries) {
     return load;
   };
   ReplayCursor c(r);
-  std::uniform_real_distribution<double> any_time(-1.0, t + 1.0);
-  std::uniform_int_distribution<std::size_t> any_row(0, rows.size() - 1);
-  std::uniform_real_distribution<double> step(0.0, 0.05);
-  double q = -0.1;
-  for (int i = 0; i < 20000; ++i) {
-    const int kind = i % 7;
-    if (kind == 0) {
-      q = any_time(rng);
-    } else if (kind == 1) {
-      q = rows[any_row(rng)].t_s;
-    } else {
-      q += step(rng);
-    }
+  for (const double q : cursor_queries(rows, t, rng)) {
     const double expected = reference(q);
     const double actual = c.load_at(q);
     ASSERT_TRUE(std::bit_cast<std::uint64_t>(actual) == std::bit_cast<std::uint64_t>(expected) ||
