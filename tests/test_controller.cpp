@@ -237,7 +237,16 @@ TEST(Controller, AFailedDynamicsStepStopsInsteadOfThrowing) {
         EXPECT_STREQ(scaling::to_string(out.limit), "dynamics_failed");
         EXPECT_EQ(out.ref_power_w, 0.0);
       });
-  EXPECT_EQ(r.controller.update(r.state, v, r.out), control::ControllerStatus::kStopped);
+  // The machine at rest at the reference: measured at rest for the valves' lag, the valves ramp
+  // to neutral.
+  r.state.qdot.setZero();
+  control::ControllerStatus stopped = control::ControllerStatus::kStopping;
+  for (int k = 0; k < 60 && stopped != control::ControllerStatus::kStopped; ++k) {
+    r.state.q = r.out.q_ref;
+    stopped = r.controller.update(r.state, v, r.out);
+  }
+  EXPECT_EQ(stopped, control::ControllerStatus::kStopped);
+  EXPECT_EQ(r.out.stop_end, control::StopEnd::kAtRest);
 
   // The dynamics back: the controller restarts from the measured pose and runs.
   r.controller.dynamics_for_testing()->fail_steps_for_testing(false);

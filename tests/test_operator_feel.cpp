@@ -41,7 +41,9 @@ Totals run_suite(const std::string& resolution, bool expect_every_target) {
       EXPECT_TRUE(out.ok()) << run.name() << ": " << missed;
     } else {
       // Baselines: no stall, the heavy lift within power and on its line, lateral speed within
-      // twice the target.
+      // three times the target (the slew-rate limit on the spool commands slows the baselines'
+      // section reversals: pinv-joint's sideways push reaches 0.072 m/s before a joint end, 0.023
+      // without the limit; docs/valves.md).
       EXPECT_EQ(s.feel.stall_events, 0) << run.name();
       if (run.targets.peak_power_share) {
         EXPECT_LE(s.peak_power_w, *run.targets.peak_power_share * out.p_max_w) << run.name();
@@ -51,7 +53,7 @@ Totals run_suite(const std::string& resolution, bool expect_every_target) {
             << run.name();
       }
       if (s.feel.one_line && run.targets.lateral_speed_m_s) {
-        EXPECT_LE(s.feel.lateral_peak_m_s, 2.0 * *run.targets.lateral_speed_m_s) << run.name();
+        EXPECT_LE(s.feel.lateral_peak_m_s, 3.0 * *run.targets.lateral_speed_m_s) << run.name();
       }
     }
   }

@@ -241,8 +241,9 @@ TEST(ReferenceFollower, CommandsTheTableInverse) {
   dynamics::cylinder_arms(cfg.model, q, arms);
   valves::ValveCommand out;
   follower.update(q, qdot, nullptr, out);
-  EXPECT_EQ(out.spool[3], 1.0);  // from neutral: deadbeat through the dead band, clipped
-  for (int k = 0; k < 20; ++k) follower.update(q, qdot, nullptr, out);
+  // From neutral: led through the dead band, at most the slew-rate limit per cycle.
+  EXPECT_EQ(out.spool[3], follower.max_step());
+  for (int k = 0; k < 30; ++k) follower.update(q, qdot, nullptr, out);
   EXPECT_NEAR(out.spool[3], dynamics::valve_table_command(curved_table(), arms[3] * 0.07), 1e-9);
   EXPECT_NEAR(out.spool[1], dynamics::valve_table_command(curved_table(), arms[1] * -0.1), 1e-9);
   EXPECT_EQ(out.spool[0], 0.0);

@@ -93,6 +93,42 @@ void print_feel_line(const control::MotionQualityResult& f) {
 
 }  // namespace
 
+double spool_step_bound(const config::CraneConfig& cfg) {
+  const double stroke = cfg.model.valves.stroke_time_s;
+  return stroke > 0.0 ? std::min(1.0 / (cfg.control.rate_hz * stroke), 2.0) : 2.0;
+}
+
+void print_stop_lines(const control::StopSummary& st, bool end_stop, double stop_time_s,
+                      double run_peak_spool_step, double stop_step_bound) {
+  if (st.stops == 0) return;
+  std::printf("  %s: stopped jerk-limited in %.2f s, ", end_stop ? "end of run" : "stop",
+              stop_time_s);
+  const double v = st.tip_speed_at_neutral_m_s;
+  switch (st.end) {
+    case control::StopEnd::kAtRest:
+      std::printf("at rest (tip %.3f m/s), then valves neutral\n", v);
+      break;
+    case control::StopEnd::kTimeout:
+      std::printf(
+          "NOT AT REST at the rest timeout (tip %.3f m/s): valves neutral on a moving crane\n", v);
+      break;
+    case control::StopEnd::kUnmeasured:
+      std::printf("no measurement: valves neutral with the reference at rest\n");
+      break;
+    case control::StopEnd::kNone:
+      std::printf("then valves neutral\n");
+      break;
+  }
+  std::printf(
+      "  stops: %ld to neutral valves, tip at most %.3f m/s then (%ld after the rest timeout, %ld "
+      "without a measurement); spool step at most %.2f per cycle (run %.2f, limit %.2f), %ld "
+      "cycles fully open against the stop's side; load pressure in stops up to %.1f MPa "
+      "(%.1f MPa before)\n",
+      st.stops, st.max_tip_speed_at_neutral_m_s, st.timeouts, st.unmeasured, st.peak_spool_step,
+      run_peak_spool_step, stop_step_bound, st.full_reverse_cycles, st.peak_load_pressure_pa * 1e-6,
+      st.steady_load_pressure_pa * 1e-6);
+}
+
 void print_load_line(const control::LoadSummary& l, bool known, bool chart) {
   if (!known && !l.weighed) {
     std::printf(
@@ -161,12 +197,11 @@ void print_summary(const control::RunSummary& s, const config::CraneConfig& cfg,
         "neutral in %ld\n",
         s.stopped_cycles, s.input_stop_cycles, s.neutral_valve_cycles);
   }
-  if (s.end_stop && s.stop_cycles > 1) {
-    std::printf("  end of run: stopped jerk-limited in %.2f s, then valves neutral\n",
-                static_cast<double>(s.stop_cycles) / cfg.control.rate_hz);
-  } else if (s.end_stop) {
-    std::printf("  end of run: at rest, valves neutral\n");
-  }
+  if (s.end_stop && s.stop_cycles <= 1) std::printf("  end of run: at rest, valves neutral\n");
+  const bool end = s.end_stop && s.stop_cycles > 1;
+  print_stop_lines(s.stop, end,
+                   end ? static_cast<double>(s.stop_cycles) / cfg.control.rate_hz : s.stop.time_s,
+                   s.peak_spool_step, spool_step_bound(cfg));
   if (mode == control::ScalingMode::kFull) {
     std::printf("  path jerk: peak %.2f m/s^3 (bound %.2f)\n", s.peak_path_jerk,
                 cfg.scaling.jerk_max_m_s3);

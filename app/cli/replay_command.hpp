@@ -43,6 +43,14 @@ CLI::App* add_replay_command(CLI::App& cli, ReplayArgs& args);
 // The summary's load lines (docs/loads.md): the crane scale against the simulated load, the load
 // moment against the chart, a load above a port relief. Shared by replay and sim.
 void print_load_line(const control::LoadSummary& load, bool known, bool chart);
+// The summary's stop lines (docs/safety.md): how the last stop ended (the measured tip speed when
+// the valves went neutral, at rest or after the rest timeout) and, over every stop, spool steps,
+// reverse kicks and load pressures. end_stop: the run ended by that stop ("end of run", else
+// "stop"). Shared by replay and sim.
+void print_stop_lines(const control::StopSummary& stop, bool end_stop, double stop_time_s,
+                      double run_peak_spool_step, double stop_step_bound);
+// The most a spool command may move per control cycle (hydraulics.valves.stroke_time; 2: none).
+double spool_step_bound(const config::CraneConfig& cfg);
 int run_replay_command(const ReplayArgs& args);
 
 }  // namespace craneassist::cli

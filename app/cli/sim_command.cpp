@@ -508,11 +508,10 @@ int run_sim_command(const SimArgs& args) {
                 s.tip_path_m, s.peak_tip_speed_m_s, s.enabled_cycles);
     std::printf("  cycle timing: %s\n", control::describe(s.timing).c_str());
     print_load_line(s.load, args.payload_known, !cfg.load_chart.empty());
-    if (s.stop_cycles > 0) {
-      std::printf("  %s: stopped jerk-limited in %.2f s, then valves neutral\n",
-                  s.end_stop ? "end of run" : "stop",
-                  static_cast<double>(s.stop_cycles) / cfg.control.rate_hz);
-    }
+    print_stop_lines(s.stop, s.end_stop,
+                     s.stop_cycles > 0 ? static_cast<double>(s.stop_cycles) / cfg.control.rate_hz
+                                       : s.stop.time_s,
+                     s.peak_spool_step, spool_step_bound(cfg));
     if (options.realtime_setup.lock_memory || options.realtime_setup.priority > 0 ||
         options.realtime_setup.cpu >= 0) {
       const control::RealtimeResult& r = s.realtime_result;

@@ -487,13 +487,17 @@ void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& mo
 
   const YAML::Node valves = r.child(h, "valves", "hydraulics");
   const std::string vp = "hydraulics.valves";
-  r.check_keys(valves, vp, {"dead_zone", "time_constant", "delay", "tables"});
+  r.check_keys(valves, vp, {"dead_zone", "time_constant", "delay", "stroke_time", "tables"});
   auto& v = model.valves;
   v.dead_zone = r.value_in(valves, "dead_zone", vp, Dimension::kDimensionless, 0.0, 0.95,
                            "between 0 and 0.95");
   v.time_constant_s =
       r.value_in(valves, "time_constant", vp, Dimension::kTime, 0.0, 5.0, "between 0 and 5 s");
   v.delay_s = r.value_in(valves, "delay", vp, Dimension::kTime, 0.0, 2.0, "between 0 and 2 s");
+  if (valves["stroke_time"].IsDefined()) {
+    v.stroke_time_s = r.value_in(valves, "stroke_time", vp, Dimension::kTime, 0.0, 5.0,
+                                 "between 0 and 5 s (0: no slew-rate limit)");
+  }
   if (valves["tables"].IsDefined()) read_valve_tables(r, valves["tables"], vp + ".tables", model);
   if (h["mhsb"].IsDefined() && !h["mhsb"].IsNull()) read_mhsb(r, h["mhsb"], model);
   // Optional load-holding valves (docs/loads.md); left out: loads are held up to the pump's
@@ -599,7 +603,8 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
 
   const YAML::Node control = r.child(root, "control", "");
   r.check_keys(control, "control",
-               {"rate", "position_gain", "flow_reserve", "activation_speed", "activation_error"});
+               {"rate", "position_gain", "flow_reserve", "activation_speed", "activation_error",
+                "rest_speed", "rest_timeout"});
   cfg.control.rate_hz =
       r.value_in(control, "rate", "control", Dimension::kFrequency, 1.0, 10000.0, "1 to 10000 Hz");
   cfg.control.position_gain_1_s = r.value_in(control, "position_gain", "control",
@@ -613,6 +618,15 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   if (control["activation_error"].IsDefined()) {
     cfg.control.activation_error_m = r.value_in(control, "activation_error", "control",
                                                 Dimension::kLength, 0.0, 0.1, "0 to 0.1 m");
+  }
+
+  if (control["rest_speed"].IsDefined()) {
+    cfg.control.rest_speed_m_s = r.value_in(control, "rest_speed", "control", Dimension::kVelocity,
+                                            1e-4, 0.1, "0.1 mm/s to 0.1 m/s");
+  }
+  if (control["rest_timeout"].IsDefined()) {
+    cfg.control.rest_timeout_s =
+        r.value_in(control, "rest_timeout", "control", Dimension::kTime, 0.0, 4.0, "0 to 4 s");
   }
 
   const YAML::Node scaling = r.child(root, "scaling", "");
@@ -648,7 +662,8 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   }
 
   const YAML::Node sim = r.child(root, "simulation", "");
-  r.check_keys(sim, "simulation", {"step", "initial", "pressure_sensors", "return_pressure"});
+  r.check_keys(sim, "simulation",
+               {"step", "initial", "pressure_sensors", "return_pressure", "spool_time_constant"});
   cfg.simulation.step_s =
       r.value_in(sim, "step", "simulation", Dimension::kTime, 1e-5, 1e-2, "between 0.01 and 10 ms");
   const double period = 1.0 / cfg.control.rate_hz;
@@ -689,6 +704,10 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
     cfg.simulation.return_pressure_pa =
         r.value_in(sim, "return_pressure", "simulation", Dimension::kPressure, 0.0,
                    model.pump.max_pressure_pa, "between 0 and the pump's max_pressure");
+  }
+  if (sim["spool_time_constant"].IsDefined()) {
+    cfg.simulation.spool_time_constant_s = r.value_in(
+        sim, "spool_time_constant", "simulation", Dimension::kTime, 0.0, 5.0, "between 0 and 5 s");
   }
   read_load_chart(r, root, cfg.load_chart);
   read_backend(r, root, cfg.backend);

@@ -74,10 +74,12 @@ struct SimBackend::Impl {
     rng.seed(s.noise_seed);
     const int n = model.dof();
     feedback.resize(static_cast<std::size_t>(n) + 1);
+    dynamics::ValveSections valves = model.valves;
+    if (s.spool_time_constant_s >= 0.0) valves.time_constant_s = s.spool_time_constant_s;
     for (int i = 1; i <= n; ++i) {
       dJointSetFeedback(crane->joint(i), &feedback[static_cast<std::size_t>(i)]);
-      sections.emplace_back(model.valves,
-                            model.cylinders[static_cast<std::size_t>(i - 1)].v_max_m_s, s.step_s);
+      sections.emplace_back(valves, model.cylinders[static_cast<std::size_t>(i - 1)].v_max_m_s,
+                            s.step_s);
     }
     spool_command.setZero(n);
     requested_velocity.setZero(n);

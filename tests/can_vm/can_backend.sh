@@ -188,9 +188,12 @@ start_capture /tmp/cap10.log
   --can-feedback-timeout 0.3 >/tmp/f10.out 2>&1; rc=$?
 stop_capture
 kill "$emu"; wait "$emu"
-grep "CAN\|end of run" /tmp/f10.out
+grep "CAN\|end of run\|stops:" /tmp/f10.out
 [ "$rc" = 0 ] || fail "end of run: expected exit 0, got $rc"
 grep -q "end of run: stopped jerk-limited" /tmp/f10.out || fail "end of run: no stop reported"
+# The valves go neutral only with the machine measured at rest (issue 27).
+grep -Eq "end of run: .*at rest \(tip 0\.00[0-9] m/s\)" /tmp/f10.out ||
+  fail "end of run: the valves went neutral on a moving crane"
 ./can_backend_check stop /tmp/cap10.log 250 || fail "end of run: valves not brought down gradually"
 
 echo "=== 11. sim --duration ends while the crane moves"
@@ -202,6 +205,8 @@ stop_capture
 kill "$emu"; wait "$emu"
 cat /tmp/f11.out
 [ "$rc" = 0 ] || fail "--duration: expected exit 0, got $rc"
+grep -Eq "end of run: .*at rest \(tip 0\.00[0-9] m/s\)" /tmp/f11.out ||
+  fail "--duration: the valves went neutral on a moving crane"
 ./can_backend_check stop /tmp/cap11.log 250 || fail "--duration: valves not brought down gradually"
 
 echo "=== 12. SIGINT while the crane moves (the operator quits)"
@@ -219,6 +224,8 @@ kill "$emu"; wait "$emu"
 cat /tmp/f12.out
 [ "$rc" = 0 ] || fail "SIGINT: expected exit 0, got $rc"
 grep -q "ran [0-2]\.[0-9]* s of machine time" /tmp/f12.out || fail "SIGINT: the run did not end early"
+grep -Eq "stop: .*at rest \(tip 0\.00[0-9] m/s\)" /tmp/f12.out ||
+  fail "SIGINT: the valves went neutral on a moving crane"
 ./can_backend_check stop /tmp/cap12.log 250 || fail "SIGINT: valves not brought down gradually"
 echo "=== 14. J1939 address claim: a node with a higher-priority NAME holds 0x80"
 # j1939_rival (raw socket, not the project's codecs) answers craneassist's claim with its own.

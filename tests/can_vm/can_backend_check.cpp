@@ -175,7 +175,15 @@ int compare(const char* sim_path, const char* can_path, double tol, bool with_pu
         eb * 1e-3, ea * 1e-3, peak_b * 6e4, peak_a * 6e4);
     pump_ok = ea > 0.0 && std::abs(eb - ea) <= 0.15 * ea;
   }
-  return (max_d <= tol && a.size() == b.size() && pump_ok) ? 0 : 1;
+  // The runs end when the machine is measured at rest (docs/safety.md): over the bus the
+  // differentiated encoder velocity settles a little later or earlier than the simulator's, so
+  // the logs may differ by up to half a second of rows.
+  constexpr std::size_t kRestRows = 50;
+  const std::size_t longer = std::max(a.size(), b.size());
+  const bool lengths_ok = longer - n <= kRestRows;
+  std::printf("rows: sim backend %zu, can backend %zu (at most %zu apart)\n", a.size(), b.size(),
+              kRestRows);
+  return (max_d <= tol && lengths_ok && pump_ok) ? 0 : 1;
 }
 
 // The tip direction error of a run log, two ways: from the logged tip velocity (what the run's

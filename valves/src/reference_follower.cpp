@@ -6,6 +6,14 @@
 #include "craneassist/dynamics/cylinders.hpp"
 
 namespace craneassist::valves {
+namespace {
+
+// The lead's search: steps of the predicted return to the wanted command (2 / max_step at most
+// matter), and bisections of the command.
+constexpr int kMaxLeadSteps = 64;
+constexpr int kLeadBisections = 20;
+
+}  // namespace
 
 ReferenceFollower::ReferenceFollower(const dynamics::CraneModel& model, double position_gain_1_s,
                                      double period_s, double activation_speed_m_s,
@@ -15,7 +23,10 @@ ReferenceFollower::ReferenceFollower(const dynamics::CraneModel& model, double p
       period_s_(period_s),
       lag_alpha_(model.valves.time_constant_s > 0.0
                      ? 1.0 - std::exp(-period_s / model.valves.time_constant_s)
-                     : 1.0) {
+                     : 1.0),
+      max_step_(model.valves.stroke_time_s > 0.0
+                    ? std::min(period_s / model.valves.stroke_time_s, 2.0)
+                    : 2.0) {
   const int n = model.dof();
   in_.velocity_ref_m_s.setZero(n);
   in_.position_error_m.setZero(n);
@@ -23,6 +34,8 @@ ReferenceFollower::ReferenceFollower(const dynamics::CraneModel& model, double p
   c_ref_.setZero(n);
   c_meas_.setZero(n);
   spool_estimate_.setZero(n);
+  last_command_.setZero(n);
+  zero_.setZero(n);
   const double lag_s = model.valves.delay_s + model.valves.time_constant_s;
   q_ref_history_.assign(static_cast<std::size_t>(std::lround(lag_s / period_s)) + 1,
                         JointVector::Zero(n));
@@ -32,19 +45,46 @@ void ReferenceFollower::reset(const JointVector& q) {
   for (auto& h : q_ref_history_) h = q;
   head_ = 0;
   spool_estimate_.setZero();
+  last_command_.setZero();
 }
 
 void ReferenceFollower::set_command_period(double command_period_s) {
   lead_ = !(command_period_s > period_s_ * (1.0 + 1e-6));
 }
 
-void ReferenceFollower::neutral(ValveCommand& out) {
-  out.spool.setZero(model_.dof());
-  spool_estimate_ += lag_alpha_ * (out.spool - spool_estimate_);
+double ReferenceFollower::send(int i, double command) {
+  const double last = last_command_[i];
+  command = std::clamp(std::clamp(command, -1.0, 1.0), last - max_step_, last + max_step_);
+  spool_estimate_[i] += lag_alpha_ * (command - spool_estimate_[i]);
+  last_command_[i] = command;
+  return command;
+}
+
+bool ReferenceFollower::neutral(ValveCommand& out) {
+  const int n = model_.dof();
+  out.spool.resize(n);
+  bool all = true;
+  for (int i = 0; i < n; ++i) {
+    out.spool[i] = send(i, 0.0);
+    all = all && out.spool[i] == 0.0;
+  }
+  return all;
 }
 
 void ReferenceFollower::update(const JointVector& q_ref, const JointVector& qdot_ref,
-                               const JointVector* q_meas, ValveCommand& out) {
+                               const JointVector* q_meas, ValveCommand& out, bool with_lead) {
+  follow(q_ref, qdot_ref, q_meas, -1.0, with_lead, out);
+}
+
+void ReferenceFollower::hold(const JointVector& q_ref, const JointVector& q_meas,
+                             double hold_error_m, ValveCommand& out) {
+  follow(q_ref, zero_, &q_meas, std::max(hold_error_m, 0.0), false, out);
+}
+
+void ReferenceFollower::follow(const JointVector& q_ref, const JointVector& qdot_ref,
+                               const JointVector* q_meas, double hold_error_m, bool with_lead,
+                               ValveCommand& out) {
+  const bool holding = hold_error_m >= 0.0;
   const int n = model_.dof();
   dynamics::cylinder_arms(model_, q_ref, dc_dq_);
   for (int i = 0; i < n; ++i) in_.velocity_ref_m_s[i] = dc_dq_[i] * qdot_ref[i];
@@ -58,23 +98,55 @@ void ReferenceFollower::update(const JointVector& q_ref, const JointVector& qdot
     in_.position_error_m.setZero(n);
   }
   valves_.update(in_, out);
-  // Deadbeat compensation of the spool lag while a spool still has to cross the dead zone to the
-  // side it is wanted on (no flow passes there, so a fast crossing costs nothing); outside it
-  // the wanted position goes through unchanged, so feedback corrections are not amplified. Only
-  // when every command reaches the valves: held for two cycles, the lead would overshoot.
+  // Compensation of the spool lag while a spool still has to cross the dead band to the side it
+  // is wanted on (no flow passes there, so a fast crossing costs nothing): the largest command,
+  // at most the wanted one plus the dead band's width (and the way back to neutral while the
+  // spool is still on the other side), that the spool estimate does not carry
+  // past the wanted position when the command then comes back to it at the slew-rate limit (the
+  // deadbeat step when there is no limit). Outside the band the wanted position goes through
+  // unchanged, so feedback corrections are not amplified. Only when every command reaches the
+  // valves (held for two cycles, the lead would overshoot), and never while holding.
   for (int i = 0; i < n; ++i) {
-    const double wanted = out.spool[i];
-    const double estimate = spool_estimate_[i];
-    // The dead band on the wanted side (the section's table, or the straight line's dead_zone).
-    const double edge = wanted != 0.0 ? valves_.dead_band_edge(i, wanted) : 0.0;
-    const bool crossing =
-        wanted != 0.0 && (estimate * wanted <= 0.0 || std::abs(estimate) < std::abs(edge));
-    const double command = crossing && lead_
-                               ? std::clamp(estimate + (wanted - estimate) / lag_alpha_, -1.0, 1.0)
-                               : wanted;
-    spool_estimate_[i] += lag_alpha_ * (command - spool_estimate_[i]);
-    out.spool[i] = command;
+    double wanted = out.spool[i];
+    if (holding && std::abs(in_.position_error_m[i]) < hold_error_m) wanted = 0.0;
+    double command = wanted;
+    if (wanted != 0.0 && lead_ && with_lead && !holding) {
+      const double side = wanted > 0.0 ? 1.0 : -1.0;
+      const double band = std::abs(valves_.dead_band_edge(i, wanted));
+      const double x = side * spool_estimate_[i];  // how far towards the wanted edge
+      if (x < band) command = side * lead(x, side * last_command_[i], std::abs(wanted), band);
+    }
+    out.spool[i] = send(i, command);
   }
+}
+
+double ReferenceFollower::lead(double x, double last, double target, double band) const {
+  // Sided coordinates: x the spool estimate, last the last command, target the wanted command.
+  const double low = std::max(target, last - max_step_);
+  // At most the wanted command plus the way to its band edge from neutral (the dead band's
+  // width), and the way back to neutral when the spool is still on the other side.
+  const double over = band - std::min(x, 0.0);
+  const double high = std::min({target + over, 1.0, last + max_step_});
+  if (!(high > low)) return std::max(low, std::min(target, high));
+  // Where the estimate ends when the command c is sent now, then steps back to the target.
+  auto peak = [&](double c) {
+    double e = x + lag_alpha_ * (c - x);
+    double top = e;
+    for (int k = 0; k < kMaxLeadSteps && c > target; ++k) {
+      c = std::max(c - max_step_, target);
+      e += lag_alpha_ * (c - e);
+      top = std::max(top, e);
+    }
+    return top;
+  };
+  if (peak(high) <= target) return high;
+  if (peak(low) > target) return low;
+  double lo = low, hi = high;  // peak(lo) <= target < peak(hi)
+  for (int k = 0; k < kLeadBisections; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (peak(mid) <= target ? lo : hi) = mid;
+  }
+  return lo;
 }
 
 }  // namespace craneassist::valves

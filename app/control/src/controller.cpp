@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/scaling/scaling_filter.hpp"
@@ -35,6 +36,20 @@ const char* to_string(ScalingMode mode) {
       return "flow";
     case ScalingMode::kNone:
       return "none";
+  }
+  return "?";
+}
+
+const char* to_string(StopEnd end) {
+  switch (end) {
+    case StopEnd::kNone:
+      return "";
+    case StopEnd::kAtRest:
+      return "at rest";
+    case StopEnd::kTimeout:
+      return "rest timeout";
+    case StopEnd::kUnmeasured:
+      return "no measurement";
   }
   return "?";
 }
@@ -97,6 +112,13 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
       polytope_(config.model.dof(), 3) {
   follower_.set_command_period(options.valve_command_period_s);
   const int n = model_.dof();
+  rest_speed_m_s_ = config.control.rest_speed_m_s;
+  hold_error_m_ = config.control.activation_error_m;
+  rest_timeout_cycles_ = std::lround(config.control.rest_timeout_s / period_s_);
+  // At rest for the valves' lag: whatever was commanded before has arrived.
+  rest_confirm_cycles_ = std::max(
+      1L, std::lround((model_.valves.delay_s + model_.valves.time_constant_s) / period_s_));
+  rest_arms_.setZero(n);
   q_ref_ = config.simulation.q_initial;
   dc_dq_.setZero(n);
   qddot_max_.setZero(n);
@@ -128,6 +150,8 @@ void Controller::reset(const valves::MachineState& state) {
   tip_error_filtered_m_ = 0.0;
   neutral_ = false;
   refusing_ = false;
+  settle_cycles_ = rest_cycles_ = 0;
+  stop_end_ = StopEnd::kNone;
   if (tip_path_) tip_path_->reset();
   if (scaler_) scaler_->reset();
 }
@@ -212,13 +236,57 @@ ControllerStatus Controller::update(const valves::MachineState& state, const Eig
   const bool stopping = stale || dynamics_failed();
   const bool at_rest = out.qdot_ref.isZero(0.0) && out.sddot == 0.0 &&
                        (options_.mode != ScalingMode::kFull || scaler_out_.at_rest);
-  if (stopping && at_rest) {
-    follower_.neutral(out.valves);  // stopped: valves neutral
-    neutral_ = true;
-    return ControllerStatus::kStopped;
-  }
-  follower_.update(q_ref_, out.qdot_ref, state_ok ? &state.q : nullptr, out.valves);
+  out.measured_tip_speed_m_s = measured_tip_speed(state, state_ok);
+  if (stopping && at_rest) return finish_stop(state, state_ok, out);
+  settle_cycles_ = rest_cycles_ = 0;
+  stop_end_ = StopEnd::kNone;
+  out.stop_end = StopEnd::kNone;
+  // A stop has no dead-band lead: a feedback correction that changes side while the crane
+  // decelerates crosses the band at the slew-rate limit, never by a full opening against the
+  // motion (on a spool slower than the model the lead would ask for one).
+  follower_.update(q_ref_, out.qdot_ref, state_ok ? &state.q : nullptr, out.valves, !stopping);
   return stopping ? ControllerStatus::kStopping : ControllerStatus::kRunning;
+}
+
+double Controller::measured_tip_speed(const valves::MachineState& state, bool state_ok) noexcept {
+  if (!state_ok) return std::numeric_limits<double>::quiet_NaN();
+  dynamics::tip_jacobian(model_, kin_, state.q, rest_jacobian_);
+  return (rest_jacobian_ * state.qdot).norm();
+}
+
+bool Controller::cylinders_at_rest(const valves::MachineState& state) noexcept {
+  dynamics::cylinder_arms(model_, state.q, rest_arms_);
+  for (int i = 0; i < model_.dof(); ++i) {
+    if (!(std::abs(rest_arms_[i] * state.qdot[i]) < rest_speed_m_s_)) return false;
+  }
+  return true;
+}
+
+ControllerStatus Controller::finish_stop(const valves::MachineState& state, bool state_ok,
+                                         ControllerOutput& out) noexcept {
+  // The reference is at rest; the machine may still move (the valves' lag, a load running on).
+  // It settles on P feedback at the reference until it is measured at rest for the valves' lag,
+  // or until the timeout; then every valve ramps to neutral.
+  if (stop_end_ == StopEnd::kNone) {
+    if (!state_ok) {
+      stop_end_ = StopEnd::kUnmeasured;
+    } else {
+      const bool rest = out.measured_tip_speed_m_s < rest_speed_m_s_ && cylinders_at_rest(state);
+      rest_cycles_ = rest ? rest_cycles_ + 1 : 0;
+      if (rest_cycles_ >= rest_confirm_cycles_) {
+        stop_end_ = StopEnd::kAtRest;
+      } else if (++settle_cycles_ > rest_timeout_cycles_) {
+        stop_end_ = StopEnd::kTimeout;
+      }
+    }
+  }
+  out.stop_end = stop_end_;
+  if (stop_end_ == StopEnd::kNone) {
+    follower_.hold(q_ref_, state.q, hold_error_m_, out.valves);
+    return ControllerStatus::kStopping;
+  }
+  neutral_ = follower_.neutral(out.valves);
+  return neutral_ ? ControllerStatus::kStopped : ControllerStatus::kStopping;
 }
 
 void Controller::update_polytope(const JointVector& q, const Eigen::Vector3d& v_cmd, bool stale,

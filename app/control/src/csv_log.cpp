@@ -17,7 +17,7 @@ std::string CsvLog::header(int dof, bool base) {
   h += ",avail_speed_m_s,avail_speed_resolved_m_s,polytope_volume_m3s3";
   for (int i = 1; i <= dof; ++i) h += ",spool" + std::to_string(i);
   for (int i = 1; i <= dof; ++i) h += ",p_load" + std::to_string(i) + "_pa";
-  h += ",load_kg,payload_estimate_kg,load_moment_ratio";
+  h += ",load_kg,payload_estimate_kg,load_moment_ratio,status";
   if (base) {
     h += ",base_x,base_y,base_phi,base_v,base_omega,base_v_cmd,base_omega_cmd,base_flow_fl_m3s,"
          "base_flow_fr_m3s,base_flow_rl_m3s,base_flow_rr_m3s,base_flow_sum_m3s,base_flow_max_m3s";
@@ -74,7 +74,7 @@ void CsvLog::write_row(const LogRow& r) {
   } else {
     std::fputc(',', file_);
   }
-  std::fprintf(file_, ",%.6g,%.6g", r.payload_estimate_kg, r.load_moment_ratio);
+  std::fprintf(file_, ",%.6g,%.6g,%s", r.payload_estimate_kg, r.load_moment_ratio, r.status);
   if (base_) {
     std::fprintf(file_, ",%.6f,%.6f,%.7f,%.6g,%.6g,%.6g,%.6g", r.base_pose[0], r.base_pose[1],
                  r.base_pose[2], r.base_velocity[0], r.base_velocity[1], r.base_command[0],

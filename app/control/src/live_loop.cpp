@@ -119,6 +119,8 @@ LiveSummary run_live(const config::CraneConfig& config, input::CommandSource& so
   LiveSummary summary;
   summary.cycles = ran.cycles;
   summary.load = stats.load;
+  summary.stop = stats.stop;
+  summary.peak_spool_step = stats.peak_spool_step;
   summary.duration_s = ran.duration_s;
   summary.wall_time_s = ran.wall_time_s;
   summary.max_late_s = ran.max_late_s();

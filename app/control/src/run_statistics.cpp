@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "craneassist/control/controller.hpp"
 
@@ -51,6 +52,20 @@ void RunStatistics::on_cycle(const CycleRecord& c) noexcept {
   tips_valid_[slot(tip_count_)] = c.state.valid && tip.allFinite();
   ++tip_count_;
   quality_.add(t, cmd, tip, tip_v);
+
+  // Spool command steps from one cycle to the next (a command of another size restarts).
+  const int n =
+      static_cast<int>(std::min<Eigen::Index>(c.command.spool.size(), dynamics::kMaxJoints));
+  double spool_step = 0.0;
+  for (int i = 0; i < n && n == spool_count_; ++i) {
+    if (std::isfinite(c.command.spool[i])) {
+      spool_step = std::max(spool_step, std::abs(c.command.spool[i] - last_spool_[i]));
+    }
+  }
+  s_.peak_spool_step = std::max(s_.peak_spool_step, spool_step);
+  add_stop(c, spool_step);
+  for (int i = 0; i < n; ++i) last_spool_[i] = c.command.spool[i];
+  spool_count_ = n;
 
   const ControllerOutput* out = c.controller;
   if (out == nullptr) return;
@@ -121,6 +136,57 @@ void RunStatistics::add_load(double t, double tip_speed, const valves::MachineSt
       ++l.moving_samples;
     }
   }
+}
+
+void RunStatistics::add_stop(const CycleRecord& c, double spool_step) noexcept {
+  StopSummary& st = s_.stop;
+  double load_pa = 0.0;
+  if (c.state.valid) {
+    for (Eigen::Index i = 0; i < c.state.load_pressure_pa.size(); ++i) {
+      if (std::isfinite(c.state.load_pressure_pa[i])) {
+        load_pa = std::max(load_pa, std::abs(c.state.load_pressure_pa[i]));
+      }
+    }
+  }
+  if (c.status == CycleStatus::kRunning) {
+    in_stop_ = false;
+    running_load_pressure_pa_ = load_pa;
+    return;
+  }
+  if (!in_stop_) {  // a stop begins (or the run begins stopped)
+    in_stop_ = true;
+    stop_start_s_ = c.time.t_s;
+    stop_steady_pa_ = running_load_pressure_pa_;
+    stop_peak_pa_ = 0.0;
+    stop_counted_ = false;
+    for (int i = 0; i < spool_count_; ++i) stop_start_spool_[i] = last_spool_[i];
+  }
+  st.peak_spool_step = std::max(st.peak_spool_step, spool_step);
+  stop_peak_pa_ = std::max(stop_peak_pa_, load_pa);
+  for (int i = 0; i < spool_count_ && i < c.command.spool.size(); ++i) {
+    const double u = c.command.spool[i];
+    if (std::abs(u) >= 0.99 && u * stop_start_spool_[i] < 0.0) {
+      ++st.full_reverse_cycles;
+      break;
+    }
+  }
+  // The first cycle with the valves neutral ends the stop.
+  const ControllerOutput* out = c.controller;
+  if (c.status != CycleStatus::kStopped || stop_counted_) return;
+  ++st.stops;
+  st.end = out != nullptr ? out->stop_end : StopEnd::kNone;
+  st.tip_speed_at_neutral_m_s =
+      out != nullptr ? out->measured_tip_speed_m_s : std::numeric_limits<double>::quiet_NaN();
+  if (std::isfinite(st.tip_speed_at_neutral_m_s)) {
+    st.max_tip_speed_at_neutral_m_s =
+        std::max(st.max_tip_speed_at_neutral_m_s, st.tip_speed_at_neutral_m_s);
+  }
+  st.time_s = c.time.t_s - stop_start_s_;
+  st.timeouts += st.end == StopEnd::kTimeout;
+  st.unmeasured += st.end == StopEnd::kUnmeasured;
+  st.peak_load_pressure_pa = std::max(st.peak_load_pressure_pa, stop_peak_pa_);
+  st.steady_load_pressure_pa = std::max(st.steady_load_pressure_pa, stop_steady_pa_);
+  stop_counted_ = true;  // the stop goes on neutral until the next running cycle
 }
 
 void RunStatistics::on_finish(const CycleTime&, const valves::MachineState& state) {

@@ -25,6 +25,11 @@ struct ControlSettings {
   double activation_error_m = 0.0;
   // Fraction of the pump's maximum flow the prescaling leaves for the feedback corrections.
   double flow_reserve = 0.0;
+  // A stop ends when the measured motion is at rest: the tip and every cylinder slower than
+  // rest_speed for the valves' lag (delay plus time constant), or rest_timeout after the
+  // reference came to rest, whichever is first; then the valves ramp to neutral (docs/safety.md).
+  double rest_speed_m_s = 0.005;
+  double rest_timeout_s = 2.0;
 };
 
 // The path scaling of the tip motion (docs/scaling.md).
@@ -55,6 +60,9 @@ struct SimulationSettings {
   double pressure_resolution_pa = 0.0;
   // Pressure in the chamber that returns to tank.
   double return_pressure_pa = 0.0;
+  // The simulated valves' spool lag when it differs from the controller's model
+  // (hydraulics.valves.time_constant); negative: the model's.
+  double spool_time_constant_s = -1.0;
 };
 
 // Rated load against reach, the horizontal distance from the slew axis to the tip (EN 12999's

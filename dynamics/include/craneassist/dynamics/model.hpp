@@ -176,6 +176,10 @@ struct ValveSections {
   double dead_zone = 0.0;  // fraction of the spool (current) range with no flow
   double time_constant_s = 0.0;
   double delay_s = 0.0;
+  // The spool command's slew-rate limit: the fastest a command may go from neutral to full
+  // opening (0: no limit). Every command sent to the valves moves at most period / stroke_time
+  // per cycle, as a valve driver's ramp would (docs/valves.md).
+  double stroke_time_s = 0.0;
   // Optional measured characteristic per section (cylinder, same index); empty tables or an
   // empty vector: the straight line through dead_zone and the cylinder's max_speed.
   std::vector<ValveTable> tables;

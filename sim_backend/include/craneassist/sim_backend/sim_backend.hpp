@@ -38,6 +38,9 @@ struct SimSettings {
   double pressure_resolution_pa = 0.0;
   unsigned noise_seed = 1;
   double return_pressure_pa = 0.0;  // in the chamber that returns to tank
+  // The spools' first-order lag when the machine's differs from the controller's model
+  // (hydraulics.valves.time_constant); negative: the model's.
+  double spool_time_constant_s = -1.0;
 };
 
 class SimBackend final : public valves::MachineInterface {

@@ -4,11 +4,18 @@
 // valve's own dead time is not mistaken for a tracking error (a Smith-predictor-style
 // compensation). The spool's first-order lag is compensated through the dead zone: the
 // follower keeps an estimate of every spool position and, while a spool still has to cross the
-// dead zone, commands what brings it to the wanted position within one period (deadbeat,
-// clipped to the spool range). All sections then cross together when a motion starts or
-// reverses, instead of the small commands lagging behind the large ones and bending the tip
-// path; beyond the dead zone the wanted position passes unchanged. Preallocated history; update()
-// allocates nothing.
+// dead zone on the side it is wanted, leads it: the largest command, at most the wanted one plus
+// the dead band's width (and the way back to neutral while the spool is still on the other side),
+// that does not carry the estimate past the wanted position once the
+// command steps back to it at the slew-rate limit (without a limit: deadbeat, the wanted position
+// within one period). All sections then cross together when a motion starts or a feedback
+// correction changes side, instead of the small commands lagging behind the large ones and
+// bending the tip path; beyond the dead zone the wanted position passes unchanged. Every command,
+// neutral included, then moves at most period / hydraulics.valves.stroke_time from the last one
+// (the slew-rate limit of a valve driver's ramp). The lead is tuned to the model's spool lag: a
+// machine whose spools are much faster than hydraulics.valves.time_constant makes the lead
+// overshoot into flow (docs/valves.md). While a stop settles (hold()) there is no lead.
+// Preallocated history; update() allocates nothing.
 #pragma once
 
 #include <vector>
@@ -34,25 +41,48 @@ class ReferenceFollower {
   void set_command_period(double command_period_s);
 
   // q_ref, qdot_ref: this cycle's joint reference; q_meas: the measurement, or nullptr when
-  // there is none (feed-forward only).
+  // there is none (feed-forward only); lead false: no dead-band lead this cycle (a stop).
   void update(const JointVector& q_ref, const JointVector& qdot_ref, const JointVector* q_meas,
-              ValveCommand& out);
+              ValveCommand& out, bool with_lead = true);
 
-  // Neutral valves (the estimate follows).
-  void neutral(ValveCommand& out);
+  // Holds the machine at a reference at rest (a stop settling): P feedback only, no dead-band
+  // lead, and a section whose cylinder position error is below hold_error_m is closed (its
+  // command goes to neutral) instead of hunting across the dead band.
+  void hold(const JointVector& q_ref, const JointVector& q_meas, double hold_error_m,
+            ValveCommand& out);
+
+  // Moves every command towards neutral at the slew-rate limit (the estimate follows); true once
+  // every command is neutral.
+  bool neutral(ValveCommand& out);
+
+  // The most a command moves per update (2: no limit, a full reversal in one cycle).
+  double max_step() const { return max_step_; }
+  // The follower's estimate of section i's spool position (the model's lag on the commands).
+  double spool_estimate(int i) const { return spool_estimate_[i]; }
 
   // Cylinder-position reference of one valve delay ago (for tracking-error measures).
   const JointVector& delayed_reference_q() const { return q_ref_history_[head_]; }
 
  private:
+  // update() and hold(): the wanted commands (DZI plus P), the lead, the slew-rate limit.
+  void follow(const JointVector& q_ref, const JointVector& qdot_ref, const JointVector* q_meas,
+              double hold_error_m, bool with_lead, ValveCommand& out);
+  // The dead-band lead in a section's sided coordinates (docs/valves.md).
+  double lead(double x, double last, double target, double band) const;
+  // command moved at most max_step_ from section i's last command; the estimate follows.
+  double send(int i, double command);
+
   const dynamics::CraneModel& model_;
   ProportionalValves valves_;
   ProportionalValvesInput in_;
   JointVector dc_dq_, c_ref_, c_meas_;
   JointVector spool_estimate_;
+  JointVector last_command_;  // what was sent last cycle
+  JointVector zero_;
   double period_s_;
-  bool lead_ = true;  // every command reaches the valves: the dead-zone lead is safe
-  double lag_alpha_;  // share of the remaining spool travel the lag covers in one period
+  bool lead_ = true;       // every command reaches the valves: the dead-zone lead is safe
+  double lag_alpha_;       // share of the remaining spool travel the lag covers in one period
+  double max_step_ = 2.0;  // the slew-rate limit per update (2: none)
   std::vector<JointVector> q_ref_history_;
   std::size_t head_ = 0;
 };

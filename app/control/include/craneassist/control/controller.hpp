@@ -65,6 +65,15 @@ struct ControllerOptions {
   bool payload_known = false;
 };
 
+// How a stop's settling ended, when the valves went to neutral (docs/safety.md).
+enum class StopEnd {
+  kNone,        // no stop, or still settling
+  kAtRest,      // the measured tip and every cylinder slower than control.rest_speed
+  kTimeout,     // still moving control.rest_timeout after the reference came to rest
+  kUnmeasured,  // no valid measurement: the reference at rest is all there is
+};
+const char* to_string(StopEnd end);  // "", "at rest", "rest timeout", "no measurement"
+
 // The load in the grapple as the controller sees it (docs/loads.md).
 struct LoadOutput {
   double estimate_kg = 0.0;   // the crane scale (the config's payload when it is known)
@@ -116,6 +125,10 @@ struct ControllerOutput {
   double polytope_volume_m3_s3 = 0.0;
   double polytope_area_m2_s2 = 0.0;
   LoadOutput load;
+  // A stop: how its settling ended (kNone until the valves start to go neutral), and the
+  // measured tip speed of this cycle (NaN without a valid measurement).
+  StopEnd stop_end = StopEnd::kNone;
+  double measured_tip_speed_m_s = 0.0;
 };
 
 // The controller's status is the cycle status of the loop (control_loop.hpp).
@@ -140,11 +153,15 @@ class Controller {
   void reset(const valves::MachineState& state);
 
   // One control period. An invalid measurement or a non-finite command brings the motion to a
-  // jerk-limited stop along the current direction (kStopping, limit stale_input) and then holds
-  // with neutral valves (kStopped); the other modes stop at once. The first valid cycle after
-  // kStopped restarts the reference at the measured configuration (as reset()). A cycle whose
-  // dynamics step fails (kFull; ODE out of memory) stops the same way (kStopping, then kStopped;
-  // limit dynamics_failed, ref_power_w 0); each cycle tries the dynamics again.
+  // jerk-limited stop along the current direction (kStopping, limit stale_input); the other
+  // modes stop the reference at once. Then the machine settles on P feedback at the reference
+  // (sections within control.activation_error closed) until it is measured at rest or
+  // control.rest_timeout has passed, and the valves ramp to neutral at the slew-rate limit
+  // (still kStopping; out.stop_end says why); with every valve neutral it holds (kStopped). The
+  // first valid cycle after kStopped restarts the reference at the measured configuration (as
+  // reset()). A cycle whose dynamics step fails (kFull; ODE out of memory) stops the same way
+  // (kStopping, then kStopped; limit dynamics_failed, ref_power_w 0); each cycle tries the dynamics
+  // again.
   ControllerStatus update(const valves::MachineState& state, const Eigen::Vector3d& v_cmd_m_s,
                           ControllerOutput& out) noexcept;
 
@@ -194,6 +211,18 @@ class Controller {
   Eigen::Vector3d stick_direction_ = Eigen::Vector3d::UnitX();
   double tip_error_filtered_m_ = 0.0;
   bool neutral_ = false;  // the last update returned kStopped (valves neutral)
+  // The end of a stop: settle on the reference, then ramp the valves to neutral.
+  ControllerStatus finish_stop(const valves::MachineState& state, bool state_ok,
+                               ControllerOutput& out) noexcept;
+  double measured_tip_speed(const valves::MachineState& state, bool state_ok) noexcept;
+  bool cylinders_at_rest(const valves::MachineState& state) noexcept;
+  double rest_speed_m_s_ = 0.005;
+  double hold_error_m_ = 0.0;
+  long rest_timeout_cycles_ = 0, rest_confirm_cycles_ = 1;
+  long settle_cycles_ = 0, rest_cycles_ = 0;
+  StopEnd stop_end_ = StopEnd::kNone;  // decided: the valves go (or are) neutral
+  dynamics::TaskJacobian rest_jacobian_;
+  JointVector rest_arms_;
   // The crane scale and the rated capacity limiter (docs/loads.md).
   void update_load(const valves::MachineState& state, ControllerOutput& out) noexcept;
   config::LoadChart chart_;

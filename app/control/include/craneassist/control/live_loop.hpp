@@ -72,8 +72,8 @@ struct LiveOptions {
   double duration_s = 0.0;                  // machine time to run; 0: until *stop is set
   const std::atomic<bool>* stop = nullptr;  // set by a signal handler or the keyboard's q
   // After a stop request (or a machine fault), keep running with a non-finite command (the
-  // controller's stop, then neutral valves) until the reference is at rest, at most this long,
-  // so the crane is not left moving.
+  // controller's stop, then neutral valves) until the machine is at rest with neutral valves, at
+  // most this long, so the crane is not left moving.
   double stop_settle_max_s = 5.0;
   std::vector<CycleObserver*> observers;  // called each cycle on the loop thread
   LiveStatusBoard* status_board = nullptr;
@@ -84,7 +84,9 @@ struct LiveOptions {
 };
 
 struct LiveSummary {
-  LoadSummary load;  // the crane scale and the load moment (docs/loads.md)
+  LoadSummary load;              // the crane scale and the load moment (docs/loads.md)
+  StopSummary stop;              // how the stops ended (docs/safety.md)
+  double peak_spool_step = 0.0;  // largest spool command change per cycle
   long cycles = 0;
   double duration_s = 0.0;   // machine time
   double wall_time_s = 0.0;  // computer time

@@ -50,6 +50,28 @@ struct LoadSummary {
   long truth_changes = 0;
 };
 
+// How the run's stops ended (docs/safety.md): a stop runs from its first cycle not running
+// (kStopping) to its first cycle with every valve neutral (kStopped).
+struct StopSummary {
+  long stops = 0;  // stops that reached neutral valves
+  // The last such stop (the end of run's, when the run ended by a stop):
+  StopEnd end = StopEnd::kNone;
+  double tip_speed_at_neutral_m_s = 0.0;  // measured on its kStopped cycle (NaN: no measurement)
+  double time_s = 0.0;                    // from its first cycle to kStopped
+  // Over every stop:
+  double max_tip_speed_at_neutral_m_s = 0.0;  // the worst measured (valid measurements)
+  long timeouts = 0;                          // ended by control.rest_timeout, still moving
+  long unmeasured = 0;                        // ended without a valid measurement
+  double peak_spool_step = 0.0;               // largest command change from one cycle to the next
+  // Cycles with a section commanded fully open (|spool| >= 0.99) against the side it was
+  // commanded when the stop began: a reverse kick.
+  long full_reverse_cycles = 0;
+  // Largest |load pressure| of any cylinder during the stops, and on the last running cycle
+  // before the stop that reached it (the steady value the stop starts from).
+  double peak_load_pressure_pa = 0.0;
+  double steady_load_pressure_pa = 0.0;
+};
+
 struct RunSummary {
   long cycles = 0;
   double duration_s = 0.0;   // machine time
@@ -84,6 +106,8 @@ struct RunSummary {
   std::size_t log_rows_dropped = 0;
   MotionQualityResult feel;  // stall events and lateral speed (motion_quality.hpp)
   LoadSummary load;
+  StopSummary stop;
+  double peak_spool_step = 0.0;  // largest command change from one cycle to the next, whole run
 };
 
 class RunStatistics final : public CycleObserver {
@@ -98,6 +122,7 @@ class RunStatistics final : public CycleObserver {
  private:
   void add_load(double t, double tip_speed, const valves::MachineState& state,
                 const ControllerOutput& out) noexcept;
+  void add_stop(const CycleRecord& c, double spool_step) noexcept;
   double period_s_;
   RunStatisticsOptions options_;
   RunSummary s_;
@@ -115,6 +140,14 @@ class RunStatistics final : public CycleObserver {
   double sum_sq_position_direction_ = 0.0;
   long position_samples_ = 0;
   double truth_since_s_ = 0.0;  // the simulated load unchanged since
+  // The last cycle's valve command (spool_count_ sections), and the stop in progress.
+  std::array<double, dynamics::kMaxJoints> last_spool_{};
+  std::array<double, dynamics::kMaxJoints> stop_start_spool_{};
+  int spool_count_ = -1;
+  bool in_stop_ = false, stop_counted_ = false;
+  double stop_start_s_ = 0.0;
+  double running_load_pressure_pa_ = 0.0;  // the last running cycle's
+  double stop_steady_pa_ = 0.0, stop_peak_pa_ = 0.0;
 };
 
 // Angle between two vectors in degrees (0 when either is zero).

@@ -14,6 +14,7 @@ inline sim_backend::SimSettings sim_settings(const config::CraneConfig& cfg) {
   s.pressure_noise_pa = cfg.simulation.pressure_noise_pa;
   s.pressure_resolution_pa = cfg.simulation.pressure_resolution_pa;
   s.return_pressure_pa = cfg.simulation.return_pressure_pa;
+  s.spool_time_constant_s = cfg.simulation.spool_time_constant_s;
   return s;
 }
 
