@@ -2,7 +2,7 @@
 what those scripts share in drawing them."""
 import csv
 
-TEXT_COLUMNS = ("active_limit", "pump_limit")
+TEXT_COLUMNS = ("active_limit", "pump_limit", "status")
 
 
 def load(path):

@@ -101,12 +101,11 @@ double spool_step_bound(const config::CraneConfig& cfg) {
 void print_stop_lines(const control::StopSummary& st, bool end_stop, double stop_time_s,
                       double run_peak_spool_step, double stop_step_bound) {
   if (st.stops == 0) return;
-  std::printf("  %s: stopped jerk-limited in %.2f s, ", end_stop ? "end of run" : "stop",
-              stop_time_s);
+  std::printf("  %s: stopped in %.2f s, ", end_stop ? "end of run" : "stop", stop_time_s);
   const double v = st.tip_speed_at_neutral_m_s;
   switch (st.end) {
     case control::StopEnd::kAtRest:
-      std::printf("at rest (tip %.3f m/s), then valves neutral\n", v);
+      std::printf("at rest (tip %.3f m/s) when the valves went neutral\n", v);
       break;
     case control::StopEnd::kTimeout:
       std::printf(

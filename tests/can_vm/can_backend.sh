@@ -190,7 +190,7 @@ stop_capture
 kill "$emu"; wait "$emu"
 grep "CAN\|end of run\|stops:" /tmp/f10.out
 [ "$rc" = 0 ] || fail "end of run: expected exit 0, got $rc"
-grep -q "end of run: stopped jerk-limited" /tmp/f10.out || fail "end of run: no stop reported"
+grep -q "end of run: stopped in" /tmp/f10.out || fail "end of run: no stop reported"
 # The valves go neutral only with the machine measured at rest (issue 27).
 grep -Eq "end of run: .*at rest \(tip 0\.00[0-9] m/s\)" /tmp/f10.out ||
   fail "end of run: the valves went neutral on a moving crane"
