@@ -151,6 +151,31 @@ TEST(CraneConfig, OutOfRangeValuesAreRejected) {
   EXPECT_EQ(error_after_edit("step: 1 ms", "step: 3 ms").field(), "simulation.step");
 }
 
+// The stop and the valves' slew-rate limit (docs/safety.md, docs/valves.md): read, defaulted
+// when left out, and refused out of range naming the line and field.
+TEST(CraneConfig, StopAndSlewRateSettings) {
+  const auto cfg = config_after_edit("rest_timeout: 2 s", "rest_timeout: 1.5 s");
+  EXPECT_DOUBLE_EQ(cfg.model.valves.stroke_time_s, 0.05);
+  EXPECT_DOUBLE_EQ(cfg.control.rest_speed_m_s, 0.005);
+  EXPECT_DOUBLE_EQ(cfg.control.rest_timeout_s, 1.5);
+  EXPECT_LT(cfg.simulation.spool_time_constant_s, 0.0) << "left out: the model's";
+  const auto without = config_after_edit("    stroke_time: 0.05 s, assumed\n", "");
+  EXPECT_EQ(without.model.valves.stroke_time_s, 0.0) << "left out: no limit";
+  const auto machine = config_after_edit("  return_pressure: 0.3 MPa, assumed",
+                                         "  return_pressure: 0.3 MPa, assumed\n"
+                                         "  spool_time_constant: 80 ms, assumed");
+  EXPECT_DOUBLE_EQ(machine.simulation.spool_time_constant_s, 0.08);
+  const auto stroke = error_after_edit("stroke_time: 0.05 s", "stroke_time: 7 s");
+  EXPECT_EQ(stroke.field(), "hydraulics.valves.stroke_time");
+  EXPECT_EQ(stroke.line(), line_of("stroke_time: 0.05 s"));
+  EXPECT_EQ(error_after_edit("rest_speed: 5 mm/s", "rest_speed: 0 mm/s").field(),
+            "control.rest_speed");
+  EXPECT_EQ(error_after_edit("rest_speed: 5 mm/s", "rest_speed: 5 s").field(),
+            "control.rest_speed");
+  EXPECT_EQ(error_after_edit("rest_timeout: 2 s", "rest_timeout: 9 s").field(),
+            "control.rest_timeout");
+}
+
 // The geometry, masses, inertias and gravity are checked against ranges in which the simulator
 // and the dynamics model run (docs/config.md#ranges; the edges run in test_replay_e2e): values
 // they cannot take (a 1e30 m link, gravity -1000) were accepted and aborted the run in ODE or
