@@ -17,10 +17,20 @@ wait_candump() {
     sleep 0.05
   done
 }
+# Until the emulator runs its loop (it prints its settings just before), then a little more: its
+# start-up and first catch-up steps are CPU bursts that, under qemu's software emulation, can
+# starve a control loop started at the same moment past its 80 ms watchdog.
+wait_emulator() {
+  for _ in $(seq 100); do
+    grep -q "feedback every" "$1" 2>/dev/null && break
+    sleep 0.1
+  done
+  sleep 0.5
+}
 start_emulator() {
   ./craneassist emulate --can vcan0 >/tmp/emu.log 2>&1 &
   emu=$!
-  sleep 0.5
+  wait_emulator /tmp/emu.log
 }
 start_capture() {
   candump -L vcan0 >"$1" &
@@ -103,7 +113,7 @@ grep -q "heartbeat lost" /tmp/emu.log || fail "the emulator did not see the hear
 echo "=== 5. the ISOBUS valve-group example mapping (every section an AVC valve, 1..4)"
 ./craneassist emulate --can vcan0 --mapping pvg32_isobus_example.yaml >/tmp/emu5.log 2>&1 &
 emu=$!
-sleep 0.5
+wait_emulator /tmp/emu5.log
 start_capture /tmp/cap5.log
 ./craneassist replay can_short.csv --backend can --can vcan0 --mapping pvg32_isobus_example.yaml \
   --log /tmp/can5.csv --settle 0.5 --can-feedback-timeout 0.3 >/tmp/f5.out 2>&1 || fail "replay with the ISOBUS mapping exited $?"
@@ -144,10 +154,13 @@ grep -q "ran [0-4]\.[0-9]* s of machine time" /tmp/live_f7.out || fail "the run 
 echo "=== 8. controller error frames during a replay: bus-off, error-passive and a restart latch"
 # cansend writes an error frame when the 8-digit id has CAN_ERR_FLAG (0x20000000): the class is
 # in the id, the controller state in byte 1 (linux/can/error.h).
-for c in "20000040#0000000000000000:bus-off" "20000004#0020000000000000:error-passive" \
-         "20000100#0000000000000000:controller restarted"; do
-  frame=${c%%:*}
-  reason=${c#*:}
+# One error frame during a replay; 1 when the run was not there to take it: a frozen-loop fault
+# (an 80 ms stall of the loop thread) before the frame. Under qemu's software emulation a busy
+# moment of the emulated CPUs does that now and then; that is the watchdog working, not the
+# error-frame handling under test, so such an attempt is run again once.
+error_frame_case() {
+  frame=$1
+  reason=$2
   start_emulator
   candump -L vcan0,0:0,#FFFFFFFF >/tmp/cap8.log &
   cd_pid=$!
@@ -155,16 +168,27 @@ for c in "20000040#0000000000000000:bus-off" "20000004#0020000000000000:error-pa
   ./craneassist replay can_short.csv --backend can --can vcan0 --no-log --settle 0 \
     --can-feedback-timeout 0.3 >/tmp/f8.out 2>&1 &
   rp=$!
-  ./can_backend_check wait-motion vcan0 10 || fail "$reason: the replay did not start moving"
+  moving=0
+  ./can_backend_check wait-motion vcan0 10 && moving=1
   sleep 0.3
   cansend vcan0 "$frame"
   wait "$rp"; rc=$?
   stop_capture
   kill "$emu" 2>/dev/null; wait "$emu"  # it may have stopped on the error frame itself
   grep CAN /tmp/f8.out
+  if grep -q "CAN FAULT (control loop frozen)" /tmp/f8.out; then return 1; fi
+  [ "$moving" = 1 ] || fail "$reason: the replay did not start moving"
   [ "$rc" = 3 ] || fail "$reason: expected exit 3 after the fault, got $rc"
   grep -q "CAN FAULT ($reason)" /tmp/f8.out || fail "$reason: no fault reported"
   ./can_backend_check safe /tmp/cap8.log error-frame 100 || fail "$reason: safe state"
+  return 0
+}
+for c in "20000040#0000000000000000:bus-off" "20000004#0020000000000000:error-passive" \
+         "20000100#0000000000000000:controller restarted"; do
+  if ! error_frame_case "${c%%:*}" "${c#*:}"; then
+    echo "the loop stalled before the error frame (a busy emulated CPU): once more"
+    error_frame_case "${c%%:*}" "${c#*:}" || fail "${c#*:}: the loop stalled before the frame twice"
+  fi
 done
 
 echo "=== 9. ACK and protocol errors are counted, the run goes on"
@@ -247,7 +271,7 @@ echo "=== 15. a lower-priority contender gives way; the run proceeds until the l
 ./craneassist emulate --can vcan0 --test-valve-fault-at 2.5 --test-valve-fault-joint lift \
   >/tmp/emu15.log 2>&1 &
 emu=$!
-sleep 0.5
+wait_emulator /tmp/emu15.log
 start_capture /tmp/cap15.log
 ./j1939_rival vcan0 80 5000000000000001 30 >/tmp/rival15.log 2>&1 &
 rv=$!
@@ -266,7 +290,7 @@ grep -q "CAN FAULT (valve fault) at .*: joint lift: valve 1 (0x20) reports a non
 echo "=== 16. the valve replies stop (test hook at 2.5 s)"
 ./craneassist emulate --can vcan0 --test-reply-stop-at 2.5 >/tmp/emu16.log 2>&1 &
 emu=$!
-sleep 0.5
+wait_emulator /tmp/emu16.log
 start_capture /tmp/cap16.log
 ./craneassist replay can_short.csv --backend can --can vcan0 --no-log --settle 0 \
   --can-feedback-timeout 0.3 >/tmp/f16.out 2>&1; rc=$?
@@ -282,7 +306,7 @@ grep -q "CAN FAULT (valve reply lost) at .*: joint .*: no valve reply for [0-9]*
 echo "=== 17. DM1 from the valve group with an active DTC (test hook at 2.5 s)"
 ./craneassist emulate --can vcan0 --test-dm1-fault-at 2.5 >/tmp/emu17.log 2>&1 &
 emu=$!
-sleep 0.5
+wait_emulator /tmp/emu17.log
 start_capture /tmp/cap17.log
 ./craneassist replay can_short.csv --backend can --can vcan0 --no-log --settle 0 \
   --can-feedback-timeout 0.3 >/tmp/f17.out 2>&1; rc=$?
