@@ -40,20 +40,6 @@ const char* to_string(ScalingMode mode) {
   return "?";
 }
 
-const char* to_string(StopEnd end) {
-  switch (end) {
-    case StopEnd::kNone:
-      return "";
-    case StopEnd::kAtRest:
-      return "at rest";
-    case StopEnd::kTimeout:
-      return "rest timeout";
-    case StopEnd::kUnmeasured:
-      return "no measurement";
-  }
-  return "?";
-}
-
 scaling::TipPathConfig tip_path_config(const config::CraneConfig& config) {
   scaling::TipPathConfig path;
   path.period_s = 1.0 / config.control.rate_hz;

@@ -72,7 +72,6 @@ enum class StopEnd {
   kTimeout,     // still moving control.rest_timeout after the reference came to rest
   kUnmeasured,  // no valid measurement: the reference at rest is all there is
 };
-const char* to_string(StopEnd end);  // "", "at rest", "rest timeout", "no measurement"
 
 // The load in the grapple as the controller sees it (docs/loads.md).
 struct LoadOutput {
