@@ -116,7 +116,7 @@ double speed(const control::LogRow& r) {
 // The ending's checks.
 void expect_gentle_stop_at_rest(const config::CraneConfig& cfg, const Ending& e) {
   SCOPED_TRACE(e.name);
-  const double bound = 1.0 / (cfg.control.rate_hz * cfg.model.valves.stroke_time_s);
+  const double bound = valves::max_spool_step(cfg.model.valves, 1.0 / cfg.control.rate_hz);
   EXPECT_GE(e.stop.stops, 1);
   EXPECT_EQ(e.stop.end, control::StopEnd::kAtRest);
   EXPECT_LT(e.stop.tip_speed_at_neutral_m_s, 0.01);

@@ -22,6 +22,7 @@
 #include "craneassist/input/replay.hpp"
 #include "craneassist/offline/sim_setup.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
+#include "craneassist/valves/reference_follower.hpp"
 #include "embedded_replays.hpp"
 #include "exit_codes.hpp"
 #include "machine_setup.hpp"
@@ -92,11 +93,6 @@ void print_feel_line(const control::MotionQualityResult& f) {
 }
 
 }  // namespace
-
-double spool_step_bound(const config::CraneConfig& cfg) {
-  const double stroke = cfg.model.valves.stroke_time_s;
-  return stroke > 0.0 ? std::min(1.0 / (cfg.control.rate_hz * stroke), 2.0) : 2.0;
-}
 
 void print_stop_lines(const control::StopSummary& st, bool end_stop, double stop_time_s,
                       double run_peak_spool_step, double stop_step_bound) {
@@ -198,9 +194,9 @@ void print_summary(const control::RunSummary& s, const config::CraneConfig& cfg,
   }
   if (s.end_stop && s.stop_cycles <= 1) std::printf("  end of run: at rest, valves neutral\n");
   const bool end = s.end_stop && s.stop_cycles > 1;
-  print_stop_lines(s.stop, end,
-                   end ? static_cast<double>(s.stop_cycles) / cfg.control.rate_hz : s.stop.time_s,
-                   s.peak_spool_step, spool_step_bound(cfg));
+  print_stop_lines(
+      s.stop, end, end ? static_cast<double>(s.stop_cycles) / cfg.control.rate_hz : s.stop.time_s,
+      s.peak_spool_step, valves::max_spool_step(cfg.model.valves, 1.0 / cfg.control.rate_hz));
   if (mode == control::ScalingMode::kFull) {
     std::printf("  path jerk: peak %.2f m/s^3 (bound %.2f)\n", s.peak_path_jerk,
                 cfg.scaling.jerk_max_m_s3);

@@ -49,8 +49,6 @@ void print_load_line(const control::LoadSummary& load, bool known, bool chart);
 // "stop"). Shared by replay and sim.
 void print_stop_lines(const control::StopSummary& stop, bool end_stop, double stop_time_s,
                       double run_peak_spool_step, double stop_step_bound);
-// The most a spool command may move per control cycle (hydraulics.valves.stroke_time; 2: none).
-double spool_step_bound(const config::CraneConfig& cfg);
 int run_replay_command(const ReplayArgs& args);
 
 }  // namespace craneassist::cli

@@ -24,6 +24,7 @@
 #include "craneassist/input/replay_source.hpp"
 #include "craneassist/input/sdl_source.hpp"
 #include "craneassist/offline/sim_setup.hpp"
+#include "craneassist/valves/reference_follower.hpp"
 #include "exit_codes.hpp"
 #include "goal_planning.hpp"
 #include "option_checks.hpp"
@@ -511,7 +512,8 @@ int run_sim_command(const SimArgs& args) {
     print_stop_lines(s.stop, s.end_stop,
                      s.stop_cycles > 0 ? static_cast<double>(s.stop_cycles) / cfg.control.rate_hz
                                        : s.stop.time_s,
-                     s.peak_spool_step, spool_step_bound(cfg));
+                     s.peak_spool_step,
+                     valves::max_spool_step(cfg.model.valves, 1.0 / cfg.control.rate_hz));
     if (options.realtime_setup.lock_memory || options.realtime_setup.priority > 0 ||
         options.realtime_setup.cpu >= 0) {
       const control::RealtimeResult& r = s.realtime_result;

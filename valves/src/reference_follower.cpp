@@ -15,6 +15,10 @@ constexpr int kLeadBisections = 20;
 
 }  // namespace
 
+double max_spool_step(const dynamics::ValveSections& valves, double period_s) {
+  return valves.stroke_time_s > 0.0 ? std::min(period_s / valves.stroke_time_s, 2.0) : 2.0;
+}
+
 ReferenceFollower::ReferenceFollower(const dynamics::CraneModel& model, double position_gain_1_s,
                                      double period_s, double activation_speed_m_s,
                                      double activation_error_m)
@@ -24,9 +28,7 @@ ReferenceFollower::ReferenceFollower(const dynamics::CraneModel& model, double p
       lag_alpha_(model.valves.time_constant_s > 0.0
                      ? 1.0 - std::exp(-period_s / model.valves.time_constant_s)
                      : 1.0),
-      max_step_(model.valves.stroke_time_s > 0.0
-                    ? std::min(period_s / model.valves.stroke_time_s, 2.0)
-                    : 2.0) {
+      max_step_(max_spool_step(model.valves, period_s)) {
   const int n = model.dof();
   in_.velocity_ref_m_s.setZero(n);
   in_.position_error_m.setZero(n);

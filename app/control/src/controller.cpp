@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/scaling/scaling_filter.hpp"
@@ -222,7 +221,6 @@ ControllerStatus Controller::update(const valves::MachineState& state, const Eig
   const bool stopping = stale || dynamics_failed();
   const bool at_rest = out.qdot_ref.isZero(0.0) && out.sddot == 0.0 &&
                        (options_.mode != ScalingMode::kFull || scaler_out_.at_rest);
-  out.measured_tip_speed_m_s = measured_tip_speed(state, state_ok);
   if (stopping && at_rest) return finish_stop(state, state_ok, out);
   settle_cycles_ = rest_cycles_ = 0;
   stop_end_ = StopEnd::kNone;
@@ -234,13 +232,9 @@ ControllerStatus Controller::update(const valves::MachineState& state, const Eig
   return stopping ? ControllerStatus::kStopping : ControllerStatus::kRunning;
 }
 
-double Controller::measured_tip_speed(const valves::MachineState& state, bool state_ok) noexcept {
-  if (!state_ok) return std::numeric_limits<double>::quiet_NaN();
+bool Controller::measured_at_rest(const valves::MachineState& state) noexcept {
   dynamics::tip_jacobian(model_, kin_, state.q, rest_jacobian_);
-  return (rest_jacobian_ * state.qdot).norm();
-}
-
-bool Controller::cylinders_at_rest(const valves::MachineState& state) noexcept {
+  if (!((rest_jacobian_ * state.qdot).norm() < rest_speed_m_s_)) return false;
   dynamics::cylinder_arms(model_, state.q, rest_arms_);
   for (int i = 0; i < model_.dof(); ++i) {
     if (!(std::abs(rest_arms_[i] * state.qdot[i]) < rest_speed_m_s_)) return false;
@@ -257,8 +251,7 @@ ControllerStatus Controller::finish_stop(const valves::MachineState& state, bool
     if (!state_ok) {
       stop_end_ = StopEnd::kUnmeasured;
     } else {
-      const bool rest = out.measured_tip_speed_m_s < rest_speed_m_s_ && cylinders_at_rest(state);
-      rest_cycles_ = rest ? rest_cycles_ + 1 : 0;
+      rest_cycles_ = measured_at_rest(state) ? rest_cycles_ + 1 : 0;
       if (rest_cycles_ >= rest_confirm_cycles_) {
         stop_end_ = StopEnd::kAtRest;
       } else if (++settle_cycles_ > rest_timeout_cycles_) {

@@ -63,7 +63,7 @@ void RunStatistics::on_cycle(const CycleRecord& c) noexcept {
     }
   }
   s_.peak_spool_step = std::max(s_.peak_spool_step, spool_step);
-  add_stop(c, spool_step);
+  add_stop(c, speed, spool_step);
   for (int i = 0; i < n; ++i) last_spool_[i] = c.command.spool[i];
   spool_count_ = n;
 
@@ -138,7 +138,7 @@ void RunStatistics::add_load(double t, double tip_speed, const valves::MachineSt
   }
 }
 
-void RunStatistics::add_stop(const CycleRecord& c, double spool_step) noexcept {
+void RunStatistics::add_stop(const CycleRecord& c, double tip_speed, double spool_step) noexcept {
   StopSummary& st = s_.stop;
   double load_pa = 0.0;
   if (c.state.valid) {
@@ -176,7 +176,7 @@ void RunStatistics::add_stop(const CycleRecord& c, double spool_step) noexcept {
   ++st.stops;
   st.end = out != nullptr ? out->stop_end : StopEnd::kNone;
   st.tip_speed_at_neutral_m_s =
-      out != nullptr ? out->measured_tip_speed_m_s : std::numeric_limits<double>::quiet_NaN();
+      c.state.valid ? tip_speed : std::numeric_limits<double>::quiet_NaN();
   if (std::isfinite(st.tip_speed_at_neutral_m_s)) {
     st.max_tip_speed_at_neutral_m_s =
         std::max(st.max_tip_speed_at_neutral_m_s, st.tip_speed_at_neutral_m_s);

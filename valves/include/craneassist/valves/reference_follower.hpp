@@ -26,6 +26,10 @@
 
 namespace craneassist::valves {
 
+// The slew-rate limit hydraulics.valves.stroke_time sets: the most a spool command may move per
+// control period (2: no limit, a full reversal in one period).
+double max_spool_step(const dynamics::ValveSections& valves, double period_s);
+
 class ReferenceFollower {
  public:
   ReferenceFollower(const dynamics::CraneModel& model, double position_gain_1_s, double period_s,

@@ -124,10 +124,8 @@ struct ControllerOutput {
   double polytope_volume_m3_s3 = 0.0;
   double polytope_area_m2_s2 = 0.0;
   LoadOutput load;
-  // A stop: how its settling ended (kNone until the valves start to go neutral), and the
-  // measured tip speed of this cycle (NaN without a valid measurement).
+  // A stop: how its settling ended (kNone until the valves start to go neutral).
   StopEnd stop_end = StopEnd::kNone;
-  double measured_tip_speed_m_s = 0.0;
 };
 
 // The controller's status is the cycle status of the loop (control_loop.hpp).
@@ -213,8 +211,8 @@ class Controller {
   // The end of a stop: settle on the reference, then ramp the valves to neutral.
   ControllerStatus finish_stop(const valves::MachineState& state, bool state_ok,
                                ControllerOutput& out) noexcept;
-  double measured_tip_speed(const valves::MachineState& state, bool state_ok) noexcept;
-  bool cylinders_at_rest(const valves::MachineState& state) noexcept;
+  // The measured tip and every cylinder slower than control.rest_speed.
+  bool measured_at_rest(const valves::MachineState& state) noexcept;
   double rest_speed_m_s_ = 0.005;
   double hold_error_m_ = 0.0;
   long rest_timeout_cycles_ = 0, rest_confirm_cycles_ = 1;

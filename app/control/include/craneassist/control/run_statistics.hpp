@@ -122,7 +122,7 @@ class RunStatistics final : public CycleObserver {
  private:
   void add_load(double t, double tip_speed, const valves::MachineState& state,
                 const ControllerOutput& out) noexcept;
-  void add_stop(const CycleRecord& c, double spool_step) noexcept;
+  void add_stop(const CycleRecord& c, double tip_speed, double spool_step) noexcept;
   double period_s_;
   RunStatisticsOptions options_;
   RunSummary s_;
