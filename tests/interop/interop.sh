@@ -204,13 +204,24 @@ dynamic_type_object | dynamic_type_information)
     printf 'format: craneassist-telemetry/1\ntype_propagation: {type_object: false, type_information: true}\n' \
       > "$work/telemetry.yaml"
   fi
-  start_reader 25
   # The writer stays 15 s: now and then (1 run in many, on a loaded machine with the sanitizers)
   # discovery and TypeLookup took longer than the 8 s of a default replay and no type came.
   settle=10
+  start_reader 25
   run_replay --telemetry-config "$work/telemetry.yaml"
   finish_reader "telemetry:"
-  [ "$(grep -c "^type_[a-z]* craneassist/" "$work/reader.out")" = 4 ] || fail "not 4 topics' types"
+  types=$(grep -c "^type_[a-z]* craneassist/" "$work/reader.out" || true)
+  if [ "$types" != 4 ] && [ "$case_name" = dynamic_type_information ]; then
+    # Fast DDS 2.9's TypeLookup client now and then never calls back for a type whose request
+    # went out while the writer's TypeLookup endpoints were still being matched (seen once in
+    # the sanitizer stage of a loaded CI run): the same pair runs once more, saying so.
+    echo "retry: $types of 4 types came through TypeLookup; running the reader and the replay once more"
+    start_reader 25
+    run_replay --telemetry-config "$work/telemetry.yaml"
+    finish_reader "telemetry:"
+    types=$(grep -c "^type_[a-z]* craneassist/" "$work/reader.out" || true)
+  fi
+  [ "$types" = 4 ] || fail "$types topics' types, not 4"
   if [ "$case_name" = dynamic_type_object ]; then
     # Fast DDS 2.9's limit: `header` (the nested Header struct) is missing from every type.
     has reader.out "craneassist/status: craneassist::msg::Status, 27 members: active_limit avail_speed_m_s avail_speed_resolved_m_s backend crane deadman input_source"
