@@ -297,7 +297,7 @@ TEST(LiveLoop, StaleInputStopsJerkLimitedAndMotionResumesOnlyAfterReArm) {
   EXPECT_EQ(probe.rows[551].cmd[0], kOut.x());
   const auto& moving_again = probe.rows[650];
   EXPECT_STREQ(moving_again.status, "running");
-  EXPECT_GT(speed(moving_again), 0.3);
+  EXPECT_GT(speed(moving_again), 0.15);  // the start shaped to the grapple's swing (sway.md)
   const Eigen::Vector3d v(moving_again.tip_v[0], moving_again.tip_v[1], moving_again.tip_v[2]);
   EXPECT_GT(v.normalized().dot(kOut.normalized()), 0.999);
   EXPECT_GT(probe.rows[690].tip[0] - probe.rows[519].tip[0], 0.2);
@@ -325,7 +325,7 @@ TEST(LiveLoop, EveryFaultStopsWithItsReason) {
     Probe probe(400);
     control::run_live(cfg, source, machine, scripted_options(3.5, &probe), nullptr);
     ASSERT_EQ(probe.rows.size(), 350u) << c.reason;
-    EXPECT_GT(speed(probe.rows[149]), 0.3) << c.reason;
+    EXPECT_GT(speed(probe.rows[149]), 0.15) << c.reason;
     EXPECT_STREQ(probe.rows[150].stop_reason, c.reason);
     EXPECT_STREQ(probe.rows[151].status, "stopping") << c.reason;
     double peak_jerk = 0.0;
@@ -359,7 +359,7 @@ TEST(LiveLoop, AChatteringDeadmanStopsTheCraneAndKeepsItStopped) {
     Probe probe(600);
     control::run_live(cfg, source, machine, scripted_options(5.0, &probe), nullptr);
     ASSERT_EQ(probe.rows.size(), 500u);
-    EXPECT_GT(speed(probe.rows[149]), 0.3);
+    EXPECT_GT(speed(probe.rows[149]), 0.15);
     int passed = 0;
     double peak_jerk = 0.0, late_peak_speed = 0.0;
     for (std::size_t k = 150; k < probe.rows.size(); ++k) {

@@ -235,6 +235,7 @@ TEST(SimLoads, ALoadThePumpCannotLiftIsHeldNotDropped) {
 TEST(SimLoads, FrictionShowsInTheChamberPressuresWhileMoving) {
   auto cfg = k70m(0.0);
   cfg.simulation.pressure_noise_pa = 0.0;
+  cfg.model.grapple = {};  // rigid: a swinging grapple would add its inertia to the force
   const auto& cyl = cfg.model.cylinders[kTilt];
   const auto force_moving = [&](double spool) {
     sim_backend::SimBackend sim(cfg.model, offline::sim_settings(cfg));

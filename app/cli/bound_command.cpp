@@ -92,6 +92,7 @@ CLI::App* add_bound_command(CLI::App& cli, BoundArgs& args) {
   add_config_option(*bound, args.config_file);
   add_payload_option(*bound, args.payload_kg);
   add_resolution_option(*bound, args.resolution, "of the controller that drives the path");
+  add_sway_option(*bound, args.no_sway_damping);
   bound
       ->add_option("--start", args.start,
                    "A path file's start configuration: the shortest feasible extension or the "
@@ -114,7 +115,9 @@ int run_bound_command(const BoundArgs& args) {
   const char* format = "replay";  // the file's format, for its errors
   try {
     cfg = load_crane(args.config_file);
-    apply_crane_options(cfg, {.payload_kg = args.payload_kg, .resolution = args.resolution});
+    apply_crane_options(cfg, {.payload_kg = args.payload_kg,
+                              .resolution = args.resolution,
+                              .no_sway_damping = args.no_sway_damping});
     std::string text;
     try {  // read once, with the CSV formats' size limit; the header says which format it is
       text = files::read_text_file(args.file, files::kMaxCsvBytes, "tip path and replay");
@@ -169,6 +172,11 @@ int run_bound_command(const BoundArgs& args) {
   }
   std::printf("craneassist bound: %s on %s, payload %.0f kg\n", args.file.c_str(),
               cfg.model.name.c_str(), cfg.model.bodies.back().mass_kg);
+  if (cfg.model.grapple.hangs() && cfg.scaling.sway_damping) {
+    std::printf(
+        "  the controller damps the grapple's swing: each start and stop takes half a swing "
+        "period longer, which the bound does not (--no-sway-damping: without)\n");
+  }
   std::printf(
       "  resolution %s; limits: pump flow and cylinder speeds (with the %.0f %% reserve), "
       "%s power with m(s), b(s), cylinder and path accelerations\n",

@@ -18,6 +18,7 @@ struct BoundArgs {
   std::string start = "shortest";
   double ds_m = 0.01;
   std::string profile_file;  // empty: none
+  bool no_sway_damping = false;
 };
 
 CLI::App* add_bound_command(CLI::App& cli, BoundArgs& args);

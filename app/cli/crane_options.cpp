@@ -55,7 +55,14 @@ config::CraneConfig load_crane(const std::string& file) {
   return file.empty() ? config::default_crane_config() : config::load_crane_config(file);
 }
 
+CLI::Option* add_sway_option(CLI::App& command, bool& off) {
+  return command.add_flag("--no-sway-damping", off,
+                          "Leave the grapple's swing undamped (the config's scaling.sway_damping "
+                          "off; docs/sway.md)");
+}
+
 void apply_crane_options(config::CraneConfig& cfg, const CraneOptions& options) {
+  if (options.no_sway_damping) cfg.scaling.sway_damping = false;
   if (options.payload_kg) {
     apply_override("--payload", [&] { config::set_payload_mass(cfg.model, *options.payload_kg); });
   }

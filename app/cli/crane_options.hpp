@@ -27,6 +27,10 @@ CLI::Option* add_initial_option(CLI::App& command, std::string& pose);
 CLI::Option* add_resolution_option(CLI::App& command, std::string& value, const std::string& what,
                                    bool allow_all = false);
 
+// --no-sway-damping: the run without the sway damping (docs/sway.md; the config's
+// scaling.sway_damping off).
+CLI::Option* add_sway_option(CLI::App& command, bool& off);
+
 // The crane config `file`, or the embedded K70M reference crane when it is empty. Throws
 // config::ConfigError naming the file, line and field.
 config::CraneConfig load_crane(const std::string& file);
@@ -37,6 +41,7 @@ struct CraneOptions {
   std::string initial{};
   std::string resolution{};
   bool initial_allowed = true;  // false on the can backend: it starts where the machine is
+  bool no_sway_damping = false;
 };
 
 // Applies the options to `cfg`. A value the config cannot take throws CLI::ValidationError

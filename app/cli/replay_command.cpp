@@ -124,6 +124,16 @@ void print_stop_lines(const control::StopSummary& st, bool end_stop, double stop
       st.steady_load_pressure_pa * 1e-6);
 }
 
+void print_swing_line(const control::SwingSummary& s, const config::CraneConfig& cfg) {
+  if (!s.measured) return;
+  const bool damped = cfg.scaling.sway_damping && cfg.model.grapple.hangs();
+  std::printf("  swing: peak %.1f deg", s.peak_deg);
+  if (s.released)
+    std::printf(", %.1f deg from 1 s after the stick's last release", s.after_release_deg);
+  std::printf(", %.1f deg at the end (sway damping %s)\n", s.end_deg,
+              damped ? "on" : "off: --no-sway-damping or scaling.sway_damping");
+}
+
 void print_load_line(const control::LoadSummary& l, bool known, bool chart) {
   if (!known && !l.weighed) {
     std::printf(
@@ -203,6 +213,7 @@ void print_summary(const control::RunSummary& s, const config::CraneConfig& cfg,
   }
   print_feel_line(s.feel);
   print_load_line(s.load, controller.payload_known, !cfg.load_chart.empty());
+  print_swing_line(s.swing, cfg);
   std::printf("  active limit (cycles):");
   for (std::size_t i = 0; i < s.limit_cycles.size(); ++i) {
     if (s.limit_cycles[i] > 0) {
@@ -285,7 +296,7 @@ int run_replay_command(const ReplayArgs& args) {
   try {
     cfg = load_crane(args.config_file);
     apply_crane_options(cfg, {args.payload_kg, args.initial, args.resolution,
-                              !uses_can_backend(args.machine, cfg)});
+                              !uses_can_backend(args.machine, cfg), args.no_sway_damping});
     if (!args.power_bound.empty()) {
       cfg.scaling.power_bound = dynamics::parse_power_bound(args.power_bound).value();
     }
@@ -416,6 +427,7 @@ CLI::App* add_replay_command(CLI::App& cli, ReplayArgs& args) {
       ->check(FiniteRange(0.0, 600.0))
       ->capture_default_str();
   add_payload_option(*replay, args.payload_kg);
+  add_sway_option(*replay, args.no_sway_damping);
   replay->add_flag("--payload-known", args.payload_known,
                    "Tell the controller the payload (--payload, the config's, and the replay's "
                    "load_kg) instead of letting the crane scale estimate it (docs/loads.md)");

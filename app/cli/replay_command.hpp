@@ -31,7 +31,9 @@ struct ReplayArgs {
   bool realtime = false;
   double settle_s = 1.0;
   std::optional<double> payload_kg;
-  bool payload_known = false;     // tell the controller the payload (else the crane scale finds it)
+  bool payload_known = false;
+  bool no_sway_damping = false;   // --no-sway-damping     // tell the controller the payload (else
+                                  // the crane scale finds it)
   std::string initial;            // start pose, "NAME=VALUE UNIT, ..."; empty: the config's
   std::string pump_max_flow;      // quantity text, e.g. "120 L/min"
   std::string prime_mover_power;  // quantity text, e.g. "60 kW"
@@ -43,6 +45,8 @@ CLI::App* add_replay_command(CLI::App& cli, ReplayArgs& args);
 // The summary's load lines (docs/loads.md): the crane scale against the simulated load, the load
 // moment against the chart, a load above a port relief. Shared by replay and sim.
 void print_load_line(const control::LoadSummary& load, bool known, bool chart);
+// The swing line (nothing when no cycle measured the swing).
+void print_swing_line(const control::SwingSummary& swing, const config::CraneConfig& cfg);
 // The summary's stop lines (docs/safety.md): how the last stop ended (the measured tip speed when
 // the valves went neutral, at rest or after the rest timeout) and, over every stop, spool steps,
 // reverse kicks and load pressures. end_stop: the run ended by that stop ("end of run", else

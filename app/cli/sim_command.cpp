@@ -221,6 +221,7 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
   sim->add_option("--goal-table", args.goal_table,
                   "--input goal: the posture table file (default: the cache, as ptp)");
   add_payload_option(*sim, args.payload_kg);
+  add_sway_option(*sim, args.no_sway_damping);
   sim->add_flag("--payload-known", args.payload_known,
                 "Tell the controller the payload instead of letting the crane scale estimate it "
                 "(docs/loads.md)");
@@ -300,7 +301,7 @@ int run_sim_command(const SimArgs& args) {
   try {
     cfg = load_crane(args.config_file);
     apply_crane_options(cfg, {args.payload_kg, args.initial, args.resolution,
-                              !uses_can_backend(args.machine, cfg)});
+                              !uses_can_backend(args.machine, cfg), args.no_sway_damping});
     // In the drive mode a pad's and the page's right stick drive the base (a mapping with a
     // drive stick); the keyboard has its own drive keys.
     jcfg = !args.joystick_file.empty() ? config::load_joystick_config(args.joystick_file)
@@ -509,6 +510,7 @@ int run_sim_command(const SimArgs& args) {
                 s.tip_path_m, s.peak_tip_speed_m_s, s.enabled_cycles);
     std::printf("  cycle timing: %s\n", control::describe(s.timing).c_str());
     print_load_line(s.load, args.payload_known, !cfg.load_chart.empty());
+    print_swing_line(s.swing, cfg);
     print_stop_lines(s.stop, s.end_stop,
                      s.stop_cycles > 0 ? static_cast<double>(s.stop_cycles) / cfg.control.rate_hz
                                        : s.stop.time_s,

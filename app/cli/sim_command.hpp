@@ -30,12 +30,13 @@ struct SimArgs {
   int cpu = -1;                    // --cpu N: pin the loop thread; -1: none
   std::optional<double> payload_kg;
   bool payload_known = false;
-  std::string resolution;  // empty: the config's
-  std::string initial;     // start pose "NAME=VALUE UNIT, ..." (sim backend); empty: the config's
-  BackendArgs machine;     // empty values: the config's backend: and can:
-  bool drive = false;      // --drive: the crane on the simulated wheeled base
-  std::string base_file;   // --base FILE (implies --drive); empty: the embedded base
-  std::string pump;        // --pump shared|separate; empty: the base config's
+  bool no_sway_damping = false;  // --no-sway-damping
+  std::string resolution;        // empty: the config's
+  std::string initial;    // start pose "NAME=VALUE UNIT, ..." (sim backend); empty: the config's
+  BackendArgs machine;    // empty values: the config's backend: and can:
+  bool drive = false;     // --drive: the crane on the simulated wheeled base
+  std::string base_file;  // --base FILE (implies --drive); empty: the embedded base
+  std::string pump;       // --pump shared|separate; empty: the base config's
   TelemetryArgs telemetry;
   WebArgs web;
   // --input goal (docs/mhsb.md#the-k70m-a-goal-for-sim): the first goal, later ones, the

@@ -514,6 +514,22 @@ void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& mo
   }
 }
 
+// Optional hanging grapple (docs/sway.md): the bodies at the tip and the payload hang from it on a
+// two-axis link in the simulator.
+void read_grapple(Reader& r, const YAML::Node& root, dynamics::CraneModel& model) {
+  const auto section =
+      r.optional_section(root, "grapple", "", {"hanger_length", "load_below", "damping"});
+  if (!section) return;
+  const YAML::Node& node = *section;
+  auto& g = model.grapple;
+  g.com_below_m = r.value_in(node, "hanger_length", "grapple", Dimension::kLength, 0.05, 10.0,
+                             "between 5 cm and 10 m");
+  g.load_below_m = r.value_in(node, "load_below", "grapple", Dimension::kLength, 0.05, 10.0,
+                              "between 5 cm and 10 m");
+  g.damping_n_m_s_rad = r.value_in(node, "damping", "grapple", Dimension::kRotaryDamping, 0.0, 1e6,
+                                   "between 0 and 1000 kN*m*s/rad");
+}
+
 // Optional rated load against reach (docs/loads.md).
 void read_load_chart(Reader& r, const YAML::Node& root, LoadChart& chart) {
   const auto section = r.optional_section(root, "load_chart", "", {"reach", "rated_load"});
@@ -581,7 +597,7 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   if (!root.IsMap()) r.fail(root, "", "expected a mapping at the top level");
   r.check_keys(root, "",
                {"format", "name", "frames", "joints", "bodies", "payload", "hydraulics", "control",
-                "scaling", "redundancy", "simulation", "backend", "can", "load_chart"});
+                "scaling", "redundancy", "simulation", "backend", "can", "load_chart", "grapple"});
   const std::string format = r.text(root, "format", "");
   if (format != kFormat) {
     r.fail(root["format"], "format",
@@ -600,6 +616,7 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   read_joints(r, root, model);
   read_bodies(r, root, model);
   read_hydraulics(r, root, model);
+  read_grapple(r, root, model);
 
   const YAML::Node control = r.child(root, "control", "");
   r.check_keys(control, "control",
@@ -633,7 +650,8 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   const std::string sp = "scaling";
   r.check_keys(scaling, sp,
                {"jerk_max", "acceleration_max", "deceleration_max", "direction_change_acceleration",
-                "tracking_error_ok", "tracking_error_filter", "power_bound", "power_reserve"});
+                "tracking_error_ok", "tracking_error_filter", "power_bound", "power_reserve",
+                "sway_damping"});
   auto& sc = cfg.scaling;
   sc.jerk_max_m_s3 =
       r.value_in(scaling, "jerk_max", sp, Dimension::kJerk, 1e-3, 1e4, "between 0.001 and 10000");
@@ -651,6 +669,7 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   sc.power_reserve = r.value_in(scaling, "power_reserve", sp, Dimension::kDimensionless, 0.0, 0.5,
                                 "between 0 and 0.5");
   sc.power_bound = r.one_of(scaling, "power_bound", sp, dynamics::kPowerBounds);
+  sc.sway_damping = r.flag(scaling, "sway_damping", sp, true);
 
   const YAML::Node redundancy = r.child(root, "redundancy", "");
   r.check_keys(redundancy, "redundancy", {"resolution"});

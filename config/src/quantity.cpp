@@ -54,6 +54,8 @@ constexpr UnitDef kUnits[] = {
     {"kN", Dimension::kForce, 1e3},
     {"N*s/m", Dimension::kDamping, 1.0},
     {"kN*s/m", Dimension::kDamping, 1e3},
+    {"N*m*s/rad", Dimension::kRotaryDamping, 1.0},
+    {"kN*m*s/rad", Dimension::kRotaryDamping, 1e3},
 };
 
 std::string_view trim(std::string_view s) {
@@ -131,6 +133,8 @@ const char* to_string(Dimension d) {
       return "force";
     case Dimension::kDamping:
       return "damping (force per speed)";
+    case Dimension::kRotaryDamping:
+      return "rotary damping (torque per angular speed)";
   }
   return "?";
 }

@@ -27,12 +27,19 @@ constexpr double kCommandChange = 0.02;
 constexpr double kMinRestTime = 0.4;  // s: valve delay and lag with margin
 constexpr double kRestartRoom = 4.0;
 constexpr double kMinRestartRoom = 0.1;  // m: a restart from rest goes at least this far
+// m/s^2: the shaped reference's acceleration may pass a bound by this before the motion takes
+// over (rounding).
+constexpr double kBoundSlack = 1e-9;
 
 }  // namespace
 
 TipScaler::TipScaler(const dynamics::CraneModel& model, const TipScalerConfig& config,
                      dynamics::RigidBodyTerms& terms)
-    : model_(model), config_(config), terms_(terms) {
+    : model_(model),
+      config_(config),
+      terms_(terms),
+      velocity_shaper_(config.period_s, config.sway_max_delay_s),
+      acceleration_shaper_(config.period_s, config.sway_max_delay_s) {
   acceleration_limits_.path_acceleration_max = config.acceleration_max;
   acceleration_limits_.power_bound = config.power_bound;
   acceleration_limits_.power_reserve = config.power_reserve;
@@ -45,20 +52,39 @@ void TipScaler::reset() {
   reversing_ = false;
   end_brake_ = false;
   s_ = 0.0;
+  velocity_shaper_.reset();
+  acceleration_shaper_.reset();
+  ref_velocity_.setZero();
+  ref_acceleration_.setZero();
+  shaping_ = false;
+  steady_cycles_ = kSteadyForever;
+}
+
+void TipScaler::hand_over() {
+  // The motion's own state becomes the reference's: continuous in velocity and acceleration.
+  velocity_ = ref_velocity_;
+  acceleration_ = ref_acceleration_;
+  shaping_ = false;
+  steady_cycles_ = 0;
 }
 
 Eigen::Vector3d TipScaler::direction(const Eigen::Vector3d& command) const {
-  const double speed = velocity_.norm();
-  if (speed > 0.0) return velocity_ / speed;
-  const double accel = acceleration_.norm();
-  if (accel > 0.0) return acceleration_ / accel;  // leaving rest (a reversal through zero)
+  // The reference's own velocity (shaped), else the motion's that leads it.
+  for (const Eigen::Vector3d* v : {&ref_velocity_, &velocity_}) {
+    const double speed = v->norm();
+    if (speed > 0.0) return *v / speed;
+  }
+  for (const Eigen::Vector3d* a : {&ref_acceleration_, &acceleration_}) {
+    const double accel = a->norm();
+    if (accel > 0.0) return *a / accel;  // leaving rest (a reversal through zero)
+  }
   const double c = command.norm();
   if (c > 0.0 && std::isfinite(c)) return command / c;
   return last_direction_;
 }
 
 double TipScaler::intended_speed(const Eigen::Vector3d& command) const {
-  const double speed = velocity_.norm();
+  const double speed = std::max(velocity_.norm(), ref_velocity_.norm());
   const double c = command.allFinite() ? command.norm() : 0.0;
   return std::max(speed, std::min(c, std::max(kIntendedShare * speed, speed + kIntendedMargin)));
 }
@@ -97,7 +123,10 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
   const double period = config_.period_s;
   const double jerk = config_.jerk_max;
   const Eigen::Vector3d& u = in.direction;
-  const double speed = velocity_.norm();
+  // A stop and the load limiter's refusal act at once: the motion continues from where the
+  // shaped reference is, unshaped.
+  if (shaping_ && (in.stale_input || in.overload_refused)) hand_over();
+  double speed = velocity_.norm();
 
   // Velocity-level limits along u and the acceleration bounds at the present speed. Without the
   // dynamics (a failed step) the bounds are those that need none: no power bound.
@@ -106,6 +135,10 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
                                                acceleration_limits_, out.terms, out.bounds);
   // A stale input or a failed dynamics step: a jerk-limited stop along the present direction.
   const bool stop = in.stale_input || out.dynamics_failed;
+  if (shaping_ && stop) {
+    hand_over();
+    speed = velocity_.norm();
+  }
 
   // One factor on the whole command.
   const double request = in.command.norm();
@@ -117,13 +150,37 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
   }
   if (in.overload_refused) cap = {0.0, ActiveLimit::kOverload};
   double target = stop ? 0.0 : std::clamp(cap.value, 0.0, request);
+  // While the reference is shaped, (v + K v_past) / (1 + K), the motion's own limits are those
+  // that keep the shaped reference within this cycle's: |v| <= (1 + K) cap - K |v_past| under a
+  // speed cap, and the same on the acceleration bounds below.
+  double k_past = 0.0;
+  Eigen::Vector3d v_past = Eigen::Vector3d::Zero(), a_past = Eigen::Vector3d::Zero();
+  if (shaping_) {
+    k_past = SwayShaper::past_weight(sway_zeta_);
+    v_past = velocity_shaper_.upcoming_past(sway_omega_rad_s_, sway_zeta_);
+    a_past = acceleration_shaper_.upcoming_past(sway_omega_rad_s_, sway_zeta_);
+    const double physical = std::min(
+        lowest_speed_cap(kInf, 1.0, in.sdot_joint_limit, out.speed, out.bounds, in.near_singular)
+            .value,
+        ahead);
+    if (std::isfinite(physical)) {
+      target = std::min(target, std::max((1.0 + k_past) * physical - k_past * v_past.norm(), 0.0));
+    }
+  }
   // Braking trigger at a joint end: the end damping cap assumes braking from zero acceleration;
   // while the path still accelerates, braking must begin earlier.
   // Once braked there, the reference stays at rest until the end damping would allow a useful
   // speed again or the stick moves elsewhere: no creeping in stop-and-go steps, which makes the
   // valves chatter through their dead zones.
-  if (speed > 0.0 && braking_distance(speed, acceleration_.dot(u), in.stop_deceleration_m_s2,
-                                      in.stop_jerk_m_s3) >= in.end_distance_m) {
+  // The reference (shaped or not) is what approaches the end.
+  const double ref_speed = ref_velocity_.norm();
+  if (ref_speed > 0.0 &&
+      braking_distance(ref_speed, ref_acceleration_.dot(u), in.stop_deceleration_m_s2,
+                       in.stop_jerk_m_s3) >= in.end_distance_m) {
+    if (shaping_) {
+      hand_over();
+      speed = velocity_.norm();
+    }
     end_brake_ = true;
     rest_time_s_ = 0.0;
     end_brake_command_ = in.command;
@@ -172,7 +229,15 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
     reversing_ =
         goal.dot(velocity_) < 0.0 && closest < kReversalShare * std::max(speed, goal.norm());
   }
-  if (reversing_) goal.setZero();
+  if (reversing_) {
+    goal.setZero();
+    // A reversal is not shaped: it comes to rest first, and every valve crosses its dead zone
+    // at rest (a shaped reference would pass through zero still decelerating).
+    if (shaping_) {
+      hand_over();
+      speed = velocity_.norm();
+    }
+  }
 
   // The segment from the present velocity to the goal.
   Eigen::Vector3d d = goal - velocity_;
@@ -204,8 +269,13 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
     double lo = -kInf, hi = kInf;
     const double eu = e.dot(u);
     const double perp_u = a_perp_new.dot(u);
-    const double s_min = stop_bound(out.bounds, acceleration_limits_.path_deceleration_max);
-    const double s_max = out.bounds.sddot_max;
+    double s_min = stop_bound(out.bounds, acceleration_limits_.path_deceleration_max);
+    double s_max = out.bounds.sddot_max;
+    if (shaping_) {
+      const double past_along = a_past.dot(u);
+      s_min = (1.0 + k_past) * s_min - k_past * past_along;
+      s_max = (1.0 + k_past) * s_max - k_past * past_along;
+    }
     if (std::abs(eu) > 1e-9) {
       double t1 = (s_min - perp_u) / eu, t2 = (s_max - perp_u) / eu;
       if (std::isnan(t1)) t1 = -kInf;
@@ -243,20 +313,65 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
     }
   }
 
-  const Eigen::Vector3d step = 0.5 * period * (velocity_ + v_new);
+  const bool moved = !(v_new == velocity_ && a_new.isZero(0.0));
+  velocity_ = v_new;
+  acceleration_ = a_new;
+  const bool motion_at_rest = v_new.isZero(0.0) && a_new.isZero(0.0);
+  if (motion_at_rest) reversing_ = false;
+
+  // Sway damping (docs/sway.md): the reference is the motion ZV-shaped to the grapple's swing.
+  // Shaping starts (or takes a new frequency) only when the motion has been steady for longer
+  // than the shaper's delay before this cycle (the shaper's history is flat), so the shaped
+  // reference never jumps; a stop, the end brake and the limiter's refusal hand the shaped state
+  // back to the motion (hand_over).
+  const bool hard = stop || end_brake_ || in.overload_refused || reversing_;
+  const long window =
+      std::lround(SwayShaper::delay_s(in.sway_omega_rad_s, in.sway_zeta) / period) + 1;
+  if (!hard && steady_cycles_ >= window) {
+    shaping_ = in.sway_omega_rad_s > 0.0;
+    sway_omega_rad_s_ = in.sway_omega_rad_s;
+    sway_zeta_ = in.sway_zeta;
+  }
+  steady_cycles_ = moved ? 0 : std::min(steady_cycles_ + 1, kSteadyForever);
+  const Eigen::Vector3d v_ref = velocity_shaper_.shape(v_new, sway_omega_rad_s_, sway_zeta_);
+  const Eigen::Vector3d a_ref = acceleration_shaper_.shape(a_new, sway_omega_rad_s_, sway_zeta_);
+  const Eigen::Vector3d v_out = shaping_ ? v_ref : v_new;
+  const Eigen::Vector3d a_out = shaping_ ? a_ref : a_new;
+  // The shaped reference within the limits at its own speed: the speed caps of this cycle (a
+  // blend with the speed of half a period ago passes a cap that has fallen since) and the
+  // acceleration bounds (the power bound is not convex in speed and acceleration). The cycle
+  // that passes one (by no more than it moved since the last) hands the shaped state to the
+  // motion, which brings it back within the jerk bound as it follows any moving limit.
+  bool past_bounds = false;
+  if (shaping_ && !(v_out == v_new && a_out == a_new)) {
+    const double ref_speed_out = v_out.norm();
+    const bool dynamics_ok = path_terms_and_bounds(model_, terms_, q, geometry, ref_speed_out,
+                                                   acceleration_limits_, out.terms, out.bounds);
+    const double speed_cap = std::min(
+        lowest_speed_cap(kInf, 1.0, in.sdot_joint_limit, out.speed, out.bounds, in.near_singular)
+            .value,
+        ahead);
+    const double along = a_out.dot(u);
+    past_bounds =
+        !dynamics_ok || ref_speed_out > speed_cap + kBoundSlack ||
+        along > out.bounds.sddot_max + kBoundSlack ||
+        along < stop_bound(out.bounds, acceleration_limits_.path_deceleration_max) - kBoundSlack;
+  }
+
+  const Eigen::Vector3d step = 0.5 * period * (ref_velocity_ + v_out);
   out.ds = step.dot(u);
   s_ += step.norm();
   out.s = s_;
-  out.sdddot = (a_new - acceleration_).norm() / period;
-  velocity_ = v_new;
-  acceleration_ = a_new;
-  out.velocity = v_new;
-  out.acceleration = a_new;
-  out.sdot = v_new.norm();
-  if (out.sdot > 0.0) last_direction_ = v_new / out.sdot;
-  out.sddot = a_new.dot(out.sdot > 0.0 ? last_direction_ : u);
-  out.at_rest = v_new.isZero(0.0) && a_new.isZero(0.0);
-  if (out.at_rest) reversing_ = false;
+  out.sdddot = (a_out - ref_acceleration_).norm() / period;
+  ref_velocity_ = v_out;
+  ref_acceleration_ = a_out;
+  out.velocity = v_out;
+  out.acceleration = a_out;
+  out.sdot = v_out.norm();
+  if (out.sdot > 0.0) last_direction_ = v_out / out.sdot;
+  out.sddot = a_out.dot(out.sdot > 0.0 ? last_direction_ : u);
+  out.at_rest = motion_at_rest && v_out.isZero(0.0) && a_out.isZero(0.0);
+  if (past_bounds) hand_over();
 
   // What holds the motion back: the failed dynamics, the stale input, a power bound the
   // tangential acceleration is pressed against, or the lowest velocity-level limit when it is

@@ -11,6 +11,7 @@
 
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/ode_crane.hpp"
+#include "craneassist/dynamics/pendulum.hpp"
 #include "craneassist/sim_backend/pump_model.hpp"
 #include "craneassist/sim_backend/valve_section.hpp"
 
@@ -20,8 +21,6 @@ namespace {
 constexpr double kLoadPressureTimeConstantS = 0.005;  // stands in for oil compressibility
 constexpr double kWorldErp = 0.2;
 constexpr double kWorldCfm = 1e-10;
-// A body closer than this to the tip point travels with the load body (the grapple and rotator).
-constexpr double kAtTipM = 1e-3;
 constexpr double kMinLoadBodyKg = 1e-3;  // the load body of a crane with nothing at its tip
 // Cylinder speed over which the Coulomb friction builds up (tanh), m/s.
 constexpr double kFrictionSmoothingM_S = 1e-3;
@@ -40,22 +39,10 @@ dynamics::CraneModel without_tip_load(const dynamics::CraneModel& m) {
   dynamics::CraneModel out = m;
   out.bodies.clear();
   for (const auto& b : m.bodies) {
-    const bool tip = b.frame == m.dof() && b.com_m.norm() < kAtTipM;
+    const bool tip = b.frame == m.dof() && b.com_m.norm() < dynamics::kAtTipM;
     if (!(tip || dynamics::is_payload(b))) out.bodies.push_back(b);
   }
   return out;
-}
-
-// Mass and inertia (about the tip point) of the bodies at the tip other than the payload.
-void tip_bodies(const dynamics::CraneModel& m, double& mass_kg, Eigen::Vector3d& inertia) {
-  mass_kg = 0.0;
-  inertia.setZero();
-  for (const auto& b : m.bodies) {
-    if (b.frame == m.dof() && b.com_m.norm() < kAtTipM && !dynamics::is_payload(b)) {
-      mass_kg += b.mass_kg;
-      inertia += b.inertia_diag_kgm2;
-    }
-  }
 }
 
 }  // namespace
@@ -116,37 +103,106 @@ struct SimBackend::Impl {
     return w;
   }
 
-  // The grapple, rotator and payload as one body welded to the tip (a fixed joint), so that the
-  // payload can change while the crane moves.
+  // The grapple, rotator and payload. Rigid: one body welded to the tip (a fixed joint), so that
+  // the payload can change while the crane moves. Hanging (model.grapple): the grapple and
+  // rotator hang below the tip on a universal joint (the two-axis link) and the payload, a body
+  // of its own, is welded to the grapple at its depth.
   void make_load_body(const JointVector& q0) {
-    tip_bodies(model, tip_mass_kg, tip_inertia);
+    dynamics::tip_bodies(model, tip_mass_kg, tip_inertia);
     dynamics::KinematicsData kin;
     dynamics::forward_kinematics(model, kin, q0);
     const Eigen::Isometry3d& tip = kin.frames[static_cast<std::size_t>(model.dof())];
-    load_body = dBodyCreate(world);
+    payload_kg = dynamics::payload_mass_kg(model);
+    const auto& g = model.grapple;
+    if (!g.hangs()) {
+      load_body = make_body(tip.translation(), tip.linear());
+      apply_load_mass();
+      load_joint = dJointCreateFixed(world, nullptr);
+      dJointAttach(load_joint, load_body, crane->body(model.dof()));
+      dJointSetFixed(load_joint);
+      return;
+    }
+    const Eigen::Vector3d down = dynamics::down_direction(model);
+    // The link's axes: one across the boom plane, fixed to the boom (the lift and tilt joints'
+    // axis stays horizontal in every pose), one along it, fixed to the grapple (any axis across
+    // the first where gravity runs along it).
+    const Eigen::Vector3d across = kin.frames[1].linear().col(2);
+    Eigen::Vector3d along = down.cross(across);
+    if (along.norm() < 1e-6) along = across.unitOrthogonal();
+    along.normalize();
+    const Eigen::Matrix3d upright = Eigen::Matrix3d::Identity();
+    load_body = make_body(tip.translation() + g.com_below_m * down, upright);
+    payload_body = make_body(tip.translation() + g.load_below_m * down, upright);
+    apply_load_mass();
+    load_joint = dJointCreateUniversal(world, nullptr);
+    dJointAttach(load_joint, crane->body(model.dof()), load_body);
+    dJointSetUniversalAnchor(load_joint, tip.translation().x(), tip.translation().y(),
+                             tip.translation().z());
+    dJointSetUniversalAxis1(load_joint, across.x(), across.y(), across.z());
+    dJointSetUniversalAxis2(load_joint, along.x(), along.y(), along.z());
+    payload_joint = dJointCreateFixed(world, nullptr);
+    dJointAttach(payload_joint, payload_body, load_body);
+    dJointSetFixed(payload_joint);
+  }
+
+  dBodyID make_body(const Eigen::Vector3d& position, const Eigen::Matrix3d& rotation) {
+    dBodyID body = dBodyCreate(world);
     dMatrix3 r;
     for (int row = 0; row < 3; ++row) {
-      for (int col = 0; col < 3; ++col) r[4 * row + col] = tip.linear()(row, col);
+      for (int col = 0; col < 3; ++col) r[4 * row + col] = rotation(row, col);
       r[4 * row + 3] = 0.0;
     }
-    dBodySetPosition(load_body, tip.translation().x(), tip.translation().y(),
-                     tip.translation().z());
-    dBodySetRotation(load_body, r);
-    payload_kg = dynamics::payload_mass_kg(model);
-    apply_load_mass();
-    load_joint = dJointCreateFixed(world, nullptr);
-    dJointAttach(load_joint, load_body, crane->body(model.dof()));
-    dJointSetFixed(load_joint);
+    dBodySetPosition(body, position.x(), position.y(), position.z());
+    dBodySetRotation(body, r);
+    return body;
+  }
+
+  static void set_mass(dBodyID body, double mass_kg, const Eigen::Vector3d& inertia) {
+    dMass mass;
+    dMassSetParameters(&mass, mass_kg, 0.0, 0.0, 0.0, inertia.x(), inertia.y(), inertia.z(), 0.0,
+                       0.0, 0.0);
+    dBodySetMass(body, &mass);
   }
 
   void apply_load_mass() {
+    if (payload_body != nullptr) {
+      // The grapple keeps its own mass; the payload is a point at its depth (a small inertia
+      // floor keeps ODE's inverse defined).
+      const double mg = std::max(tip_mass_kg, kMinLoadBodyKg);
+      set_mass(load_body, mg, tip_inertia.cwiseMax(1e-3 * mg));
+      const double mp = std::max(payload_kg, kMinLoadBodyKg);
+      set_mass(payload_body, mp, Eigen::Vector3d::Constant(1e-3 * mp));
+      return;
+    }
     const double m = std::max(tip_mass_kg + payload_kg, kMinLoadBodyKg);
     // A point payload adds no inertia of its own; a small floor keeps ODE's inverse defined.
-    const Eigen::Vector3d inertia = tip_inertia.cwiseMax(1e-3 * m);
-    dMass mass;
-    dMassSetParameters(&mass, m, 0.0, 0.0, 0.0, inertia.x(), inertia.y(), inertia.z(), 0.0, 0.0,
-                       0.0);
-    dBodySetMass(load_body, &mass);
+    set_mass(load_body, m, tip_inertia.cwiseMax(1e-3 * m));
+  }
+
+  // The link's damping (its brake or friction), as torques against each axis's rate.
+  void damp_link() {
+    const double c = model.grapple.damping_n_m_s_rad;
+    if (payload_body == nullptr || c <= 0.0) return;
+    dJointAddUniversalTorques(load_joint, -c * dJointGetUniversalAngle1Rate(load_joint),
+                              -c * dJointGetUniversalAngle2Rate(load_joint));
+  }
+
+  // The hanger's swing from the vertical and its components towards and across the reach.
+  void measure_swing(valves::MachineState& state) const {
+    if (payload_body == nullptr) return;
+    dVector3 anchor;
+    dJointGetUniversalAnchor(load_joint, anchor);
+    const dReal* c = dBodyGetPosition(load_body);
+    const Eigen::Vector3d r(c[0] - anchor[0], c[1] - anchor[1], c[2] - anchor[2]);
+    const Eigen::Vector3d down = dynamics::down_direction(model);
+    // Outwards: the tip's horizontal direction from the slew axis (the base frame's z).
+    Eigen::Vector3d radial(anchor[0], anchor[1], 0.0);
+    radial = radial.norm() > 1e-9 ? Eigen::Vector3d(radial.normalized()) : Eigen::Vector3d::UnitX();
+    const Eigen::Vector3d tangential = Eigen::Vector3d::UnitZ().cross(radial);
+    const double vertical = r.dot(down);
+    state.swing_rad = std::atan2((r - vertical * down).norm(), vertical);
+    state.swing_radial_rad = std::atan2(r.dot(radial), vertical);
+    state.swing_tangential_rad = std::atan2(r.dot(tangential), vertical);
   }
 
   // Holds every joint for a few steps so feedback carries the static loads.
@@ -269,6 +325,7 @@ struct SimBackend::Impl {
         if (friction_effort != 0.0) dJointAddHingeTorque(j, friction_effort);
       }
     }
+    damp_link();
     dWorldStep(world, settings.step_s);
     crane->read_state(q, qdot);
   }
@@ -324,8 +381,10 @@ struct SimBackend::Impl {
   JointVector spool_command, requested_velocity, demand, load_pressure, force, q, qdot;
   JointVector force_filtered, pressure_a, pressure_b;
   std::array<bool, dynamics::kMaxJoints> creep{}, stall{};
-  dBodyID load_body = nullptr;
+  dBodyID load_body = nullptr;  // the grapple (rigid: with the payload)
   dJointID load_joint = nullptr;
+  dBodyID payload_body = nullptr;  // hanging grapple only
+  dJointID payload_joint = nullptr;
   double tip_mass_kg = 0.0;
   Eigen::Vector3d tip_inertia = Eigen::Vector3d::Zero();
   double payload_kg = 0.0;
@@ -366,6 +425,7 @@ valves::BackendStatus SimBackend::read(valves::MachineState& state) {
   state.pressure_b_pa = s.pressure_b;
   state.chamber_pressures = true;
   state.payload_truth_kg = s.payload_kg;
+  s.measure_swing(state);
   state.pump.flow_m3_s = s.pump_result.flow_m3_s;
   state.pump.pressure_pa = s.pump_result.supply_pressure_pa;
   state.pump.power_w = s.pump_result.power_w;

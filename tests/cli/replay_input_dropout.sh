@@ -20,7 +20,8 @@ awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
   if (t == 3.49) y0 = $c["tip_y"]
   if (t == 5.0) y1 = $c["tip_y"]
 } END {
-  if (y1 - y0 < 0.3) { print "the tip did not go up after the stop: " y0 " -> " y1; bad = 1 }
+  # Sway damping shapes the restart (docs/sway.md): 0.2 m in 1.5 s at 0.3 m/s.
+  if (y1 - y0 < 0.15) { print "the tip did not go up after the stop: " y0 " -> " y1; bad = 1 }
   exit bad
 }' "$work/log.csv"
 echo "input dropout OK"

@@ -25,7 +25,7 @@ trap 'rm -f "$out"' EXIT
   i=0
   while [ $i -lt 150 ]; do printf '100,100\n'; i=$((i + 1)); done  # refused, the move goes on
   sleep 8
-} | "$craneassist" sim --input goal --goal 5.6,1.2 --duration 7 --no-telemetry \
+} | "$craneassist" sim --input goal --goal 5.6,1.2 --duration 9 --no-telemetry \
   --goal-grid "0.5 m" --goal-table "$table" >"$out" 2>&1 || { cat "$out"; echo "FAIL: sim failed"; exit 1; }
 fail() { cat "$out"; echo "FAIL: $*"; exit 1; }
 grep -q "goal '???garbage': expected X,Z in m" "$out" || fail "the binary line was not named"

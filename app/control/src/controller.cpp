@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "craneassist/dynamics/cylinders.hpp"
+#include "craneassist/dynamics/pendulum.hpp"
 #include "craneassist/scaling/scaling_filter.hpp"
 
 namespace craneassist::control {
@@ -60,6 +61,12 @@ scaling::TipScalerConfig tip_scaler_config(const config::CraneConfig& config) {
   scaler.flow_reserve = config.control.flow_reserve;
   scaler.power_bound = sc.power_bound;
   scaler.power_reserve = sc.power_reserve;
+  // The slowest swing: the grapple with the heaviest load the config's range allows (or empty,
+  // when the load hangs above the grapple's centre of mass), with margin.
+  const auto& model = config.model;
+  const double slowest = std::min(dynamics::grapple_pendulum(model, 0.0).omega_rad_s,
+                                  dynamics::grapple_pendulum(model, 1e5).omega_rad_s);
+  if (slowest > 0.0) scaler.sway_max_delay_s = 1.5 * scaling::SwayShaper::delay_s(slowest, 0.0);
   return scaler;
 }
 
@@ -111,6 +118,7 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
   chart_ = config.load_chart;
   deceleration_max_ = config.scaling.deceleration_max_m_s2;
   jerk_max_ = config.scaling.jerk_max_m_s3;
+  sway_damping_ = config.scaling.sway_damping && model_.grapple.hangs();
   known_payload_kg_ = dynamics::payload_mass_kg(model_);
   dynamics::PayloadEstimatorSettings scale;
   scale.period_s = period_s_;
@@ -327,6 +335,14 @@ void Controller::update_full(const valves::MachineState& state, const Eigen::Vec
   tip_path_->update(q_ref_, path_in, tip_out_);
   scaling::TipScalerInput in = tip_scaler_input(v_cmd, u, tip_out_, stale);
   in.tracking_factor = scaling::tracking_factor(tip_error_filtered_m_, tracking_error_ok_m_);
+  if (sway_damping_) {
+    // The swing's frequency with the load the scale has found (the rated load before it has).
+    const double load_kg =
+        std::isfinite(out.load.estimate_kg) ? out.load.estimate_kg : out.load.model_kg;
+    const dynamics::Pendulum pendulum = dynamics::grapple_pendulum(model_, load_kg);
+    in.sway_omega_rad_s = pendulum.omega_rad_s;
+    in.sway_zeta = pendulum.zeta;
+  }
   // The rated capacity limiter: a motion that takes the load further out (raises the load
   // moment) slows to rest when the crane is overloaded, or when the moment would pass the chart
   // where a stop from the present speed ends (braking ahead of the chart); once refused it stays

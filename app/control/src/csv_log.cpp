@@ -18,6 +18,7 @@ std::string CsvLog::header(int dof, bool base) {
   for (int i = 1; i <= dof; ++i) h += ",spool" + std::to_string(i);
   for (int i = 1; i <= dof; ++i) h += ",p_load" + std::to_string(i) + "_pa";
   h += ",load_kg,payload_estimate_kg,load_moment_ratio,status";
+  h += ",swing_deg,swing_radial_deg,swing_tangential_deg";
   if (base) {
     h += ",base_x,base_y,base_phi,base_v,base_omega,base_v_cmd,base_omega_cmd,base_flow_fl_m3s,"
          "base_flow_fr_m3s,base_flow_rl_m3s,base_flow_rr_m3s,base_flow_sum_m3s,base_flow_max_m3s";
@@ -75,6 +76,14 @@ void CsvLog::write_row(const LogRow& r) {
     std::fputc(',', file_);
   }
   std::fprintf(file_, ",%.6g,%.6g,%s", r.payload_estimate_kg, r.load_moment_ratio, r.status);
+  // Empty where nothing measures the swing (a rigid tip, a machine without a swing sensor).
+  for (const double deg : {r.swing_deg, r.swing_radial_deg, r.swing_tangential_deg}) {
+    if (std::isfinite(deg)) {
+      std::fprintf(file_, ",%.4f", deg);
+    } else {
+      std::fputc(',', file_);
+    }
+  }
   if (base_) {
     std::fprintf(file_, ",%.6f,%.6f,%.7f,%.6g,%.6g,%.6g,%.6g", r.base_pose[0], r.base_pose[1],
                  r.base_pose[2], r.base_velocity[0], r.base_velocity[1], r.base_command[0],

@@ -120,6 +120,7 @@ LiveSummary run_live(const config::CraneConfig& config, input::CommandSource& so
   summary.cycles = ran.cycles;
   summary.load = stats.load;
   summary.stop = stats.stop;
+  summary.swing = stats.swing;
   summary.peak_spool_step = stats.peak_spool_step;
   summary.duration_s = ran.duration_s;
   summary.wall_time_s = ran.wall_time_s;

@@ -67,6 +67,24 @@ void RunStatistics::on_cycle(const CycleRecord& c) noexcept {
   for (int i = 0; i < n; ++i) last_spool_[i] = c.command.spool[i];
   spool_count_ = n;
 
+  // The swing, and what the stick's last return to rest left of it.
+  const bool stick_moving = cmd.allFinite() && cmd.norm() > 0.0;
+  if (stick_moving_ && !stick_moving) {
+    release_s_ = t;
+    s_.swing.released = true;
+    s_.swing.after_release_deg = 0.0;
+  }
+  if (stick_moving) s_.swing.released = false;
+  stick_moving_ = stick_moving;
+  if (const double swing = std::abs(c.state.swing_rad) * 180.0 / M_PI; std::isfinite(swing)) {
+    s_.swing.measured = true;
+    s_.swing.peak_deg = std::max(s_.swing.peak_deg, swing);
+    s_.swing.end_deg = swing;
+    if (s_.swing.released && t >= release_s_ + 1.0) {
+      s_.swing.after_release_deg = std::max(s_.swing.after_release_deg, swing);
+    }
+  }
+
   const ControllerOutput* out = c.controller;
   if (out == nullptr) return;
   s_.peak_path_jerk = std::max(s_.peak_path_jerk, std::abs(out->sdddot));

@@ -42,6 +42,9 @@ struct ScalingSettings {
   double tracking_error_filter_s = 0.05;            // first-order filter on the tip error
   dynamics::PowerBound power_bound = dynamics::PowerBound::kLoadSensing;
   double power_reserve = 0.0;  // share of P_max kept for feedback corrections
+  // Sway damping of the hanging grapple (docs/sway.md): the goal velocity input-shaped to the
+  // pendulum (a crane whose grapple does not hang has nothing to damp).
+  bool sway_damping = true;
 };
 
 struct RedundancySettings {

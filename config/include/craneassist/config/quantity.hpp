@@ -32,6 +32,7 @@ enum class Dimension {
   kInverseLength,  // a gain per metre (path-following gains)
   kForce,          // cylinder friction
   kDamping,        // viscous friction, force per speed
+  kRotaryDamping,  // viscous friction of a joint, torque per angular speed
 };
 
 const char* to_string(Dimension dimension);

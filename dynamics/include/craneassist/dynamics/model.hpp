@@ -216,6 +216,18 @@ struct Mhsb {
   ServoValve valve;
 };
 
+// The grapple and rotator hanging from the boom tip on a two-axis link (a universal joint whose
+// pivot is the tip the operator steers; docs/sway.md), with the load in the grapple. Only the
+// simulator swings it: the controller's dynamics carry the tip's bodies and the payload at the
+// tip, which is where their weight acts at rest. com_below_m 0: nothing hangs (the bodies at the
+// tip are rigid there).
+struct HangingGrapple {
+  double com_below_m = 0.0;        // pivot to the centre of mass of the bodies at the tip
+  double load_below_m = 0.0;       // pivot to the load's centre in the grapple (a point mass)
+  double damping_n_m_s_rad = 0.0;  // the link's brake or friction damping, each axis
+  bool hangs() const { return com_below_m > 0.0; }
+};
+
 struct CraneModel {
   std::string name;
   std::vector<DhJoint> joints;      // n joints
@@ -227,6 +239,7 @@ struct CraneModel {
   Pump pump;
   ValveSections valves;
   LoadHolding load_holding;
+  HangingGrapple grapple;
   // An MHSB circuit (hydraulics.mhsb); absent: valve sections on a load-sensing or
   // constant-pressure pump.
   std::optional<Mhsb> mhsb;

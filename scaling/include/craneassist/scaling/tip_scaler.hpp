@@ -36,6 +36,7 @@
 #include "craneassist/scaling/path_constraints.hpp"
 #include "craneassist/scaling/path_scaler.hpp"
 #include "craneassist/scaling/scaling_filter.hpp"
+#include "craneassist/scaling/sway_shaper.hpp"
 
 namespace craneassist::dynamics {
 class RigidBodyTerms;
@@ -52,6 +53,8 @@ struct TipScalerConfig {
   double flow_reserve = 0.0;
   PowerBound power_bound = PowerBound::kLoadSensing;
   double power_reserve = 0.0;
+  // The longest sway-shaping delay kept (half the slowest swing period; sway_shaper.hpp).
+  double sway_max_delay_s = 3.0;
 };
 
 struct TipScalerInput {
@@ -70,6 +73,12 @@ struct TipScalerInput {
   // overloaded crane): the target is rest, reached within the jerk and deceleration bounds
   // (limit kOverload).
   bool overload_refused = false;
+  // Sway damping (docs/sway.md): the hanging grapple's natural frequency and damping ratio; the
+  // reference velocity is the scaler's motion ZV-shaped to them (SwayShaper). 0: no shaping. A
+  // stop (stale input, failed dynamics), the brake at a joint end and the limiter's refusal are
+  // not shaped: the motion takes over from the shaped reference and acts at once.
+  double sway_omega_rad_s = 0.0;
+  double sway_zeta = 0.0;
 };
 
 struct TipScalerOutput {
@@ -105,8 +114,9 @@ class TipScaler {
   // The speed the motion heads for with this command: the bounds of the redundancy resolution
   // are shaped for it (ahead of the present speed by a margin, never beyond the command).
   double intended_speed(const Eigen::Vector3d& command) const;
-  double speed() const { return velocity_.norm(); }
-  const Eigen::Vector3d& velocity() const { return velocity_; }
+  // The reference's speed and velocity (shaped when the sway damping shapes it).
+  double speed() const { return ref_velocity_.norm(); }
+  const Eigen::Vector3d& velocity() const { return ref_velocity_; }
 
   // geometry: TipPath's resolution of in.direction at q.
   void update(const JointVector& q, const PathGeometry& geometry, const TipScalerInput& in,
@@ -128,6 +138,16 @@ class TipScaler {
   bool end_brake_ = false;    // braked at a joint end, holding until the end damping frees it
   double rest_time_s_ = 0.0;  // at rest since the brake
   Eigen::Vector3d end_brake_command_ = Eigen::Vector3d::Zero();
+  // Sway damping: velocity_ and acceleration_ are the motion the limits shape; the reference is
+  // that motion ZV-shaped (SwayShaper) while shaping_, the motion itself otherwise.
+  void hand_over();
+  static constexpr long kSteadyForever = 1L << 30;
+  SwayShaper velocity_shaper_, acceleration_shaper_;
+  Eigen::Vector3d ref_velocity_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d ref_acceleration_ = Eigen::Vector3d::Zero();
+  bool shaping_ = false;
+  long steady_cycles_ = kSteadyForever;
+  double sway_omega_rad_s_ = 0.0, sway_zeta_ = 0.0;  // latched while shaping
 };
 
 }  // namespace craneassist::scaling

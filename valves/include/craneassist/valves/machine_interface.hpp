@@ -50,6 +50,13 @@ struct MachineState {
   bool chamber_pressures = false;
   // The simulator's truth: the mass in the grapple (NaN on a machine, which does not know it).
   double payload_truth_kg = std::numeric_limits<double>::quiet_NaN();
+  // The hanging grapple's swing (docs/sway.md), rad: the hanger's angle from the vertical, and
+  // its two components, towards the load's reach (radial: the grapple further out than the tip)
+  // and across it (tangential: towards a positive slew). NaN where nothing measures it (a rigid
+  // tip; a machine without a swing sensor).
+  double swing_rad = std::numeric_limits<double>::quiet_NaN();
+  double swing_radial_rad = std::numeric_limits<double>::quiet_NaN();
+  double swing_tangential_rad = std::numeric_limits<double>::quiet_NaN();
   PumpMeasurement pump;
   BaseMeasurement base;
   bool valid = false;

@@ -228,6 +228,7 @@ class Controller {
   bool overload_ = false;
   bool refusing_ = false;  // the limiter refuses the outward motion (held while pushed on)
   double deceleration_max_ = 1.0, jerk_max_ = 1.0;  // the scaling's, for the stop ahead
+  bool sway_damping_ = false;  // the grapple hangs and scaling.sway_damping is on
 };
 
 }  // namespace craneassist::control

@@ -86,6 +86,7 @@ struct LiveOptions {
 struct LiveSummary {
   LoadSummary load;              // the crane scale and the load moment (docs/loads.md)
   StopSummary stop;              // how the stops ended (docs/safety.md)
+  SwingSummary swing;            // the hanging grapple's swing (docs/sway.md)
   double peak_spool_step = 0.0;  // largest spool command change per cycle
   long cycles = 0;
   double duration_s = 0.0;   // machine time

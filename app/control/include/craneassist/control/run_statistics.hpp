@@ -50,6 +50,17 @@ struct LoadSummary {
   long truth_changes = 0;
 };
 
+// The hanging grapple's swing over the run (docs/sway.md; MachineState::swing_rad), degrees.
+struct SwingSummary {
+  bool measured = false;  // some cycle measured the swing
+  double peak_deg = 0.0;
+  // From 1 s after the stick last came back to rest (its command zero or no command) to the end:
+  // the swing the last stop left (released false: the stick never came back to rest).
+  bool released = false;
+  double after_release_deg = 0.0;
+  double end_deg = 0.0;  // the last cycle's
+};
+
 // How the run's stops ended (docs/safety.md): a stop runs from its first cycle not running
 // (kStopping) to its first cycle with every valve neutral (kStopped).
 struct StopSummary {
@@ -107,6 +118,7 @@ struct RunSummary {
   MotionQualityResult feel;  // stall events and lateral speed (motion_quality.hpp)
   LoadSummary load;
   StopSummary stop;
+  SwingSummary swing;
   double peak_spool_step = 0.0;  // largest command change from one cycle to the next, whole run
 };
 
@@ -148,6 +160,8 @@ class RunStatistics final : public CycleObserver {
   double stop_start_s_ = 0.0;
   double running_load_pressure_pa_ = 0.0;  // the last running cycle's
   double stop_steady_pa_ = 0.0, stop_peak_pa_ = 0.0;
+  bool stick_moving_ = false;
+  double release_s_ = 0.0;  // when the stick last came back to rest
 };
 
 // Angle between two vectors in degrees (0 when either is zero).
