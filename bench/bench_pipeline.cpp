@@ -51,11 +51,18 @@ void BM_SimulatorControlPeriod(benchmark::State& state) {
 }
 BENCHMARK(BM_SimulatorControlPeriod)->Unit(benchmark::kMicrosecond);
 
+// The K70M with its sway damping on (argument 1, the default) or off (0, --no-sway-damping).
+config::CraneConfig k70m_sway(const benchmark::State& state) {
+  auto cfg = config::default_crane_config();
+  cfg.scaling.sway_damping = state.range(0) != 0;
+  return cfg;
+}
+
 // One controller update (redundancy resolution, path scaling, valve mapping) of a crane moving
 // out, up and sideways from its start pose, on a machine that follows the reference; started over
 // every 3 s of motion so that it measures motion, not a crane come to rest at a workspace end.
 void BM_ControllerUpdate(benchmark::State& state) {
-  const auto cfg = config::default_crane_config();
+  const auto cfg = k70m_sway(state);
   control::Controller controller(cfg, {});
   const valves::MachineState start = still_at_start(cfg);
   valves::MachineState s = start;
@@ -75,12 +82,12 @@ void BM_ControllerUpdate(benchmark::State& state) {
     }
   }
 }
-BENCHMARK(BM_ControllerUpdate)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ControllerUpdate)->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond);
 
 // The same stick held with the crane at the end of its workspace (every cycle resolves,
 // damps the ends and holds the reference at rest): the busiest case of the end handling.
 void BM_ControllerUpdateAtWorkspaceEnd(benchmark::State& state) {
-  const auto cfg = config::default_crane_config();
+  const auto cfg = k70m_sway(state);
   control::Controller controller(cfg, {});
   valves::MachineState s = still_at_start(cfg);
   controller.reset(s);
@@ -96,7 +103,7 @@ void BM_ControllerUpdateAtWorkspaceEnd(benchmark::State& state) {
     s.q = out.q_ref;
   }
 }
-BENCHMARK(BM_ControllerUpdateAtWorkspaceEnd)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ControllerUpdateAtWorkspaceEnd)->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond);
 
 // H(q), C(q,qdot) qdot and g(q) from the ODE model of the reference crane.
 void BM_RigidBodyTerms(benchmark::State& state) {
