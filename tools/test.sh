@@ -42,4 +42,4 @@ cmake --build build-clang -j"$jobs"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:new_delete_type_mismatch=0 \
   LSAN_OPTIONS="suppressions=$PWD/tests/lsan-fastdds.supp" \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build-clang --output-on-failure -j"$jobs" -LE 'fuzz_soak|research'
+  ctest --test-dir build-clang --output-on-failure -j"$jobs" -LE 'fuzz_soak|research|sway'

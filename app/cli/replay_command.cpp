@@ -130,7 +130,7 @@ void print_swing_line(const control::SwingSummary& s, const config::CraneConfig&
   std::printf("  swing: peak %.1f deg", s.peak_deg);
   if (s.released)
     std::printf(", %.1f deg from 1 s after the stick's last release", s.after_release_deg);
-  std::printf(", %.1f deg at the end (sway damping %s)\n", s.end_deg,
+  std::printf(", %.1f deg in the last second (sway damping %s)\n", s.end_deg,
               damped ? "on" : "off: --no-sway-damping or scaling.sway_damping");
 }
 

@@ -79,7 +79,9 @@ void RunStatistics::on_cycle(const CycleRecord& c) noexcept {
   if (const double swing = std::abs(c.state.swing_rad) * 180.0 / M_PI; std::isfinite(swing)) {
     s_.swing.measured = true;
     s_.swing.peak_deg = std::max(s_.swing.peak_deg, swing);
-    s_.swing.end_deg = swing;
+    swing_deg_[swing_count_ % kSwingRing] = swing;
+    swing_t_[swing_count_ % kSwingRing] = t;
+    ++swing_count_;
     if (s_.swing.released && t >= release_s_ + 1.0) {
       s_.swing.after_release_deg = std::max(s_.swing.after_release_deg, swing);
     }
@@ -221,6 +223,16 @@ RunSummary RunStatistics::summary(const LoopSummary& loop) const {
   s.end_stop = loop.end_stop;
   s.stop_cycles = loop.stop_cycles;
   s.log_rows_dropped = loop.log_rows_dropped;
+  // What still swings: the largest swing over the run's last second.
+  const std::size_t kept = std::min(swing_count_, kSwingRing);
+  if (kept > 0) {
+    const double last_t = swing_t_[(swing_count_ - 1) % kSwingRing];
+    for (std::size_t k = 0; k < kept; ++k) {
+      const std::size_t at = (swing_count_ - 1 - k) % kSwingRing;
+      if (swing_t_[at] < last_t - 1.0) break;
+      s.swing.end_deg = std::max(s.swing.end_deg, swing_deg_[at]);
+    }
+  }
   s.rms_direction_error_deg =
       s.direction_samples > 0
           ? std::sqrt(sum_sq_direction_ / static_cast<double>(s.direction_samples))

@@ -58,7 +58,7 @@ struct SwingSummary {
   // the swing the last stop left (released false: the stick never came back to rest).
   bool released = false;
   double after_release_deg = 0.0;
-  double end_deg = 0.0;  // the last cycle's
+  double end_deg = 0.0;  // the largest over the run's last second (what still swings)
 };
 
 // How the run's stops ended (docs/safety.md): a stop runs from its first cycle not running
@@ -162,6 +162,10 @@ class RunStatistics final : public CycleObserver {
   double stop_steady_pa_ = 0.0, stop_peak_pa_ = 0.0;
   bool stick_moving_ = false;
   double release_s_ = 0.0;  // when the stick last came back to rest
+  // The last cycles' swing (a ring, with their times), for the largest over the last second.
+  static constexpr std::size_t kSwingRing = 1024;
+  std::array<double, kSwingRing> swing_deg_{}, swing_t_{};
+  std::size_t swing_count_ = 0;
 };
 
 // Angle between two vectors in degrees (0 when either is zero).
