@@ -62,6 +62,9 @@ void each_field(Row& row, Frame& f, int n, Copy copy) {
   copy(row.payload_converged, f.payload_converged);
   copy(row.load_warning, f.load_warning);
   copy(row.load_overload, f.load_overload);
+  copy(row.swing_rad, f.swing_rad);
+  copy(row.swing_radial_rad, f.swing_radial_rad);
+  copy(row.swing_tangential_rad, f.swing_tangential_rad);
   copy(row.base_present, f.base_present);
   copy(row.base_shared_pump, f.base_shared_pump);
   copy(row.base_pose, f.base_pose);

@@ -1,5 +1,6 @@
 #include "craneassist/dynamics/pendulum.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -20,6 +21,25 @@ void tip_bodies(const CraneModel& m, double& mass_kg, Eigen::Vector3d& inertia_k
 Eigen::Vector3d down_direction(const CraneModel& m) noexcept {
   const double g = m.gravity_m_s2.norm();
   return g > 1e-9 ? Eigen::Vector3d(m.gravity_m_s2 / g) : Eigen::Vector3d(0.0, 0.0, -1.0);
+}
+
+void swing_axes(const Eigen::Vector3d& tip_base, Eigen::Vector3d& radial,
+                Eigen::Vector3d& tangential) noexcept {
+  radial = Eigen::Vector3d(tip_base.x(), tip_base.y(), 0.0);
+  radial = radial.norm() > 1e-9 ? Eigen::Vector3d(radial.normalized()) : Eigen::Vector3d::UnitX();
+  tangential = Eigen::Vector3d::UnitZ().cross(radial);
+}
+
+Eigen::Vector3d grapple_position(const CraneModel& m, const Eigen::Vector3d& tip_base,
+                                 double radial_rad, double tangential_rad) noexcept {
+  if (!m.grapple.hangs() || !std::isfinite(radial_rad) || !std::isfinite(tangential_rad)) {
+    return tip_base;
+  }
+  Eigen::Vector3d radial, tangential;
+  swing_axes(tip_base, radial, tangential);
+  const Eigen::Vector3d along =
+      down_direction(m) + std::tan(radial_rad) * radial + std::tan(tangential_rad) * tangential;
+  return tip_base + m.grapple.com_below_m * along.normalized();
 }
 
 double Pendulum::period_s() const {

@@ -195,10 +195,8 @@ struct SimBackend::Impl {
     const dReal* c = dBodyGetPosition(load_body);
     const Eigen::Vector3d r(c[0] - anchor[0], c[1] - anchor[1], c[2] - anchor[2]);
     const Eigen::Vector3d down = dynamics::down_direction(model);
-    // Outwards: the tip's horizontal direction from the slew axis (the base frame's z).
-    Eigen::Vector3d radial(anchor[0], anchor[1], 0.0);
-    radial = radial.norm() > 1e-9 ? Eigen::Vector3d(radial.normalized()) : Eigen::Vector3d::UnitX();
-    const Eigen::Vector3d tangential = Eigen::Vector3d::UnitZ().cross(radial);
+    Eigen::Vector3d radial, tangential;
+    dynamics::swing_axes(Eigen::Vector3d(anchor[0], anchor[1], anchor[2]), radial, tangential);
     const double vertical = r.dot(down);
     state.swing_rad = std::atan2((r - vertical * down).norm(), vertical);
     state.swing_radial_rad = std::atan2(r.dot(radial), vertical);

@@ -64,6 +64,21 @@ try {
     `available along the stick ${going.frame.avail.toFixed(2)} m/s, the reference ${Math.hypot(...going.frame.ref).toFixed(2)} m/s within it`);
   check(going.polytope !== idle.polytope && going.gauge !== idle.gauge,
     `the polytope's figures follow the crane: '${idle.polytope}', '${idle.gauge}' at rest, then '${going.polytope}', '${going.gauge}'`);
+  // The hanging grapple (docs/sway.md): drawn its hanger length below the tip, swinging as the
+  // crane starts, its swing shown.
+  const grapple = await page.evaluate(() => ({
+    g: window.craneassist.grapple, max: window.craneassist.swing_max,
+    text: document.getElementById('swing')?.textContent,
+  }));
+  check(grapple.g !== null, 'the grapple is drawn');
+  if (grapple.g) {
+    const l = Math.hypot(...grapple.g.at.map((v, i) => v - grapple.g.tip[i]));
+    check(Math.abs(l - 0.7) < 0.01 && grapple.g.at[1] < grapple.g.tip[1] - 0.6,
+      `the grapple hangs ${l.toFixed(3)} m below the tip`);
+  }
+  check(grapple.max > 0.5, `the grapple swung up to ${grapple.max.toFixed(1)} deg as the crane started`);
+  check(/^[0-9.]+ deg \(out -?[0-9.]+, across -?[0-9.]+\)$/.test(grapple.text || ''),
+    `the page shows the swing: '${grapple.text}'`);
   const latency = await page.evaluate(() => window.craneassist.latency_ms);
   check(latency.length > 0, `stick to drawing: ${latency.map((v) => v.toFixed(0)).join(', ')} ms`);
 

@@ -77,9 +77,9 @@ void CsvLog::write_row(const LogRow& r) {
   }
   std::fprintf(file_, ",%.6g,%.6g,%s", r.payload_estimate_kg, r.load_moment_ratio, r.status);
   // Empty where nothing measures the swing (a rigid tip, a machine without a swing sensor).
-  for (const double deg : {r.swing_deg, r.swing_radial_deg, r.swing_tangential_deg}) {
-    if (std::isfinite(deg)) {
-      std::fprintf(file_, ",%.4f", deg);
+  for (const double rad : {r.swing_rad, r.swing_radial_rad, r.swing_tangential_rad}) {
+    if (std::isfinite(rad)) {
+      std::fprintf(file_, ",%.4f", rad * 180.0 / M_PI);
     } else {
       std::fputc(',', file_);
     }

@@ -62,10 +62,9 @@ void LogRowBuilder::fill(LogRow& row, double t, const Eigen::Vector3d& cmd,
   row.ref_power_w = out.ref_power_w;
   row.flow_demand_m3s = out.flow_demand_m3_s;
   row.load_kg = state.payload_truth_kg;
-  constexpr double kDeg = 180.0 / M_PI;
-  row.swing_deg = state.swing_rad * kDeg;
-  row.swing_radial_deg = state.swing_radial_rad * kDeg;
-  row.swing_tangential_deg = state.swing_tangential_rad * kDeg;
+  row.swing_rad = state.swing_rad;
+  row.swing_radial_rad = state.swing_radial_rad;
+  row.swing_tangential_rad = state.swing_tangential_rad;
   row.payload_estimate_kg = out.load.estimate_kg;
   row.load_moment_ratio = out.load.moment_ratio;
   row.rated_load_kg = out.load.rated_kg;

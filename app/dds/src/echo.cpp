@@ -82,6 +82,9 @@ void describe(const msg::Status& m, FieldVisitor& v) {
   v.flag("load_warning", m.load_warning());
   v.flag("overload", m.overload());
   v.number("load_truth_kg", m.load_truth_kg(), "kg");
+  v.number("swing_rad", m.swing_rad(), "rad");
+  v.number("swing_radial_rad", m.swing_radial_rad(), "rad");
+  v.number("swing_tangential_rad", m.swing_tangential_rad(), "rad");
 }
 
 void describe(const msg::JointState& m, FieldVisitor& v) {

@@ -235,6 +235,9 @@ struct TelemetryPublisher::Impl {
     status.load_warning(f.load_warning);
     status.overload(f.load_overload);
     status.load_truth_kg(f.load_truth_kg);
+    status.swing_rad(f.swing_rad);
+    status.swing_radial_rad(f.swing_radial_rad);
+    status.swing_tangential_rad(f.swing_tangential_rad);
     return writers[0]->write(&status);
   }
 

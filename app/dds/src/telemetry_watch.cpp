@@ -122,6 +122,9 @@ struct TelemetryWatch::Impl {
     frame.load_warning = s.load_warning();
     frame.load_overload = s.overload();
     frame.load_truth_kg = s.load_truth_kg();
+    frame.swing_rad = s.swing_rad();
+    frame.swing_radial_rad = s.swing_radial_rad();
+    frame.swing_tangential_rad = s.swing_tangential_rad();
     updated();
   }
 

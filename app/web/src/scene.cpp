@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "craneassist/dynamics/cylinders.hpp"
+#include "craneassist/dynamics/pendulum.hpp"
 
 namespace craneassist::web {
 namespace {
@@ -257,6 +258,22 @@ void SceneBuilder::frame_json(const control::LogRow& row, std::uint64_t seq, std
       .flag("overload", row.load_overload)
       .number("truth", row.load_kg)
       .close();
+  // The hanging grapple (docs/sway.md): its swing in degrees (from the vertical, towards the reach,
+  // across it; null where nothing measures it) and where its centre of mass hangs (crane frame).
+  if (model_.grapple.hangs()) {
+    constexpr double kDeg = 180.0 / M_PI;
+    const Eigen::Matrix3d& t = model_.task_from_base;
+    const Eigen::Vector3d tip(row.tip[0], row.tip[1], row.tip[2]);
+    const Eigen::Vector3d at =
+        t * dynamics::grapple_position(model_, t.transpose() * tip, row.swing_radial_rad,
+                                       row.swing_tangential_rad);
+    Object(f.nested("grapple"))
+        .number("swing", row.swing_rad * kDeg)
+        .number("radial", row.swing_radial_rad * kDeg)
+        .number("tangential", row.swing_tangential_rad * kDeg)
+        .vec3("at", at)
+        .close();
+  }
   if (row.base_present) base_json(row, f.nested("base"));
 
   // The drawing: joint frame origins, and each cylinder's ends.

@@ -21,6 +21,8 @@ const probe = {
   sent: 0,            // stick states sent
   shown: null,        // the frame the gauges show
   avail_arrow: null,  // the available-speed arrow: { length, dir } (null: hidden)
+  grapple: null,      // the drawn grapple: { at, tip, swing } in the crane frame (null: none hangs)
+  swing_max: 0,       // the largest swing drawn, deg
 };
 window.craneassist = probe;
 
@@ -92,6 +94,12 @@ const arrowLength = (speed) => 0.3 + 2 * speed;  // 0.5 m/s: 1.3 m
 const stickDir = new THREE.Vector3(1, 0, 0);
 const tipMarker = new THREE.Mesh(new THREE.SphereGeometry(0.07, 16, 12), dark);
 craneRoot.add(tipMarker);
+// The hanging grapple (docs/sway.md): its link from the tip and the grapple, where the frame
+// says its centre of mass hangs.
+const grappleLink = new THREE.Mesh(unitCylinder, dark);
+const grappleBody = new THREE.Mesh(unitBox, new THREE.MeshStandardMaterial({ color: 0xc98a2e, metalness: 0.4, roughness: 0.5 }));
+grappleLink.visible = grappleBody.visible = false;
+craneRoot.add(grappleLink, grappleBody);
 
 function resize() {
   const w = view.clientWidth, h = view.clientHeight;
@@ -134,6 +142,18 @@ function drawCrane(frame) {
   }
   const tip = vec(frame.tip);
   tipMarker.position.copy(tip);
+  const g = frame.grapple;
+  grappleLink.visible = grappleBody.visible = !!(g && g.at.every((x) => x !== null));
+  probe.grapple = null;
+  if (grappleLink.visible) {
+    const at = vec(g.at);
+    place(grappleLink, tip, at, 0.04);
+    // The grapple's body hangs along the link, centred where its centre of mass is.
+    const d = at.clone().sub(tip);
+    place(grappleBody, at.clone().addScaledVector(d, -0.35), at.clone().addScaledVector(d, 0.35), 0.3);
+    probe.grapple = { at: g.at, tip: frame.tip, swing: g.swing };
+    probe.swing_max = Math.max(probe.swing_max, g.swing || 0);
+  }
   trail.points.push(tip.clone().applyMatrix4(craneRoot.matrix));  // the trail on the ground
   if (trail.points.length > trail.max) trail.points.shift();
   const pos = trailGeometry.attributes.position;
@@ -300,6 +320,10 @@ function showFrame(f) {
     }
     probe.load = l;
   }
+  // The grapple's swing from the vertical (docs/sway.md).
+  const g = f.grapple;
+  $('swing').textContent = g && g.swing !== null
+    ? `${fmt(g.swing, 1)} deg (out ${fmt(g.radial, 1)}, across ${fmt(g.tangential, 1)})` : 'not measured';
   probe.shown = f;
   plotSpeed.push(f.t, [norm(f.tip_v), norm(f.cmd), f.scale]);
 }

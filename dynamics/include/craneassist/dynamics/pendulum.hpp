@@ -19,6 +19,18 @@ void tip_bodies(const CraneModel& m, double& mass_kg, Eigen::Vector3d& inertia_k
 // Where the grapple hangs: along gravity, or down the base frame's z axis without gravity.
 Eigen::Vector3d down_direction(const CraneModel& m) noexcept;
 
+// The horizontal directions the swing is measured along at a tip (base frame): radial, from the
+// slew axis (the base frame's z) out through the tip (x on the axis), and tangential, towards a
+// positive slew (z x radial).
+void swing_axes(const Eigen::Vector3d& tip_base, Eigen::Vector3d& radial,
+                Eigen::Vector3d& tangential) noexcept;
+
+// Where the grapple's centre of mass hangs (base frame) below a tip swung by radial_rad towards
+// the reach and tangential_rad across it: what the simulator measures (MachineState::swing_*),
+// drawn back. A model whose grapple does not hang, or a non-finite angle: the tip.
+Eigen::Vector3d grapple_position(const CraneModel& m, const Eigen::Vector3d& tip_base,
+                                 double radial_rad, double tangential_rad) noexcept;
+
 struct Pendulum {
   double omega_rad_s = 0.0;  // undamped natural frequency; 0: nothing hangs
   double zeta = 0.0;         // damping ratio of the link's damping

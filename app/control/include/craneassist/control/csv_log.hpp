@@ -37,11 +37,11 @@ struct LogRow {
   // estimate, the load moment against the chart (ControllerOutput::load).
   double load_kg = std::numeric_limits<double>::quiet_NaN();
   double payload_estimate_kg = 0.0, load_moment_ratio = 0.0;
-  // The hanging grapple's swing (docs/sway.md; MachineState), degrees: from the vertical, towards
-  // the reach and across it. NaN where nothing measures it.
-  double swing_deg = std::numeric_limits<double>::quiet_NaN();
-  double swing_radial_deg = std::numeric_limits<double>::quiet_NaN();
-  double swing_tangential_deg = std::numeric_limits<double>::quiet_NaN();
+  // The hanging grapple's swing (docs/sway.md; MachineState), rad (the CSV writes degrees): from
+  // the vertical, towards the reach and across it. NaN where nothing measures it.
+  double swing_rad = std::numeric_limits<double>::quiet_NaN();
+  double swing_radial_rad = std::numeric_limits<double>::quiet_NaN();
+  double swing_tangential_rad = std::numeric_limits<double>::quiet_NaN();
   // Live and telemetry only (not in the CSV): the chart's rated load at the reach, the reach,
   // and the scale's and limiter's state.
   double rated_load_kg = 0.0, load_reach_m = 0.0;

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -47,6 +48,11 @@ struct TelemetryFrame {
   double load_truth_kg = 0.0, payload_estimate_kg = 0.0, load_moment_ratio = 0.0;
   double rated_load_kg = 0.0, load_reach_m = 0.0;
   bool payload_converged = false, load_warning = false, load_overload = false;
+  // The hanging grapple's swing (docs/sway.md), rad: from the vertical, towards the reach, across
+  // it; NaN where nothing measures it.
+  double swing_rad = std::numeric_limits<double>::quiet_NaN();
+  double swing_radial_rad = std::numeric_limits<double>::quiet_NaN();
+  double swing_tangential_rad = std::numeric_limits<double>::quiet_NaN();
   // The wheeled base under the crane (sim --drive; topic craneassist/base): pose in the world
   // (x, y, heading), motion and drive command (forward speed, yaw rate), hub-motor flows (fl, fr,
   // rl, rr), their sum and the drive pump's Q_max. base_present false: a fixed base.
