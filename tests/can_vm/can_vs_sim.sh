@@ -75,7 +75,9 @@ compare "demo, finer machine: energy or direction" demo.csv 0 /tmp/demo_sim.out 
 # 95th percentile of the tip's direction error (from its displacement over 100 ms,
 # can_backend_check p95), against the targets: 3 % of the rated 650 kg, 1.02 P_max, 2 deg.
 # The K70M's load chart is left out here: this lift ends near 100 % of it, where the limiter
-# (checked in part 4) would decide the figures.
+# (checked in part 4) would decide the figures. So is its hanging grapple (docs/sway.md): the
+# scale's accuracy is measured on the load it was specified for, rigid at the tip (swinging, one
+# of the shipped mapping's runs ended at 672.8 kg: docs/loads.md).
 #   a. every resolution on the finer machine of part 2;
 #   b. the shipped mapping (20 ms commands, 0.01 deg encoders), every resolution, and pinv-joint
 #      told the load.
@@ -84,9 +86,10 @@ compare "demo, finer machine: energy or direction" demo.csv 0 /tmp/demo_sim.out 
 # run to run by a degree or two, told or not (docs/can.md, "The crane scale over the bus").
 echo "=== 3. 650 kg unannounced over the bus at 20 kW"
 sed -e 's/prime_mover_power: 35 kW/prime_mover_power: 20 kW/' -e '/^load_chart:/,/^ *rated_load:/d' \
-  k70m.yaml > /tmp/k70m_20kw.yaml
+  -e '/^grapple:/,/^ *damping:/d' k70m.yaml > /tmp/k70m_20kw.yaml
 grep -q "prime_mover_power: 20 kW" /tmp/k70m_20kw.yaml || fail "the 20 kW config was not written"
 grep -q "^load_chart:" /tmp/k70m_20kw.yaml && fail "the load chart is still in the 20 kW config"
+grep -q "^grapple:" /tmp/k70m_20kw.yaml && fail "the grapple still hangs in the 20 kW config"
 bus_run() {  # NAME CONFIG PAYLOAD REPLAY MAPPING FEEDBACK_S [replay options]: /tmp/bus_NAME.*
   name=$1; config=$2; payload=$3; replay=$4; mapping=$5; feedback=$6; shift 6
   ./craneassist emulate --can vcan0 --payload "$payload" --config "$config" --mapping "$mapping" \
