@@ -123,10 +123,15 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
   const double period = config_.period_s;
   const double jerk = config_.jerk_max;
   const Eigen::Vector3d& u = in.direction;
-  // A stop and the load limiter's refusal act at once: the motion continues from where the
-  // shaped reference is, unshaped.
-  if (shaping_ && (in.stale_input || in.overload_refused)) hand_over();
   double speed = velocity_.norm();
+  // What acts at once takes the motion over from where the shaped reference is, unshaped.
+  const auto take_over = [&] {
+    if (!shaping_) return;
+    hand_over();
+    speed = velocity_.norm();
+  };
+  // A stop and the load limiter's refusal.
+  if (in.stale_input || in.overload_refused) take_over();
 
   // Velocity-level limits along u and the acceleration bounds at the present speed. Without the
   // dynamics (a failed step) the bounds are those that need none: no power bound.
@@ -135,10 +140,7 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
                                                acceleration_limits_, out.terms, out.bounds);
   // A stale input or a failed dynamics step: a jerk-limited stop along the present direction.
   const bool stop = in.stale_input || out.dynamics_failed;
-  if (shaping_ && stop) {
-    hand_over();
-    speed = velocity_.norm();
-  }
+  if (stop) take_over();
 
   // One factor on the whole command.
   const double request = in.command.norm();
@@ -150,6 +152,14 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
   }
   if (in.overload_refused) cap = {0.0, ActiveLimit::kOverload};
   double target = stop ? 0.0 : std::clamp(cap.value, 0.0, request);
+  // The lowest of this cycle's velocity-level limits whatever the stick asks (out.bounds as they
+  // stand when called).
+  const auto physical_cap = [&] {
+    return std::min(
+        lowest_speed_cap(kInf, 1.0, in.sdot_joint_limit, out.speed, out.bounds, in.near_singular)
+            .value,
+        ahead);
+  };
   // While the reference is shaped, (v + K v_past) / (1 + K), the motion's own limits are those
   // that keep the shaped reference within this cycle's: |v| <= (1 + K) cap - K |v_past| under a
   // speed cap, and the same on the acceleration bounds below.
@@ -159,10 +169,7 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
     k_past = SwayShaper::past_weight(sway_zeta_);
     v_past = velocity_shaper_.upcoming_past(sway_omega_rad_s_, sway_zeta_);
     a_past = acceleration_shaper_.upcoming_past(sway_omega_rad_s_, sway_zeta_);
-    const double physical = std::min(
-        lowest_speed_cap(kInf, 1.0, in.sdot_joint_limit, out.speed, out.bounds, in.near_singular)
-            .value,
-        ahead);
+    const double physical = physical_cap();
     if (std::isfinite(physical)) {
       target = std::min(target, std::max((1.0 + k_past) * physical - k_past * v_past.norm(), 0.0));
     }
@@ -177,10 +184,7 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
   if (ref_speed > 0.0 &&
       braking_distance(ref_speed, ref_acceleration_.dot(u), in.stop_deceleration_m_s2,
                        in.stop_jerk_m_s3) >= in.end_distance_m) {
-    if (shaping_) {
-      hand_over();
-      speed = velocity_.norm();
-    }
+    take_over();
     end_brake_ = true;
     rest_time_s_ = 0.0;
     end_brake_command_ = in.command;
@@ -233,10 +237,7 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
     goal.setZero();
     // A reversal is not shaped: it comes to rest first, and every valve crosses its dead zone
     // at rest (a shaped reference would pass through zero still decelerating).
-    if (shaping_) {
-      hand_over();
-      speed = velocity_.norm();
-    }
+    take_over();
   }
 
   // The segment from the present velocity to the goal.
@@ -347,10 +348,7 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
     const double ref_speed_out = v_out.norm();
     const bool dynamics_ok = path_terms_and_bounds(model_, terms_, q, geometry, ref_speed_out,
                                                    acceleration_limits_, out.terms, out.bounds);
-    const double speed_cap = std::min(
-        lowest_speed_cap(kInf, 1.0, in.sdot_joint_limit, out.speed, out.bounds, in.near_singular)
-            .value,
-        ahead);
+    const double speed_cap = physical_cap();
     const double along = a_out.dot(u);
     past_bounds =
         !dynamics_ok || ref_speed_out > speed_cap + kBoundSlack ||
