@@ -5,10 +5,13 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Geometry>
+#include <array>
+#include <cmath>
 #include <random>
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
+#include "craneassist/dynamics/pendulum.hpp"
 #include "craneassist/dynamics/urdf.hpp"
 
 using namespace craneassist;
@@ -24,9 +27,11 @@ Eigen::Isometry3d to_eigen(const urdf::Pose& p) {
   return t;
 }
 
-// base_link to `link` at q (the joints in the model's order), composed from the URDF alone.
+// base_link to `link` at q (the joints in the model's order) and the hanger's angles, composed
+// from the URDF alone.
 Eigen::Isometry3d urdf_pose(const urdf::ModelInterface& m, const std::string& link,
-                            const dynamics::CraneModel& model, const dynamics::JointVector& q) {
+                            const dynamics::CraneModel& model, const dynamics::JointVector& q,
+                            const std::array<double, 2>& hanger = {0.0, 0.0}) {
   auto l = m.getLink(link);
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   while (l && l->parent_joint) {
@@ -38,6 +43,12 @@ Eigen::Isometry3d urdf_pose(const urdf::ModelInterface& m, const std::string& li
       if (j.type == urdf::Joint::REVOLUTE)
         motion.linear() = Eigen::AngleAxisd(q[i], axis).toRotationMatrix();
       if (j.type == urdf::Joint::PRISMATIC) motion.translation() = q[i] * axis;
+    }
+    for (std::size_t i = 0; i < hanger.size(); ++i) {
+      if (j.name == dynamics::kHangerJointNames[i]) {
+        EXPECT_EQ(j.type, urdf::Joint::REVOLUTE);
+        motion.linear() = Eigen::AngleAxisd(hanger[i], axis).toRotationMatrix();
+      }
     }
     t = to_eigen(j.parent_to_joint_origin_transform) * motion * t;
     l = m.getLink(j.parent_link_name);
@@ -68,6 +79,19 @@ void check_crane(const config::CraneConfig& cfg) {
   }
   std::mt19937 rng(7);
   dynamics::KinematicsData data;
+  const dynamics::HangerAxes axes = dynamics::hanger_axes(model);
+  if (model.grapple.hangs()) {
+    for (const char* name : dynamics::kHangerJointNames) EXPECT_TRUE(urdf_model->getJoint(name));
+    ASSERT_TRUE(urdf_model->getLink("grapple_link"));
+    // The grapple, rotator and payload hang: grapple_link carries them, tip_link nothing.
+    double at_tip = 0.0;
+    for (const auto& b : model.bodies) {
+      if (b.frame == model.dof() && b.com_m.norm() < dynamics::kAtTipM) at_tip += b.mass_kg;
+    }
+    const auto& inertial = urdf_model->getLink("grapple_link")->inertial;
+    ASSERT_TRUE(inertial);
+    EXPECT_NEAR(inertial->mass, at_tip, 1e-9 * at_tip + 1e-3);
+  }
   for (int k = 0; k < 200; ++k) {
     dynamics::JointVector q(model.dof());
     for (int i = 0; i < model.dof(); ++i) {
@@ -79,6 +103,24 @@ void check_crane(const config::CraneConfig& cfg) {
     EXPECT_LT((tip.translation() - data.frames[model.dof()].translation()).norm(), 1e-6)
         << model.name << " pose " << k;
     EXPECT_LT((tip.linear() - data.frames[model.dof()].linear()).norm(), 1e-6);
+    if (!model.grapple.hangs()) continue;
+    // The grapple where the swing puts it: the URDF's grapple_link, at the hanger angles of a
+    // swing, holds the grapple's centre of mass where grapple_position() (the simulator's
+    // measure, drawn back) has it.
+    const double radial = std::uniform_real_distribution<double>(-0.6, 0.6)(rng);
+    const double tangential = std::uniform_real_distribution<double>(-0.6, 0.6)(rng);
+    const auto angles = dynamics::hanger_joint_angles(model, axes, data.frames[model.dof()], radial, tangential);
+    const Eigen::Isometry3d grapple = urdf_pose(*urdf_model, "grapple_link", model, q, angles);
+    const Eigen::Vector3d com = grapple * (model.grapple.com_below_m * axes.hang);
+    const Eigen::Vector3d expected = dynamics::grapple_position(
+        model, data.frames[model.dof()].translation(), radial, tangential);
+    EXPECT_LT((com - expected).norm(), 1e-6) << model.name << " pose " << k;
+    // A swing nothing measures: straight down.
+    const auto still = dynamics::hanger_joint_angles(model, axes, data.frames[model.dof()], NAN, NAN);
+    const Eigen::Vector3d down =
+        urdf_pose(*urdf_model, "grapple_link", model, q, still) * axes.hang -
+        data.frames[model.dof()].translation();
+    EXPECT_LT((down.normalized() - dynamics::down_direction(model)).norm(), 1e-6);
   }
 }
 
@@ -88,7 +130,7 @@ TEST(Urdf, TheReferenceCraneReadsBackWithTheModelsKinematicsAndMass) {
   check_crane(config::default_crane_config());
 }
 
-TEST(Urdf, APayloadIsInTheLastLinksMass) {
+TEST(Urdf, APayloadIsInTheGrapplesMass) {
   auto cfg = config::default_crane_config();
   config::set_payload_mass(cfg.model, 650.0);
   check_crane(cfg);

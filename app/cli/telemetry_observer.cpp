@@ -1,5 +1,7 @@
 #include "telemetry_observer.hpp"
 
+#include "craneassist/dynamics/urdf.hpp"
+
 #include <algorithm>
 #include <type_traits>
 
@@ -65,6 +67,8 @@ void each_field(Row& row, Frame& f, int n, Copy copy) {
   copy(row.swing_rad, f.swing_rad);
   copy(row.swing_radial_rad, f.swing_radial_rad);
   copy(row.swing_tangential_rad, f.swing_tangential_rad);
+  copy(row.hanger_rad, f.hanger_rad);
+  copy(row.hanger_rate_rad_s, f.hanger_rate_rad_s);
   copy(row.base_present, f.base_present);
   copy(row.base_shared_pump, f.base_shared_pump);
   copy(row.base_pose, f.base_pose);
@@ -107,6 +111,10 @@ dds::TelemetryInfo telemetry_info(const config::CraneConfig& config, const char*
   for (const auto& j : m.joints) {
     info.joint_names.push_back(j.name);
     info.joint_prismatic.push_back(j.type == dynamics::JointType::kPrismatic);
+  }
+  if (m.grapple.hangs()) {
+    info.hanger_joint_names.assign(dynamics::kHangerJointNames.begin(),
+                                   dynamics::kHangerJointNames.end());
   }
   info.flow_limit_m3_s = m.pump.max_flow_m3_s;
   info.power_limit_w = m.pump.prime_mover_power_w;

@@ -25,7 +25,8 @@ int run_urdf_command(const UrdfArgs& args) {
     return input_error_exit("config");
   }
   return write_output(dynamics::to_urdf(cfg.model, args.name), args.output,
-                      std::to_string(cfg.model.dof()) + " joints");
+                      std::to_string(cfg.model.dof()) + " joints" +
+                          (cfg.model.grapple.hangs() ? ", the grapple on its two-axis link" : ""));
 }
 
 }  // namespace craneassist::cli

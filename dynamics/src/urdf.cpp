@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
+#include "craneassist/dynamics/pendulum.hpp"
 
 namespace craneassist::dynamics {
 namespace {
@@ -54,24 +56,62 @@ struct Inertial {
   Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();  // about com, in the link's axes
 };
 
-// The bodies on one DH frame, moved into a link frame by `link_from_frame`, combined.
-Inertial combine(const CraneModel& model, int frame, const Eigen::Isometry3d& link_from_frame) {
+// A body in a link's frame: its mass at com with its inertia (about com) in the link's axes.
+struct PlacedBody {
+  double mass = 0.0;
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+};
+
+Inertial combine(const std::vector<PlacedBody>& bodies) {
   Inertial out;
-  for (const Body& b : model.bodies) {
-    if (b.frame != frame || b.mass_kg <= 0.0) continue;
-    out.mass += b.mass_kg;
-    out.com += b.mass_kg * (link_from_frame * b.com_m);
+  for (const PlacedBody& b : bodies) {
+    out.mass += b.mass;
+    out.com += b.mass * b.com;
   }
   if (out.mass <= 0.0) return out;
   out.com /= out.mass;
-  for (const Body& b : model.bodies) {
-    if (b.frame != frame || b.mass_kg <= 0.0) continue;
-    const Eigen::Matrix3d r = link_from_frame.linear();
-    const Eigen::Vector3d c = link_from_frame * b.com_m - out.com;
-    out.inertia += r * b.inertia_diag_kgm2.asDiagonal() * r.transpose() +
-                   b.mass_kg * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
+  for (const PlacedBody& b : bodies) {
+    const Eigen::Vector3d c = b.com - out.com;
+    out.inertia +=
+        b.inertia + b.mass * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
   }
   return out;
+}
+
+// The grapple hangs from the tip, so the bodies at the tip point (the grapple, rotator and
+// payload) are grapple_link's, not the last boom link's.
+bool hangs_from_tip(const CraneModel& model, const Body& b) {
+  return model.grapple.hangs() && b.frame == model.dof() && b.com_m.norm() < kAtTipM;
+}
+
+// The bodies on one DH frame (but those that hang from the tip), moved into a link frame by
+// `link_from_frame`, combined.
+Inertial combine(const CraneModel& model, int frame, const Eigen::Isometry3d& link_from_frame) {
+  std::vector<PlacedBody> placed;
+  const Eigen::Matrix3d r = link_from_frame.linear();
+  for (const Body& b : model.bodies) {
+    if (b.frame != frame || b.mass_kg <= 0.0 || hangs_from_tip(model, b)) continue;
+    placed.push_back({b.mass_kg, link_from_frame * b.com_m,
+                      r * b.inertia_diag_kgm2.asDiagonal() * r.transpose()});
+  }
+  return combine(placed);
+}
+
+// grapple_link's bodies, in its frame (the grapple hangs along axes.hang): the grapple and
+// rotator com_below_m down the hanger, the payload load_below_m (a point).
+Inertial grapple_inertial(const CraneModel& model, const HangerAxes& axes) {
+  std::vector<PlacedBody> placed;
+  for (const Body& b : model.bodies) {
+    if (!hangs_from_tip(model, b) || b.mass_kg <= 0.0) continue;
+    const bool payload = is_payload(b);
+    const double depth = payload ? model.grapple.load_below_m : model.grapple.com_below_m;
+    // The bodies' inertia diagonal is in the tip frame's axes, as the simulator takes it.
+    placed.push_back({b.mass_kg, depth * axes.hang,
+                      payload ? Eigen::Matrix3d::Zero()
+                              : Eigen::Matrix3d(b.inertia_diag_kgm2.asDiagonal())});
+  }
+  return combine(placed);
 }
 
 std::string inertial(const Inertial& in) {
@@ -87,7 +127,74 @@ std::string inertial(const Inertial& in) {
          "\" iyz=\"" + num(i(1, 2)) + "\" izz=\"" + num(i(2, 2)) + "\"/>\n    </inertial>\n";
 }
 
+// A box of `size` centred at `centre` with its z axis along `z` (unit), in a link's frame.
+std::string box_visual(const Eigen::Vector3d& centre, const Eigen::Vector3d& z,
+                       const std::string& size, const char* material) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() = centre;
+  t.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), z).toRotationMatrix();
+  return "    <visual>\n      " + origin(t) + "\n      <geometry><box size=\"" + size +
+         "\"/></geometry>\n      <material name=\"" + material + "\"/>\n    </visual>\n";
+}
+
+// The hanger's two joints and links below tip_link.
+std::string hanger_urdf(const CraneModel& model) {
+  const HangerAxes axes = hanger_axes(model);
+  const double below = model.grapple.com_below_m;
+  const auto joint = [](const char* name, const char* parent, const char* child,
+                        const Eigen::Vector3d& axis) {
+    return std::string("  <joint name=\"") + name + "\" type=\"revolute\">\n    <parent link=\"" +
+           parent + "\"/>\n    <child link=\"" + child +
+           "\"/>\n    <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\n    <axis xyz=\"" + xyz(axis) +
+           "\"/>\n    <limit lower=\"" + num(-M_PI) + "\" upper=\"" + num(M_PI) +
+           "\" velocity=\"100\" effort=\"0\"/>\n  </joint>\n";
+  };
+  return "  <link name=\"hanger_link\">\n" + inertial(Inertial{}) + "  </link>\n" +
+         joint(kHangerJointNames[0], "tip_link", "hanger_link", axes.across) +
+         "  <link name=\"grapple_link\">\n" +
+         box_visual(0.5 * below * axes.hang, axes.hang, "0.06 0.06 " + num(below), "dark") +
+         box_visual(below * axes.hang, axes.hang, "0.5 0.25 0.5", "boom") +
+         inertial(grapple_inertial(model, axes)) + "  </link>\n" +
+         joint(kHangerJointNames[1], "hanger_link", "grapple_link", axes.along);
+}
+
 }  // namespace
+
+HangerAxes hanger_axes(const CraneModel& model) {
+  HangerAxes axes;
+  const int n = model.dof();
+  if (n < 2) return axes;
+  JointVector q(n);
+  for (int i = 0; i < n; ++i) {
+    const auto& j = model.joints[static_cast<std::size_t>(i)];
+    q[i] = 0.5 * (j.q_min + j.q_max);
+  }
+  KinematicsData kin;
+  forward_kinematics(model, kin, q);
+  const Eigen::Matrix3d tip_from_base = kin.frames[static_cast<std::size_t>(n)].linear().transpose();
+  axes.across = (tip_from_base * kin.frames[1].linear().col(2)).normalized();
+  Eigen::Vector3d hang = tip_from_base * down_direction(model);
+  hang -= hang.dot(axes.across) * axes.across;
+  axes.hang = hang.norm() > 1e-9 ? Eigen::Vector3d(hang.normalized()) : axes.across.unitOrthogonal();
+  axes.along = axes.across.cross(axes.hang);
+  return axes;
+}
+
+std::array<double, 2> hanger_joint_angles(const CraneModel& model, const HangerAxes& axes,
+                                          const Eigen::Isometry3d& tip, double radial_rad,
+                                          double tangential_rad) noexcept {
+  const bool measured = std::isfinite(radial_rad) && std::isfinite(tangential_rad);
+  // The hanging direction, base frame (as grapple_position), then in the tip frame.
+  const Eigen::Vector3d base_hang =
+      (grapple_position(model, tip.translation(), measured ? radial_rad : 0.0,
+                        measured ? tangential_rad : 0.0) -
+       tip.translation())
+          .normalized();
+  const Eigen::Vector3d h = tip.linear().transpose() * base_hang;
+  // h = Rot(across, a1) Rot(along, a2) hang = cos a2 (cos a1 hang + sin a1 along) - sin a2 across.
+  return {std::atan2(h.dot(axes.along), h.dot(axes.hang)),
+          -std::asin(std::clamp(h.dot(axes.across), -1.0, 1.0))};
+}
 
 std::string to_urdf(const CraneModel& model, const std::string& robot_name) {
   const int n = model.dof();
@@ -125,8 +232,9 @@ std::string to_urdf(const CraneModel& model, const std::string& robot_name) {
   out += "  <link name=\"tip_link\"/>\n  <joint name=\"tip\" type=\"fixed\">\n    <parent link=\"" +
          model.joints[static_cast<std::size_t>(n - 1)].name +
          "_link\"/>\n    <child link=\"tip_link\"/>\n    " + origin(fixed(n - 1)) +
-         "\n  </joint>\n</robot>\n";
-  return out;
+         "\n  </joint>\n";
+  if (model.grapple.hangs()) out += hanger_urdf(model);
+  return out + "</robot>\n";
 }
 
 }  // namespace craneassist::dynamics

@@ -47,6 +47,9 @@ static long g_command_matches = 0, g_command_nan = 0, g_reference_moving = 0;
 static double g_last_position[8], g_last_q[8];
 static int g_last_position_n = -1, g_last_q_n = -1;
 static double g_stamp_age_max_s = 0.0;
+/* The range each JointState position took over the run (the hanger joints must swing). */
+static double g_position_min[8], g_position_max[8];
+static const double kPi = 3.14159265358979323846;
 static char g_last_status[32] = "";
 
 static int64_t wall_ns(void) {
@@ -78,8 +81,11 @@ static void check_joint_state(const sensor_msgs_msg_dds__JointState_* m) {
   CHECK((int)m->velocity._length == g_dof, kJointStates, "%u velocities", m->velocity._length);
   CHECK(m->effort._length == 0, kJointStates, "%u efforts", m->effort._length);
   for (uint32_t i = 0; i < m->position._length && i < 8; ++i) {
-    CHECK(isfinite(m->position._buffer[i]), kJointStates, "position %u", i);
-    g_last_position[i] = m->position._buffer[i];
+    const double p = m->position._buffer[i];
+    CHECK(isfinite(p), kJointStates, "position %u", i);
+    if (g_count[kJointStates] == 1 || p < g_position_min[i]) g_position_min[i] = p;
+    if (g_count[kJointStates] == 1 || p > g_position_max[i]) g_position_max[i] = p;
+    g_last_position[i] = p;
   }
   for (uint32_t i = 0; i < m->velocity._length; ++i) {
     CHECK(isfinite(m->velocity._buffer[i]), kJointStates, "velocity %u", i);
@@ -198,13 +204,24 @@ int main(int argc, char** argv) {
   }
   dds_delete(pp);
 
+  /* The crane's joints first, as craneassist/joints has them; after them the URDF's hanger
+     joints of a hanging grapple, which the grapple's swing turns (the replay starts moving). */
   double last_diff = 0.0;
-  bool same_joints = g_last_position_n == g_dof && g_last_q_n == g_dof;
-  for (int i = 0; same_joints && i < g_dof; ++i) {
+  bool same_joints = g_last_position_n == g_dof && g_last_q_n > 0 && g_last_q_n <= g_dof;
+  for (int i = 0; same_joints && i < g_last_q_n; ++i) {
     last_diff = fmax(last_diff, fabs(g_last_position[i] - g_last_q[i]));
   }
   CHECK(same_joints && last_diff == 0.0, kJointStates,
         "last positions differ from the last craneassist/joints q by %g", last_diff);
+  double hanger_range = 0.0;
+  for (int i = g_last_q_n; same_joints && i < g_dof; ++i) {
+    const double range = g_position_max[i] - g_position_min[i];
+    CHECK(g_position_min[i] >= -kPi && g_position_max[i] <= kPi, kJointStates,
+          "%s from %g to %g rad", g_joint_names[i], g_position_min[i], g_position_max[i]);
+    if (range > hanger_range) hanger_range = range;
+  }
+  CHECK(!same_joints || g_dof == g_last_q_n || hanger_range > 1e-3, kJointStates,
+        "the hanger joints never moved (range %g rad)", hanger_range);
   CHECK(g_command_matches > 0, kCommand, "never (%g, %g, %g)", g_command[0], g_command[1],
         g_command[2]);
   CHECK(g_reference_moving > 0, kReference, "never moving");
@@ -212,11 +229,12 @@ int main(int argc, char** argv) {
       "cyclone ros2 reader: received joint_states %ld, tip_velocity/command %ld, "
       "tip_velocity/reference %ld; status %ld, joints %ld; last status '%s'; command "
       "(%g, %g, %g) in %ld samples, NaN in %ld; %ld moving references along it; last positions "
-      "= last craneassist q: %s; stamp age max %.1f ms; %ld failed checks\n",
+      "= last craneassist q: %s; %d hanger joints, swinging over %.4f rad; stamp age max %.1f ms; "
+      "%ld failed checks\n",
       g_count[kJointStates], g_count[kCommand], g_count[kReference], g_count[kStatus],
       g_count[kJoints], g_last_status, g_command[0], g_command[1], g_command[2], g_command_matches,
       g_command_nan, g_reference_moving, same_joints && last_diff == 0.0 ? "yes" : "no",
-      1e3 * g_stamp_age_max_s, *check_errors());
+      g_dof - g_last_q_n, hanger_range, 1e3 * g_stamp_age_max_s, *check_errors());
   bool ok = *check_errors() == 0;
   for (int t = 0; t < kTopics; ++t) {
     if (g_count[t] == 0) {

@@ -194,6 +194,7 @@ YAML
   has replay.out "ROS 2 topics /crane1/joint_states"
   has reader.out " 0 failed checks"
   has reader.out "last positions = last craneassist q: yes"
+  has reader.out "2 hanger joints, swinging"   # the K70M's grapple hangs: the URDF's hanger
   echo "joints: $joints; command in base_link: $command_base"
   echo "ros2 OK"
   ;;

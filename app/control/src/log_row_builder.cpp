@@ -7,7 +7,10 @@
 namespace craneassist::control {
 
 LogRowBuilder::LogRowBuilder(const dynamics::CraneModel& model)
-    : model_(model), cyl_pos_(model.dof()), cyl_arm_(model.dof()) {
+    : model_(model),
+      cyl_pos_(model.dof()),
+      cyl_arm_(model.dof()),
+      hanger_axes_(dynamics::hanger_axes(model)) {
   // Size the working data once (forward kinematics at the zero configuration).
   dynamics::JointVector q = dynamics::JointVector::Zero(model.dof());
   dynamics::tip_jacobian(model_, kin_, q, jac_);
@@ -21,6 +24,19 @@ void LogRowBuilder::measure(const valves::MachineState& state) noexcept {
     tip_v_ = jac_ * state.qdot;
     dynamics::cylinder_lengths(model_, state.q, cyl_pos_);
     dynamics::cylinder_arms(model_, state.q, cyl_arm_);
+    if (model_.grapple.hangs()) {
+      const auto angles = dynamics::hanger_joint_angles(
+          model_, hanger_axes_, kin_.frames[static_cast<std::size_t>(n)], state.swing_radial_rad,
+          state.swing_tangential_rad);
+      const double dt = state.t_s - hanger_t_s_;
+      for (std::size_t k = 0; k < angles.size(); ++k) {
+        // Through +-pi the step is taken modulo 2 pi.
+        const double step = std::remainder(angles[k] - hanger_[k], 2.0 * M_PI);
+        hanger_rate_[k] = dt > 0.0 ? step / dt : 0.0;
+        hanger_[k] = angles[k];
+      }
+      hanger_t_s_ = state.t_s;
+    }
   } else {
     tip_.setZero();
     tip_v_.setZero();
@@ -65,6 +81,8 @@ void LogRowBuilder::fill(LogRow& row, double t, const Eigen::Vector3d& cmd,
   row.swing_rad = state.swing_rad;
   row.swing_radial_rad = state.swing_radial_rad;
   row.swing_tangential_rad = state.swing_tangential_rad;
+  row.hanger_rad = hanger_;
+  row.hanger_rate_rad_s = hanger_rate_;
   row.payload_estimate_kg = out.load.estimate_kg;
   row.load_moment_ratio = out.load.moment_ratio;
   row.rated_load_kg = out.load.rated_kg;

@@ -60,7 +60,10 @@ Ros2Writers::Ros2Writers(fdds::DomainParticipant& participant, fdds::Publisher& 
     if (writers_[i] == nullptr)
       throw std::runtime_error("DDS: cannot create the writer of " + name);
   }
-  joint_state_.name(info.joint_names);
+  std::vector<std::string> names = info.joint_names;
+  names.insert(names.end(), info.hanger_joint_names.begin(), info.hanger_joint_names.end());
+  joint_state_.name(names);
+  hangers_ = std::min(info.hanger_joint_names.size(), std::size_t{2});
   twist_.header().frame_id("base_link");
 }
 
@@ -84,6 +87,10 @@ bool Ros2Writers::write_joint_states(const TelemetryFrame& f, const Stamp& stamp
   joint_state_.header().stamp(stamp);
   joint_state_.position().assign(f.q.begin(), f.q.begin() + static_cast<std::ptrdiff_t>(n));
   joint_state_.velocity().assign(f.qdot.begin(), f.qdot.begin() + static_cast<std::ptrdiff_t>(n));
+  for (std::size_t k = 0; k < hangers_; ++k) {
+    joint_state_.position().push_back(f.hanger_rad[k]);
+    joint_state_.velocity().push_back(f.hanger_rate_rad_s[k]);
+  }
   return writers_[0]->write(&joint_state_);
 }
 

@@ -46,6 +46,7 @@ class Ros2Writers {
   TopicPacer pacers_[kTopics];
   std::array<double, 9> base_from_crane_;
   sensor_msgs::msg::dds_::JointState_ joint_state_;
+  std::size_t hangers_ = 0;  // the hanger joints after the crane's (TelemetryInfo)
   geometry_msgs::msg::dds_::TwistStamped_ twist_;
   std::atomic<std::uint64_t> written_[kTopics] = {};
 };

@@ -42,6 +42,10 @@ struct LogRow {
   double swing_rad = std::numeric_limits<double>::quiet_NaN();
   double swing_radial_rad = std::numeric_limits<double>::quiet_NaN();
   double swing_tangential_rad = std::numeric_limits<double>::quiet_NaN();
+  // Telemetry only (not in the CSV): the angles and rates of the URDF's hanger joints that draw
+  // the grapple where the swing has it (dynamics::hanger_joint_angles; straight down where
+  // nothing measures the swing), rad and rad/s. Zero without a hanging grapple.
+  std::array<double, 2> hanger_rad{}, hanger_rate_rad_s{};
   // Live and telemetry only (not in the CSV): the chart's rated load at the reach, the reach,
   // and the scale's and limiter's state.
   double rated_load_kg = 0.0, load_reach_m = 0.0;

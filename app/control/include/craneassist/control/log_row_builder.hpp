@@ -3,10 +3,13 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
+#include <limits>
 
 #include "craneassist/control/controller.hpp"
 #include "craneassist/control/csv_log.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
+#include "craneassist/dynamics/urdf.hpp"
 
 namespace craneassist::control {
 
@@ -14,8 +17,9 @@ class LogRowBuilder {
  public:
   explicit LogRowBuilder(const dynamics::CraneModel& model);
 
-  // The measured tip position and velocity (crane frame; zero when the state is invalid) and the
-  // cylinder positions and velocities. Allocation-free.
+  // The measured tip position and velocity (crane frame; zero when the state is invalid), the
+  // cylinder positions and velocities, and the hanger joints' angles (their rates from the last
+  // measurement). Allocation-free.
   void measure(const valves::MachineState& state) noexcept;
   const Eigen::Vector3d& tip() const noexcept { return tip_; }
   const Eigen::Vector3d& tip_velocity() const noexcept { return tip_v_; }
@@ -31,6 +35,9 @@ class LogRowBuilder {
   dynamics::TaskJacobian jac_;
   dynamics::JointVector cyl_pos_, cyl_arm_;
   Eigen::Vector3d tip_ = Eigen::Vector3d::Zero(), tip_v_ = Eigen::Vector3d::Zero();
+  dynamics::HangerAxes hanger_axes_;
+  std::array<double, 2> hanger_{}, hanger_rate_{};
+  double hanger_t_s_ = std::numeric_limits<double>::quiet_NaN();
 };
 
 }  // namespace craneassist::control

@@ -53,6 +53,8 @@ struct TelemetryFrame {
   double swing_rad = std::numeric_limits<double>::quiet_NaN();
   double swing_radial_rad = std::numeric_limits<double>::quiet_NaN();
   double swing_tangential_rad = std::numeric_limits<double>::quiet_NaN();
+  // The URDF's hanger joints (TelemetryInfo::hanger_joint_names): angles, rad, and rates, rad/s.
+  std::array<double, 2> hanger_rad{}, hanger_rate_rad_s{};
   // The wheeled base under the crane (sim --drive; topic craneassist/base): pose in the world
   // (x, y, heading), motion and drive command (forward speed, yaw rate), hub-motor flows (fl, fr,
   // rl, rr), their sum and the drive pump's Q_max. base_present false: a fixed base.
@@ -72,6 +74,9 @@ struct TelemetryInfo {
   std::string pump_mode;
   std::vector<std::string> joint_names;
   std::vector<bool> joint_prismatic;  // per joint: q in m (true) or rad (false)
+  // The URDF's hanger joints of a hanging grapple (dynamics::kHangerJointNames; empty when
+  // nothing hangs): /joint_states carries them after the crane's joints.
+  std::vector<std::string> hanger_joint_names;
   double flow_limit_m3_s = 0.0;
   double power_limit_w = 0.0;
   // Maps a crane-frame vector (tip commands: x forward, y up, z lateral) to the DH base frame,
