@@ -109,14 +109,16 @@ void check_crane(const config::CraneConfig& cfg) {
     // measure, drawn back) has it.
     const double radial = std::uniform_real_distribution<double>(-0.6, 0.6)(rng);
     const double tangential = std::uniform_real_distribution<double>(-0.6, 0.6)(rng);
-    const auto angles = dynamics::hanger_joint_angles(model, axes, data.frames[model.dof()], radial, tangential);
+    const auto angles =
+        dynamics::hanger_joint_angles(model, axes, data.frames[model.dof()], radial, tangential);
     const Eigen::Isometry3d grapple = urdf_pose(*urdf_model, "grapple_link", model, q, angles);
     const Eigen::Vector3d com = grapple * (model.grapple.com_below_m * axes.hang);
     const Eigen::Vector3d expected = dynamics::grapple_position(
         model, data.frames[model.dof()].translation(), radial, tangential);
     EXPECT_LT((com - expected).norm(), 1e-6) << model.name << " pose " << k;
     // A swing nothing measures: straight down.
-    const auto still = dynamics::hanger_joint_angles(model, axes, data.frames[model.dof()], NAN, NAN);
+    const auto still =
+        dynamics::hanger_joint_angles(model, axes, data.frames[model.dof()], NAN, NAN);
     const Eigen::Vector3d down =
         urdf_pose(*urdf_model, "grapple_link", model, q, still) * axes.hang -
         data.frames[model.dof()].translation();

@@ -1,9 +1,9 @@
 #include "telemetry_observer.hpp"
 
-#include "craneassist/dynamics/urdf.hpp"
-
 #include <algorithm>
 #include <type_traits>
+
+#include "craneassist/dynamics/urdf.hpp"
 
 namespace craneassist::cli {
 

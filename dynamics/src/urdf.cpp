@@ -107,9 +107,9 @@ Inertial grapple_inertial(const CraneModel& model, const HangerAxes& axes) {
     const bool payload = is_payload(b);
     const double depth = payload ? model.grapple.load_below_m : model.grapple.com_below_m;
     // The bodies' inertia diagonal is in the tip frame's axes, as the simulator takes it.
-    placed.push_back({b.mass_kg, depth * axes.hang,
-                      payload ? Eigen::Matrix3d::Zero()
-                              : Eigen::Matrix3d(b.inertia_diag_kgm2.asDiagonal())});
+    placed.push_back(
+        {b.mass_kg, depth * axes.hang,
+         payload ? Eigen::Matrix3d::Zero() : Eigen::Matrix3d(b.inertia_diag_kgm2.asDiagonal())});
   }
   return combine(placed);
 }
@@ -171,11 +171,13 @@ HangerAxes hanger_axes(const CraneModel& model) {
   }
   KinematicsData kin;
   forward_kinematics(model, kin, q);
-  const Eigen::Matrix3d tip_from_base = kin.frames[static_cast<std::size_t>(n)].linear().transpose();
+  const Eigen::Matrix3d tip_from_base =
+      kin.frames[static_cast<std::size_t>(n)].linear().transpose();
   axes.across = (tip_from_base * kin.frames[1].linear().col(2)).normalized();
   Eigen::Vector3d hang = tip_from_base * down_direction(model);
   hang -= hang.dot(axes.across) * axes.across;
-  axes.hang = hang.norm() > 1e-9 ? Eigen::Vector3d(hang.normalized()) : axes.across.unitOrthogonal();
+  axes.hang =
+      hang.norm() > 1e-9 ? Eigen::Vector3d(hang.normalized()) : axes.across.unitOrthogonal();
   axes.along = axes.across.cross(axes.hang);
   return axes;
 }

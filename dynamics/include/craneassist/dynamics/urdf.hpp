@@ -26,8 +26,7 @@
 namespace craneassist::dynamics {
 
 // The URDF names of the hanger's joints, in the order of hanger_joint_angles().
-inline constexpr std::array<const char*, 2> kHangerJointNames = {"hanger_across",
-                                                                   "hanger_along"};
+inline constexpr std::array<const char*, 2> kHangerJointNames = {"hanger_across", "hanger_along"};
 
 // The hanger's axes in the tip frame (the last DH frame): `across` (the first joint's axis, the
 // lift joint's axis, fixed to the boom), `hang` (where the grapple hangs at zero angles: down,
