@@ -36,6 +36,13 @@ const Eigen::Vector3d& SwayShaper::upcoming_past(double omega_rad_s, double zeta
   return history_[(next + history_.size() - steps(omega_rad_s, zeta)) % history_.size()];
 }
 
+void SwayShaper::set_upcoming_past(std::size_t k, const Eigen::Vector3d& goal, double omega_rad_s,
+                                   double zeta) noexcept {
+  const std::size_t n = history_.size();
+  const std::size_t next = (head_ + 1) % n;
+  if (k < steps(omega_rad_s, zeta)) history_[(next + n - steps(omega_rad_s, zeta) + k) % n] = goal;
+}
+
 Eigen::Vector3d SwayShaper::shape(const Eigen::Vector3d& goal, double omega_rad_s,
                                   double zeta) noexcept {
   head_ = (head_ + 1) % history_.size();

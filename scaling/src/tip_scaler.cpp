@@ -30,6 +30,14 @@ constexpr double kMinRestartRoom = 0.1;  // m: a restart from rest goes at least
 // m/s^2: the shaped reference's acceleration may pass a bound by this before the motion takes
 // over (rounding).
 constexpr double kBoundSlack = 1e-9;
+// And by this share of the bound: the bounds vary with the path speed (the cylinder accelerations
+// through f'' sdot^2), so a blend of two motions, each within the bound at its own speed, is
+// within the bound at the blended speed to about this (measured: 8e-6 of a cylinder-acceleration
+// bound at the start of a loaded lift).
+constexpr double kBoundShare = 1e-4;
+double slack(double bound) {
+  return kBoundSlack + kBoundShare * std::abs(bound);
+}
 
 }  // namespace
 
@@ -58,6 +66,7 @@ void TipScaler::reset() {
   ref_acceleration_.setZero();
   shaping_ = false;
   steady_cycles_ = kSteadyForever;
+  since_hand_over_ = kSteadyForever;
 }
 
 void TipScaler::hand_over() {
@@ -66,6 +75,34 @@ void TipScaler::hand_over() {
   acceleration_ = ref_acceleration_;
   shaping_ = false;
   steady_cycles_ = 0;
+}
+
+bool TipScaler::seed_shaper_past(const Eigen::Vector3d& v, const Eigen::Vector3d& a) {
+  // The past the coming shape() calls blend with, a window of T = n periods: it starts where the
+  // motion is now (so the shaped reference starts on it) and ends there too, where the recorded
+  // motion takes over (so the past goes on continuously), with the motion's acceleration at both
+  // ends. The least jerk that does it: the acceleration swings from a to -a and back at the jerk
+  // 4 |a| / T, h'(tau) = a (1 - 4 min(tau, T - tau) / T); the velocity goes |a| T / 8 ahead of v
+  // along a and as far back. Seeded only where that keeps the jerk bound (|a| <= J T / 4) and
+  // leaves the past's velocity at least half the present one (never through rest: a motion
+  // near the end of a stop is not shaped); otherwise false, and shaping waits.
+  const std::size_t n = velocity_shaper_.window(sway_omega_rad_s_, sway_zeta_);
+  const double span = static_cast<double>(n) * config_.period_s;
+  if (n == 0 || 4.0 * a.norm() > config_.jerk_max * span ||
+      a.norm() * span / 8.0 > 0.5 * v.norm() + kSegmentEpsilon) {
+    return false;
+  }
+  Eigen::Vector3d h = v;
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto accel = [&](std::size_t i) {
+      const double tau = static_cast<double>(i) * config_.period_s;
+      return Eigen::Vector3d(a * (1.0 - 4.0 * std::min(tau, span - tau) / span));
+    };
+    velocity_shaper_.set_upcoming_past(k, h, sway_omega_rad_s_, sway_zeta_);
+    acceleration_shaper_.set_upcoming_past(k, accel(k), sway_omega_rad_s_, sway_zeta_);
+    h += 0.5 * config_.period_s * (accel(k) + accel(k + 1));
+  }
+  return true;
 }
 
 Eigen::Vector3d TipScaler::direction(const Eigen::Vector3d& command) const {
@@ -321,19 +358,42 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
   if (motion_at_rest) reversing_ = false;
 
   // Sway damping (docs/sway.md): the reference is the motion ZV-shaped to the grapple's swing.
-  // Shaping starts (or takes a new frequency) only when the motion has been steady for longer
-  // than the shaper's delay before this cycle (the shaper's history is flat), so the shaped
-  // reference never jumps; a stop, the end brake and the limiter's refusal hand the shaped state
-  // back to the motion (hand_over).
+  // A stop, the end brake, the limiter's refusal and a reversal hand the shaped state back to
+  // the motion (hand_over). Shaping takes a new frequency only when the motion has been steady
+  // for longer than the shaper's delay (its history is flat, so the shaped reference does not
+  // jump). It starts again as soon as none of those acts (after a limit the shaped reference
+  // would pass, half a swing period later), on a motion that no limit holds back, whatever the
+  // motion does then (a stick that keeps moving, an arc): the shaper's past is replaced by one
+  // that starts and ends on the motion as it is now (seed_shaper_past), so the shaped reference
+  // starts on the motion, continuous, and blends two motions within the bounds. What the motion
+  // does from then on is shaped; the swing the unshaped part started is not cancelled.
   const bool hard = stop || end_brake_ || in.overload_refused || reversing_;
   const long window =
       std::lround(SwayShaper::delay_s(in.sway_omega_rad_s, in.sway_zeta) / period) + 1;
-  if (!hard && steady_cycles_ >= window) {
+  // A limit holds the motion back: the power or pressure bound it accelerates against, or a
+  // velocity-level limit below the request (what out.limit reports, below).
+  const bool power_limited = status == ScalingFilterStatus::kAccelerationLimited &&
+                             (out.bounds.limit_max == ActiveLimit::kPower ||
+                              out.bounds.limit_max == ActiveLimit::kPressure) &&
+                             a_new.dot(u) >= out.bounds.sddot_max - 1e-9;
+  const bool held_back = power_limited || (cap.kind != ActiveLimit::kNone && cap.value < request);
+  if (!hard && in.sway_omega_rad_s > 0.0 && !shaping_ && since_hand_over_ >= window &&
+      (steady_cycles_ >= window || !held_back)) {
+    const double omega = sway_omega_rad_s_, zeta = sway_zeta_;
+    sway_omega_rad_s_ = in.sway_omega_rad_s;
+    sway_zeta_ = in.sway_zeta;
+    shaping_ = steady_cycles_ >= window || seed_shaper_past(v_new, a_new);
+    if (!shaping_) {
+      sway_omega_rad_s_ = omega;  // as it was (no shaping: the history goes on recording)
+      sway_zeta_ = zeta;
+    }
+  } else if (!hard && steady_cycles_ >= window) {
     shaping_ = in.sway_omega_rad_s > 0.0;
     sway_omega_rad_s_ = in.sway_omega_rad_s;
     sway_zeta_ = in.sway_zeta;
   }
   steady_cycles_ = moved ? 0 : std::min(steady_cycles_ + 1, kSteadyForever);
+  since_hand_over_ = std::min(since_hand_over_ + 1, kSteadyForever);
   const Eigen::Vector3d v_ref = velocity_shaper_.shape(v_new, sway_omega_rad_s_, sway_zeta_);
   const Eigen::Vector3d a_ref = acceleration_shaper_.shape(a_new, sway_omega_rad_s_, sway_zeta_);
   const Eigen::Vector3d v_out = shaping_ ? v_ref : v_new;
@@ -350,10 +410,10 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
                                                    acceleration_limits_, out.terms, out.bounds);
     const double speed_cap = physical_cap();
     const double along = a_out.dot(u);
-    past_bounds =
-        !dynamics_ok || ref_speed_out > speed_cap + kBoundSlack ||
-        along > out.bounds.sddot_max + kBoundSlack ||
-        along < stop_bound(out.bounds, acceleration_limits_.path_deceleration_max) - kBoundSlack;
+    const double lowest = stop_bound(out.bounds, acceleration_limits_.path_deceleration_max);
+    past_bounds = !dynamics_ok || ref_speed_out > speed_cap + kBoundSlack ||
+                  along > out.bounds.sddot_max + slack(out.bounds.sddot_max) ||
+                  along < lowest - slack(lowest);
   }
 
   const Eigen::Vector3d step = 0.5 * period * (ref_velocity_ + v_out);
@@ -369,7 +429,12 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
   if (out.sdot > 0.0) last_direction_ = v_out / out.sdot;
   out.sddot = a_out.dot(out.sdot > 0.0 ? last_direction_ : u);
   out.at_rest = motion_at_rest && v_out.isZero(0.0) && a_out.isZero(0.0);
-  if (past_bounds) hand_over();
+  if (past_bounds) {
+    // Shaping starts again no sooner than half a swing period later (not at once into the same
+    // limit).
+    hand_over();
+    since_hand_over_ = 0;
+  }
 
   // What holds the motion back: the failed dynamics, the stale input, a power bound the
   // tangential acceleration is pressed against, or the lowest velocity-level limit when it is

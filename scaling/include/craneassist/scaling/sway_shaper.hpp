@@ -31,6 +31,14 @@ class SwayShaper {
   static double past_weight(double zeta) noexcept;
   // The past goal the next shape() call blends with (the one recorded a delay before it).
   const Eigen::Vector3d& upcoming_past(double omega_rad_s, double zeta) const noexcept;
+  // The number of shape() calls whose past goals are already recorded (the delay in periods).
+  std::size_t window(double omega_rad_s, double zeta) const noexcept {
+    return steps(omega_rad_s, zeta);
+  }
+  // Replaces the past goal that the k-th next shape() call blends with (k = 0: the next call;
+  // k < window()): a shaper started on a motion that was not at rest gets a past of its own.
+  void set_upcoming_past(std::size_t k, const Eigen::Vector3d& goal, double omega_rad_s,
+                         double zeta) noexcept;
 
  private:
   std::size_t steps(double omega_rad_s, double zeta) const noexcept;

@@ -141,12 +141,16 @@ class TipScaler {
   // Sway damping: velocity_ and acceleration_ are the motion the limits shape; the reference is
   // that motion ZV-shaped (SwayShaper) while shaping_, the motion itself otherwise.
   void hand_over();
+  // The shaper's past from the motion's present state (re-entry after a hand-over); false when
+  // no such past keeps the jerk bound (the motion accelerates too hard).
+  bool seed_shaper_past(const Eigen::Vector3d& v, const Eigen::Vector3d& a);
   static constexpr long kSteadyForever = 1L << 30;
   SwayShaper velocity_shaper_, acceleration_shaper_;
   Eigen::Vector3d ref_velocity_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d ref_acceleration_ = Eigen::Vector3d::Zero();
   bool shaping_ = false;
   long steady_cycles_ = kSteadyForever;
+  long since_hand_over_ = kSteadyForever;
   double sway_omega_rad_s_ = 0.0, sway_zeta_ = 0.0;  // latched while shaping
 };
 
