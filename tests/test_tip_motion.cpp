@@ -16,6 +16,7 @@
 #include "craneassist/control/controller.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
+#include "craneassist/dynamics/pendulum.hpp"
 #include "craneassist/dynamics/rigid_body_terms.hpp"
 #include "craneassist/scaling/tip_path.hpp"
 #include "craneassist/scaling/tip_scaler.hpp"
@@ -35,16 +36,20 @@ class TipMotion {
         scaler_(cfg_.model, control::tip_scaler_config(cfg_), terms_),
         q(cfg_.simulation.q_initial) {}
 
-  // One cycle; returns the reference tip velocity (J(q) qdot_ref) of the cycle.
-  Eigen::Vector3d step(const Eigen::Vector3d& command, bool stale = false) {
+  // One cycle; returns the reference tip velocity (J(q) qdot_ref) of the cycle. A pendulum
+  // (omega > 0): the reference is shaped to it (sway damping).
+  Eigen::Vector3d step(const Eigen::Vector3d& command, bool stale = false,
+                       const dynamics::Pendulum& pendulum = {}) {
     const Eigen::Vector3d u = scaler_.direction(command);
     scaling::TipPathInput in;
     in.direction = u;
     in.sdot = scaler_.speed();
     in.intended_speed = stale ? in.sdot : scaler_.intended_speed(command);
     path_.update(q, in, path_out);
-    scaler_.update(q, path_out.geometry, control::tip_scaler_input(command, u, path_out, stale),
-                   out);
+    scaling::TipScalerInput scaler_in = control::tip_scaler_input(command, u, path_out, stale);
+    scaler_in.sway_omega_rad_s = pendulum.omega_rad_s;
+    scaler_in.sway_zeta = pendulum.zeta;
+    scaler_.update(q, path_out.geometry, scaler_in, out);
     const auto& g = path_out.geometry;
     for (int i = 0; i < cfg_.model.dof(); ++i) {
       const auto& joint = cfg_.model.joints[static_cast<std::size_t>(i)];
@@ -357,6 +362,66 @@ TEST(TipMotion, LateralMotionAtTheSlewAxisSaysSingularity) {
   EXPECT_GT(singular_near_axis, near_axis / 2);
   EXPECT_LT(peak_near_axis, 0.05) << "past the slew axis only at a crawl";
   EXPECT_GT(peak_beyond, 0.4) << "and at speed again beyond it";
+}
+
+// Sway damping after a hand-over (docs/sway.md): a dropout stops the crane unshaped, handing the
+// shaped reference to the motion; when the stick comes back within half a swing period and keeps
+// moving (an arc: never steady), shaping starts again at once, so what the arc and the stop after
+// it add to the swing is a fraction of what they add undamped. (The swing the unshaped stop left is
+// the same in both runs and is taken out: the pendulum is linear, so the runs with and without the
+// arc differ by what the arc and its stop did.) Within the jerk bound and without a jump.
+TEST(TipMotion, SwayDampingStartsAgainAfterAStopOnAMotionThatIsNeverSteady) {
+  const auto cfg = config::default_crane_config();
+  const dynamics::Pendulum pendulum = dynamics::grapple_pendulum(cfg.model, 0.0);
+  ASSERT_GT(pendulum.omega_rad_s, 0.0);
+  // The pendulum's state (x, z swing and their rates) at the end of a run.
+  const auto final_swing = [&](bool damped, bool arc) {
+    TipMotion m(cfg);
+    const dynamics::Pendulum p = damped ? pendulum : dynamics::Pendulum{};
+    // A linear pendulum under the reference's horizontal acceleration (crane frame x and z).
+    const double w = pendulum.omega_rad_s, length = 9.81 / (w * w);
+    Eigen::Vector2d x = Eigen::Vector2d::Zero(), xd = Eigen::Vector2d::Zero();
+    Eigen::Vector3d last = Eigen::Vector3d::Zero(), last_a = Eigen::Vector3d::Zero();
+    const double dt = m.period();
+    for (int k = 0; k < 1400; ++k) {
+      const double t = k * dt;
+      Eigen::Vector3d command = Eigen::Vector3d::Zero();
+      bool stale = false;
+      if (t < 2.0) {
+        command = Eigen::Vector3d(0.3, 0.0, 0.0);
+      } else if (t < 2.8) {
+        stale = true;  // a dropout: the stop hands the shaped reference over
+      } else if (arc && t < 6.8) {
+        const double phi = 0.25 * (t - 2.8);  // an arc: the command turns all the time
+        command = 0.3 * Eigen::Vector3d(std::cos(phi), 0.0, std::sin(phi));
+      }
+      m.step(command, stale, p);
+      // The reference's own velocity and acceleration: continuous, within the jerk bound.
+      const Eigen::Vector3d v = m.out.velocity, a = m.out.acceleration;
+      EXPECT_LE(m.out.sdddot, cfg.scaling.jerk_max_m_s3 * (1.0 + 1e-9)) << "t " << t;
+      EXPECT_LE((a - last_a).norm(), cfg.scaling.jerk_max_m_s3 * dt * (1.0 + 1e-9)) << "t " << t;
+      EXPECT_LE((v - last).norm(), 0.5 * dt * (a.norm() + last_a.norm()) + 1e-12) << "t " << t;
+      last = v;
+      last_a = a;
+      for (int j = 0; j < 10; ++j) {
+        const double h = dt / 10.0;
+        xd += h * (-w * w * x - Eigen::Vector2d(a.x(), a.z()) / length);
+        x += h * xd;
+      }
+    }
+    EXPECT_TRUE(m.out.at_rest);
+    Eigen::Vector4d state;
+    state << x, xd / w;
+    return state;
+  };
+  const double damped = (final_swing(true, true) - final_swing(true, false)).norm();
+  const double undamped = (final_swing(false, true) - final_swing(false, false)).norm();
+  std::printf(
+      "[ figures  ] the swing an arc and a stop add after a dropout: %.3f deg damped, "
+      "%.3f deg undamped\n",
+      damped * 180.0 / M_PI, undamped * 180.0 / M_PI);
+  EXPECT_GT(undamped * 180.0 / M_PI, 1.0);
+  EXPECT_LT(damped, 0.1 * undamped);
 }
 
 TEST(TipMotion, CyclesAllocateNothing) {

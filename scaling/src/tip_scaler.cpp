@@ -67,6 +67,7 @@ void TipScaler::reset() {
   shaping_ = false;
   steady_cycles_ = kSteadyForever;
   since_hand_over_ = kSteadyForever;
+  held_back_ = false;
 }
 
 void TipScaler::hand_over() {
@@ -78,29 +79,33 @@ void TipScaler::hand_over() {
 }
 
 bool TipScaler::seed_shaper_past(const Eigen::Vector3d& v, const Eigen::Vector3d& a) {
-  // The past the coming shape() calls blend with, a window of T = n periods: it starts where the
-  // motion is now (so the shaped reference starts on it) and ends there too, where the recorded
-  // motion takes over (so the past goes on continuously), with the motion's acceleration at both
-  // ends. The least jerk that does it: the acceleration swings from a to -a and back at the jerk
-  // 4 |a| / T, h'(tau) = a (1 - 4 min(tau, T - tau) / T); the velocity goes |a| T / 8 ahead of v
-  // along a and as far back. Seeded only where that keeps the jerk bound (|a| <= J T / 4) and
-  // leaves the past's velocity at least half the present one (never through rest: a motion
-  // near the end of a stop is not shaped); otherwise false, and shaping waits.
+  // The past the coming shape() calls blend with, a window of T = n periods, from the state this
+  // cycle starts from, (v, a): it starts there (so the shaped reference starts on the motion) and
+  // ends where the motion will be when the recorded motion takes over, v + a dt after T, with the
+  // acceleration a at both ends (so the past goes on continuously). The least jerk that does it:
+  // the acceleration swings from a to -a and back at the jerk 4 |a| / T (the velocity |a| T / 8
+  // ahead of v along a and as far back), plus the one period's a dt spread over the middle,
+  // h'(tau) = a (1 - 4 m / T) + (a dt / T) 4 m / T, m = min(tau, T - tau). Seeded only where
+  // that keeps the jerk bound (|a| <= J T / 4) and leaves the past's velocity at least half the
+  // present one (never through rest: a motion near the end of a stop is not shaped); otherwise
+  // false, and shaping waits.
   const std::size_t n = velocity_shaper_.window(sway_omega_rad_s_, sway_zeta_);
-  const double span = static_cast<double>(n) * config_.period_s;
+  const double dt = config_.period_s;
+  const double span = static_cast<double>(n) * dt;
   if (n == 0 || 4.0 * a.norm() > config_.jerk_max * span ||
       a.norm() * span / 8.0 > 0.5 * v.norm() + kSegmentEpsilon) {
     return false;
   }
+  const auto accel = [&](std::size_t k) {
+    const double tau = static_cast<double>(k) * dt;
+    const double m = 4.0 * std::min(tau, span - tau) / span;
+    return Eigen::Vector3d(a * (1.0 - m + m * dt / span));
+  };
   Eigen::Vector3d h = v;
   for (std::size_t k = 0; k < n; ++k) {
-    const auto accel = [&](std::size_t i) {
-      const double tau = static_cast<double>(i) * config_.period_s;
-      return Eigen::Vector3d(a * (1.0 - 4.0 * std::min(tau, span - tau) / span));
-    };
     velocity_shaper_.set_upcoming_past(k, h, sway_omega_rad_s_, sway_zeta_);
     acceleration_shaper_.set_upcoming_past(k, accel(k), sway_omega_rad_s_, sway_zeta_);
-    h += 0.5 * config_.period_s * (accel(k) + accel(k + 1));
+    h += 0.5 * dt * (accel(k) + accel(k + 1));
   }
   return true;
 }
@@ -178,6 +183,22 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
   // A stale input or a failed dynamics step: a jerk-limited stop along the present direction.
   const bool stop = in.stale_input || out.dynamics_failed;
   if (stop) take_over();
+  // Sway damping starts again (see below) before this cycle's motion: on the state the cycle
+  // starts from, the motion's and the reference's alike (not shaping), so this cycle's change is
+  // the first to be shaped and its limits the tightened ones.
+  const long window =
+      std::lround(SwayShaper::delay_s(in.sway_omega_rad_s, in.sway_zeta) / period) + 1;
+  if (!shaping_ && in.sway_omega_rad_s > 0.0 && !stop && !in.overload_refused && !end_brake_ &&
+      !reversing_ && since_hand_over_ >= window && (steady_cycles_ >= window || !held_back_)) {
+    const double omega = sway_omega_rad_s_, zeta = sway_zeta_;
+    sway_omega_rad_s_ = in.sway_omega_rad_s;
+    sway_zeta_ = in.sway_zeta;
+    shaping_ = steady_cycles_ >= window || seed_shaper_past(velocity_, acceleration_);
+    if (!shaping_) {
+      sway_omega_rad_s_ = omega;  // as it was (no shaping: the history goes on recording)
+      sway_zeta_ = zeta;
+    }
+  }
 
   // One factor on the whole command.
   const double request = in.command.norm();
@@ -368,26 +389,15 @@ void TipScaler::update(const JointVector& q, const PathGeometry& geometry, const
   // starts on the motion, continuous, and blends two motions within the bounds. What the motion
   // does from then on is shaped; the swing the unshaped part started is not cancelled.
   const bool hard = stop || end_brake_ || in.overload_refused || reversing_;
-  const long window =
-      std::lround(SwayShaper::delay_s(in.sway_omega_rad_s, in.sway_zeta) / period) + 1;
   // A limit holds the motion back: the power or pressure bound it accelerates against, or a
-  // velocity-level limit below the request (what out.limit reports, below).
-  const bool power_limited = status == ScalingFilterStatus::kAccelerationLimited &&
-                             (out.bounds.limit_max == ActiveLimit::kPower ||
-                              out.bounds.limit_max == ActiveLimit::kPressure) &&
-                             a_new.dot(u) >= out.bounds.sddot_max - 1e-9;
-  const bool held_back = power_limited || (cap.kind != ActiveLimit::kNone && cap.value < request);
-  if (!hard && in.sway_omega_rad_s > 0.0 && !shaping_ && since_hand_over_ >= window &&
-      (steady_cycles_ >= window || !held_back)) {
-    const double omega = sway_omega_rad_s_, zeta = sway_zeta_;
-    sway_omega_rad_s_ = in.sway_omega_rad_s;
-    sway_zeta_ = in.sway_zeta;
-    shaping_ = steady_cycles_ >= window || seed_shaper_past(v_new, a_new);
-    if (!shaping_) {
-      sway_omega_rad_s_ = omega;  // as it was (no shaping: the history goes on recording)
-      sway_zeta_ = zeta;
-    }
-  } else if (!hard && steady_cycles_ >= window) {
+  // velocity-level limit below the request (what out.limit reports, below). Shaping does not
+  // start again into it (next cycle).
+  held_back_ = (status == ScalingFilterStatus::kAccelerationLimited &&
+                (out.bounds.limit_max == ActiveLimit::kPower ||
+                 out.bounds.limit_max == ActiveLimit::kPressure) &&
+                a_new.dot(u) >= out.bounds.sddot_max - 1e-9) ||
+               (cap.kind != ActiveLimit::kNone && cap.value < request);
+  if (!hard && steady_cycles_ >= window) {
     shaping_ = in.sway_omega_rad_s > 0.0;
     sway_omega_rad_s_ = in.sway_omega_rad_s;
     sway_zeta_ = in.sway_zeta;

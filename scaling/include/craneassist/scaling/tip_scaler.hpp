@@ -151,6 +151,7 @@ class TipScaler {
   bool shaping_ = false;
   long steady_cycles_ = kSteadyForever;
   long since_hand_over_ = kSteadyForever;
+  bool held_back_ = false;                           // last cycle: a limit held the motion back
   double sway_omega_rad_s_ = 0.0, sway_zeta_ = 0.0;  // latched while shaping
 };
 
