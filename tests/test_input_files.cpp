@@ -53,8 +53,8 @@ std::vector<Format> formats() {
   return {
       {"replay",
        {"t", "v_x", "v_y", "v_z"},
-       "'t,v_x,v_y,v_z' or 't,v_x,v_y,v_z,stop' or 't,v_x,v_y,v_z,load_kg' or "
-       "'t,v_x,v_y,v_z,stop,load_kg'",
+       "'t,v_x,v_y,v_z', then any of the columns 'stop', 'wait' and 'load_kg' in this order (at "
+       "most 't,v_x,v_y,v_z,stop,wait,load_kg')",
        "t,v_x,v_y,v_z",
        ReplayLimits{}.max_rows,
        [](std::string_view text) { Replay::parse(text, kSource); },

@@ -467,8 +467,8 @@ TEST(ReplayStopColumn, StrictErrorsNameTheStopField) {
   expect_rejected(h + "0,0,0,0,0,1\n", 2, "", "expected 5 fields");
   expect_rejected(h + "0,0,0.1,0,1\n", 2, "v_y", "must be 0 in a stop row (stop = 1), got '0.1'");
   expect_rejected("t,v_x,v_y,v_z,Stop\n", 1, "",
-                  "expected the header 't,v_x,v_y,v_z' or 't,v_x,v_y,v_z,stop' or "
-                  "'t,v_x,v_y,v_z,load_kg' or 't,v_x,v_y,v_z,stop,load_kg', got "
+                  "expected the header 't,v_x,v_y,v_z', then any of the columns 'stop', 'wait' "
+                  "and 'load_kg' in this order (at most 't,v_x,v_y,v_z,stop,wait,load_kg'), got "
                   "'t,v_x,v_y,v_z,Stop'");
   expect_rejected("t,v_x,v_y,v_z\n0,0,0,0,1\n", 2, "", "expected 4 fields (t,v_x,v_y,v_z), got 5");
   const FileError e = parse_error(h + "0,0,0,0,0\n1,0,0,0,x\n");
@@ -543,10 +543,10 @@ TEST(ReplayLoadColumn, HeaderForms) {
   expect_load(spaced.rows()[0].load_kg, 7.0);
 }
 
-TEST(ReplayLoadColumn, OtherHeadersListTheFourForms) {
+TEST(ReplayLoadColumn, OtherHeadersNameTheOptionalColumnsAndTheirOrder) {
   const std::string expected =
-      "expected the header 't,v_x,v_y,v_z' or 't,v_x,v_y,v_z,stop' or 't,v_x,v_y,v_z,load_kg' or "
-      "'t,v_x,v_y,v_z,stop,load_kg', got ";
+      "expected the header 't,v_x,v_y,v_z', then any of the columns 'stop', 'wait' and 'load_kg' "
+      "in this order (at most 't,v_x,v_y,v_z,stop,wait,load_kg'), got ";
   expect_rejected("# c\nt,v_x,v_y,v_z,load_kg,stop\n0,0,0,0,0,0\n", 2, "",
                   expected + "'t,v_x,v_y,v_z,load_kg,stop'");
   expect_rejected("t,v_x,v_y,v_z,Load_kg\n0,0,0,0,0\n", 1, "",
@@ -862,6 +862,49 @@ TEST(ReplayLoadColumn, DocumentationExamplesParse) {
     }
   }
   EXPECT_GE(with_load, 2);
+}
+
+// The wait column (docs/replay-format.md#waits): a flag after stop and before load_kg, in every
+// combination with them, strict like stop, written only when a row waits.
+TEST(ReplayWaitColumn, ReadInEveryCombinationStrictAndRoundTrips) {
+  const Replay w = Replay::parse("t,v_x,v_y,v_z,wait\n0,0.1,0,0,0\n1,0,0,0,1\n", "w.csv");
+  ASSERT_EQ(w.rows().size(), 2u);
+  EXPECT_FALSE(w.rows()[0].wait);
+  EXPECT_TRUE(w.rows()[1].wait);
+  EXPECT_TRUE(w.has_waits());
+  const Replay all = Replay::parse(
+      "t,v_x,v_y,v_z,stop,wait,load_kg\n0,0.1,0,0,0,0,\n1,0,0,0,1,0,300\n2,0,0,0,0,1,\n", "a.csv");
+  ASSERT_EQ(all.rows().size(), 3u);
+  EXPECT_TRUE(all.rows()[1].stop);
+  EXPECT_FALSE(all.rows()[1].wait);
+  EXPECT_EQ(all.rows()[1].load_kg, 300.0);
+  EXPECT_TRUE(all.rows()[2].wait);
+  EXPECT_TRUE(std::isnan(all.rows()[2].load_kg));
+  const Replay wl = Replay::parse("t,v_x,v_y,v_z,wait,load_kg\n0,0,0,0,1,450\n", "wl.csv");
+  EXPECT_TRUE(wl.rows()[0].wait);
+  EXPECT_EQ(wl.rows()[0].load_kg, 450.0);
+  EXPECT_FALSE(Replay::parse("t,v_x,v_y,v_z\n0,0,0,0\n", "n.csv").has_waits());
+
+  const std::string h = "t,v_x,v_y,v_z,wait\n";
+  expect_rejected(h + "0,0,0,0,2\n", 2, "wait", "expected 0 or 1, got '2'");
+  expect_rejected(h + "0,0,0,0,\n", 2, "wait", "missing value");
+  expect_rejected(h + "0,0,0,0\n", 2, "", "expected 5 fields (t,v_x,v_y,v_z,wait), got 4");
+  expect_rejected("t,v_x,v_y,v_z,wait,stop\n", 1, "", "then any of the columns 'stop', 'wait'");
+
+  std::vector<ReplayRow> rows = {{0.0, Eigen::Vector3d(0.1, 0, 0)},
+                                 {0.5, Eigen::Vector3d::Zero(), false, NAN, true},
+                                 {1.25, Eigen::Vector3d::Zero(), true, 200.0, true}};
+  std::ostringstream out;
+  write_replay(out, rows);
+  EXPECT_EQ(
+      out.str(),
+      "t,v_x,v_y,v_z,stop,wait,load_kg\n0,0.1,0,0,0,0,\n0.5,0,0,0,0,1,\n1.25,0,0,0,1,1,200\n");
+  const Replay back = Replay::parse(out.str(), "rt.csv");
+  ASSERT_EQ(back.rows().size(), 3u);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(back.rows()[i].wait, rows[i].wait) << i;
+    EXPECT_EQ(back.rows()[i].stop, rows[i].stop) << i;
+  }
 }
 
 }  // namespace

@@ -101,3 +101,68 @@ TEST(ScenarioSuite, ARunMissingATargetSaysWhichAndByHowMuch) {
   EXPECT_NE(out.missed[1].find("direction error"), std::string::npos) << out.missed[1];
   EXPECT_FALSE(out.ok());
 }
+
+// The loading-cycle benchmark (examples/replays/loading.yaml): each cycle as craneassist runs it
+// and on the flow-only baseline, the waits' targets, and the new fields' mistakes.
+TEST(ScenarioSuite, TheLoadingBenchmarkPairsEachCycleWithItsBaseline) {
+  const auto suite = offline::load_suite(kReplays / "loading.yaml");
+  offline::check_suite(suite, config::default_crane_config());
+  ASSERT_EQ(suite.runs.size(), 6u);
+  for (std::size_t i = 0; i < suite.runs.size(); i += 2) {
+    const auto& ours = suite.runs[i];
+    const auto& base = suite.runs[i + 1];
+    EXPECT_EQ(ours.scaling, control::ScalingMode::kFull);
+    EXPECT_FALSE(ours.sway_damping.has_value());
+    EXPECT_EQ(base.scaling, control::ScalingMode::kFlowOnly);
+    ASSERT_TRUE(base.sway_damping.has_value());
+    EXPECT_FALSE(*base.sway_damping);
+    EXPECT_TRUE(ours.same_motion(base));
+    EXPECT_EQ(base.name(), ours.name() + " (scaling flow, no sway damping)");
+    ASSERT_TRUE(ours.targets.timed_out_waits);
+    EXPECT_EQ(*ours.targets.timed_out_waits, 0);
+  }
+  EXPECT_FALSE(suite.runs[0].same_motion(suite.runs[2]));
+}
+
+TEST(ScenarioSuite, TheBaselineFieldsAndWaitTargetsAreCheckedAndNamed) {
+  const std::string head = "format: craneassist-suite/1\nruns:\n  - replay: demo.csv\n";
+  auto e = error_of(head + "    scaling: fast\n");
+  EXPECT_EQ(e.field(), "runs[0].scaling");
+  EXPECT_EQ(e.line(), 4);
+  EXPECT_NE(e.reason().find("expected full, flow or none, got 'fast'"), std::string::npos);
+  e = error_of(head + "    sway_damping: off\n");
+  EXPECT_EQ(e.field(), "runs[0].sway_damping");
+  EXPECT_NE(e.reason().find("expected true or false, got 'off'"), std::string::npos);
+  e = error_of(head + "    wait_swing: 2 m\n");
+  EXPECT_EQ(e.field(), "runs[0].wait_swing");
+  e = error_of(head + "    wait_swing: 0 deg\n");
+  EXPECT_EQ(e.field(), "runs[0].wait_swing");
+  e = error_of(head + "    targets: {residual_swing: 2 kg}\n");
+  EXPECT_EQ(e.field(), "runs[0].targets.residual_swing");
+  e = error_of(head + "    targets: {cycle_time: 2 m}\n");
+  EXPECT_EQ(e.field(), "runs[0].targets.cycle_time");
+  e = error_of(head + "    targets: {timed_out_waits: 0.5}\n");
+  EXPECT_EQ(e.field(), "runs[0].targets.timed_out_waits");
+  e = error_of(head + "    targets: {overload_cycles: -3}\n");
+  EXPECT_EQ(e.field(), "runs[0].targets.overload_cycles");
+  const auto suite = offline::parse_suite(
+      head + "    scaling: none\n    sway_damping: true\n    wait_swing: 3 deg\n", "ok.yaml",
+      kReplays);
+  EXPECT_EQ(suite.runs[0].scaling, control::ScalingMode::kNone);
+  EXPECT_TRUE(*suite.runs[0].sway_damping);
+  EXPECT_DOUBLE_EQ(suite.runs[0].wait_swing_rad, 3.0 * M_PI / 180.0);
+  EXPECT_EQ(suite.runs[0].name(), "demo.csv @default (scaling none)");
+}
+
+TEST(ScenarioSuite, AWaitingRunMissesItsCycleTimeAndTimeoutTargets) {
+  auto suite = offline::parse_suite(
+      "format: craneassist-suite/1\nruns:\n  - replay: loading/near.csv\n    sway_damping: false\n"
+      "    targets: {cycle_time: 40 s, timed_out_waits: 0, residual_swing: 1 deg}\n",
+      "tight.yaml", kReplays);
+  const auto out = offline::run_suite_run(config::default_crane_config(), suite.runs[0], "", {});
+  EXPECT_GT(out.summary.waits.waits, 0);
+  ASSERT_EQ(out.missed.size(), 3u);
+  EXPECT_NE(out.missed[0].find("residual swing"), std::string::npos) << out.missed[0];
+  EXPECT_NE(out.missed[1].find("cycle time"), std::string::npos) << out.missed[1];
+  EXPECT_NE(out.missed[2].find("timed-out waits"), std::string::npos) << out.missed[2];
+}

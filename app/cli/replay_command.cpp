@@ -134,6 +134,22 @@ void print_swing_line(const control::SwingSummary& s, const config::CraneConfig&
               damped ? "on" : "off: --no-sway-damping or scaling.sway_damping");
 }
 
+void print_wait_lines(const control::RunSummary& s, const control::WaitSettings& settings,
+                      double replay_end_s) {
+  const control::WaitSummary& w = s.waits;
+  if (w.waits == 0) return;
+  std::printf(
+      "  waits: %ld for the grapple to settle (swing within %.1f deg for %.2f s), %.2f s in all, "
+      "longest %.2f s, %ld timed out (%.0f s)",
+      w.waits, settings.swing_rad * 180.0 / M_PI, settings.window_s, w.total_s, w.longest_s,
+      w.timed_out, settings.timeout_s);
+  if (std::isfinite(w.residual_swing_deg)) {
+    std::printf("; residual swing %.1f deg (from 1 s into a wait)", w.residual_swing_deg);
+  }
+  std::printf("\n  cycle time: %.2f s (the replay's %.2f s and %.2f s waiting)\n", s.cycle_time_s,
+              replay_end_s, w.total_s);
+}
+
 void print_load_line(const control::LoadSummary& l, bool known, bool chart) {
   if (!known && !l.weighed) {
     std::printf(
@@ -171,8 +187,9 @@ void print_load_line(const control::LoadSummary& l, bool known, bool chart) {
 namespace {
 
 void print_summary(const control::RunSummary& s, const config::CraneConfig& cfg,
-                   const std::string& replay_name, const control::ControllerOptions& controller,
-                   const control::CsvLog* log, const char* backend) {
+                   const std::string& replay_name, const control::RunOptions& options,
+                   double replay_end_s, const control::CsvLog* log, const char* backend) {
+  const control::ControllerOptions& controller = options.controller;
   const control::ScalingMode mode = controller.mode;
   const double speedup = s.wall_time_s > 0.0 ? s.duration_s / s.wall_time_s : 0.0;
   std::printf("craneassist replay: %s on %s\n", replay_name.c_str(), cfg.model.name.c_str());
@@ -214,6 +231,7 @@ void print_summary(const control::RunSummary& s, const config::CraneConfig& cfg,
   print_feel_line(s.feel);
   print_load_line(s.load, controller.payload_known, !cfg.load_chart.empty());
   print_swing_line(s.swing, cfg);
+  print_wait_lines(s, options.waits, replay_end_s);
   std::printf("  active limit (cycles):");
   for (std::size_t i = 0; i < s.limit_cycles.size(); ++i) {
     if (s.limit_cycles[i] > 0) {
@@ -367,12 +385,13 @@ int run_replay_command(const ReplayArgs& args) {
     options.settle_s = args.settle_s;
     options.freeze_at_s = args.freeze_at_s;
     options.freeze_for_s = args.freeze_for_s;
-    spdlog::info("running {} ({:.1f} s) on {} with the {} backend{}", replay_name,
-                 replay.end_time_s() + args.settle_s, cfg.model.name, machine.name(),
-                 options.realtime ? ", paced at real time" : "");
+    options.waits = control::wait_settings(cfg, args.wait_swing_deg * M_PI / 180.0);
+    spdlog::info("running {} ({:.1f} s{}) on {} with the {} backend{}", replay_name,
+                 replay.end_time_s() + args.settle_s, replay.has_waits() ? " and its waits" : "",
+                 cfg.model.name, machine.name(), options.realtime ? ", paced at real time" : "");
     const control::RunSummary summary =
         control::run_replay(cfg, replay, machine, options, log ? &*log : nullptr);
-    print_summary(summary, cfg, replay_name, options.controller, log ? &*log : nullptr,
+    print_summary(summary, cfg, replay_name, options, replay.end_time_s(), log ? &*log : nullptr,
                   machine.name());
     telemetry.finish();
     if (summary.log_rows_dropped > 0) {
@@ -428,6 +447,12 @@ CLI::App* add_replay_command(CLI::App& cli, ReplayArgs& args) {
       ->capture_default_str();
   add_payload_option(*replay, args.payload_kg);
   add_sway_option(*replay, args.no_sway_damping);
+  replay
+      ->add_option("--wait-swing", args.wait_swing_deg,
+                   "A wait row holds the replay until the grapple's swing stays within this many "
+                   "degrees for a swing period (docs/replay-format.md#waits)")
+      ->check(FiniteRange(0.01, 90.0))
+      ->capture_default_str();
   replay->add_flag("--payload-known", args.payload_known,
                    "Tell the controller the payload (--payload, the config's, and the replay's "
                    "load_kg) instead of letting the crane scale estimate it (docs/loads.md)");

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "craneassist/control/controller.hpp"
+#include "craneassist/control/replay_runner.hpp"
 #include "craneassist/control/run_statistics.hpp"
 #include "machine_setup.hpp"
 #include "telemetry_setup.hpp"
@@ -31,11 +32,12 @@ struct ReplayArgs {
   bool realtime = false;
   double settle_s = 1.0;
   std::optional<double> payload_kg;
-  bool payload_known = false;
-  bool no_sway_damping = false;   // --no-sway-damping     // tell the controller the payload (else
-                                  // the crane scale finds it)
-  std::string initial;            // start pose, "NAME=VALUE UNIT, ..."; empty: the config's
-  std::string pump_max_flow;      // quantity text, e.g. "120 L/min"
+  bool payload_known = false;    // tell the controller the payload (else the crane scale finds it)
+  bool no_sway_damping = false;  // --no-sway-damping
+  double wait_swing_deg =
+      2.0;                    // a wait row waits for the swing within this (docs/replay-format.md)
+  std::string initial;        // start pose, "NAME=VALUE UNIT, ..."; empty: the config's
+  std::string pump_max_flow;  // quantity text, e.g. "120 L/min"
   std::string prime_mover_power;  // quantity text, e.g. "60 kW"
   std::string pump_mode;          // empty: the config's; ls or cp
   std::string supply_pressure;    // quantity text, e.g. "20 MPa", or a bare number in MPa
@@ -47,6 +49,9 @@ CLI::App* add_replay_command(CLI::App& cli, ReplayArgs& args);
 void print_load_line(const control::LoadSummary& load, bool known, bool chart);
 // The swing line (nothing when no cycle measured the swing).
 void print_swing_line(const control::SwingSummary& swing, const config::CraneConfig& cfg);
+// The waits and cycle time lines of a replay with wait rows (nothing without).
+void print_wait_lines(const control::RunSummary& summary, const control::WaitSettings& settings,
+                      double replay_end_s);
 // The summary's stop lines (docs/safety.md): how the last stop ended (the measured tip speed when
 // the valves went neutral, at rest or after the rest timeout) and, over every stop, spool steps,
 // reverse kicks and load pressures. end_stop: the run ended by that stop ("end of run", else

@@ -309,7 +309,15 @@ int run_sim_command(const SimArgs& args) {
            : kind == "web"             ? config::web_joystick_config()
            : pad && drive              ? config::drive_joystick_config()
                                        : config::default_joystick_config();
-    if (kind == "replay") replay = input::Replay::load_file(args.input[1]);
+    if (kind == "replay") {
+      replay = input::Replay::load_file(args.input[1]);
+      if (replay->has_waits()) {
+        spdlog::warn(
+            "{}: its wait rows are played at their times here (live input does not wait); "
+            "craneassist replay waits for the grapple to settle (docs/replay-format.md#waits)",
+            args.input[1]);
+      }
+    }
     tcfg = load_telemetry_settings(args.telemetry);
     if (kind == "dds") check_remote_input_settings(tcfg);
     apply_backend_options(cfg, args.machine);

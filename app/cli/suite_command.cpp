@@ -20,8 +20,52 @@ constexpr int kExitTargetsMissed = 1;
 
 std::string log_name(const offline::SuiteRun& run, const std::string& resolution) {
   std::string name = std::filesystem::path(run.replay_text).stem().string() + "_" + run.pose;
+  if (run.scaling != control::ScalingMode::kFull) {
+    name += std::string("_scaling-") + control::to_string(run.scaling);
+  }
+  if (run.sway_damping.has_value() && !*run.sway_damping) name += "_undamped";
   if (!resolution.empty()) name += "_" + resolution;
   return name + ".csv";
+}
+
+// Runs that are another run's baseline (the same replay, pose and load with flow prescaling
+// only and no sway damping): what craneassist changes against it, per pair.
+template <class Done>
+void print_baseline_comparison(const std::vector<Done>& done) {
+  const auto is_baseline = [](const offline::SuiteRun& r) {
+    return r.scaling == control::ScalingMode::kFlowOnly && r.sway_damping.has_value() &&
+           !*r.sway_damping;
+  };
+  const auto change = [](double ours, double base) {
+    return base > 0.0 ? 100.0 * (ours / base - 1.0) : 0.0;
+  };
+  bool header = false;
+  for (const auto& b : done) {
+    if (!is_baseline(*b.run)) continue;
+    for (const auto& d : done) {
+      if (&d == &b || is_baseline(*d.run) || !d.run->same_motion(*b.run)) continue;
+      if (!header) {
+        std::printf("    against the flow-only baseline (scaling flow, no sway damping):\n");
+        header = true;
+      }
+      const auto& o = d.summary;
+      const auto& base = b.summary;
+      std::printf("      %s: energy %+.0f %%, peak power %+.0f %%, peak swing %+.0f %%",
+                  d.run->name().c_str(), change(o.energy_j, base.energy_j),
+                  change(o.peak_power_w, base.peak_power_w),
+                  change(o.swing.peak_deg, base.swing.peak_deg));
+      if (o.waits.waits > 0 && base.waits.waits > 0) {
+        std::printf(
+            ", residual swing %+.0f %%, cycle time %+.1f %% (%.1f s against %.1f s; waits %.1f s "
+            "against %.1f s, %ld and %ld timed out)",
+            change(o.waits.residual_swing_deg, base.waits.residual_swing_deg),
+            change(o.cycle_time_s, base.cycle_time_s), o.cycle_time_s, base.cycle_time_s,
+            o.waits.total_s, base.waits.total_s, o.waits.timed_out, base.waits.timed_out);
+      }
+      std::printf(", overload cycles %ld against %ld\n", o.load.overload_cycles,
+                  base.load.overload_cycles);
+    }
+  }
 }
 
 // One resolution over the suite: a table row per run. Returns the number of runs that missed a
@@ -34,9 +78,14 @@ int run_one_resolution(const offline::Suite& suite, const config::CraneConfig& c
   std::printf("  resolution %s\n", config::resolution_description(shown).c_str());
   int width = 3;  // the run names' column, as wide as the longest
   for (const auto& run : suite.runs) width = std::max(width, static_cast<int>(run.name().size()));
-  std::printf("    %-*s %6s %10s %10s %9s %9s  %s\n", width, "run", "stalls", "lateral",
-              "peak power", "dir. err", "energy", "result");
+  std::printf("    %-*s %6s %10s %10s %9s %9s %11s %8s  %s\n", width, "run", "stalls", "lateral",
+              "peak power", "dir. err", "energy", "swing", "cycle", "result");
   int missed = 0;
+  struct Done {
+    const offline::SuiteRun* run;
+    control::RunSummary summary;
+  };
+  std::vector<Done> done;
   for (const auto& run : suite.runs) {
     if (!args.only.empty() && run.name().find(args.only) == std::string::npos) continue;
     const std::filesystem::path log =
@@ -47,14 +96,27 @@ int run_one_resolution(const offline::Suite& suite, const config::CraneConfig& c
     char lateral[32] = "-";
     if (s.feel.one_line)
       std::snprintf(lateral, sizeof lateral, "%.3f m/s", s.feel.lateral_peak_m_s);
-    std::printf("    %-*s %6d %10s %6.2f Pmax %5.2f deg %6.1f kJ  %s\n", width, run.name().c_str(),
-                s.feel.stall_events, lateral, s.peak_power_w / out.p_max_w,
-                s.max_direction_error_deg, s.energy_j / 1e3, out.ok() ? "ok" : "MISSED");
+    // The swing: its peak, and with waits the residual swing (from 1 s into a wait).
+    char swing[32] = "-";
+    if (s.swing.measured && std::isfinite(s.waits.residual_swing_deg)) {
+      std::snprintf(swing, sizeof swing, "%.1f/%.1f deg", s.swing.peak_deg,
+                    s.waits.residual_swing_deg);
+    } else if (s.swing.measured) {
+      std::snprintf(swing, sizeof swing, "%.1f deg", s.swing.peak_deg);
+    }
+    char cycle[32] = "-";
+    if (s.waits.waits > 0) std::snprintf(cycle, sizeof cycle, "%.1f s", s.cycle_time_s);
+    std::printf("    %-*s %6d %10s %6.2f Pmax %5.2f deg %6.1f kJ %11s %8s  %s\n", width,
+                run.name().c_str(), s.feel.stall_events, lateral, s.peak_power_w / out.p_max_w,
+                s.max_direction_error_deg, s.energy_j / 1e3, swing, cycle,
+                out.ok() ? "ok" : "MISSED");
     for (const auto& m : out.missed) std::printf("      missed: %s\n", m.c_str());
     missed += !out.ok();
     energy_j += s.energy_j;
     ++runs;
+    done.push_back({&run, s});
   }
+  print_baseline_comparison(done);
   return missed;
 }
 

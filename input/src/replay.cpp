@@ -22,19 +22,23 @@ using detail::kMaxNumberChars;
 using detail::number;
 
 constexpr std::string_view kLoadColumn = "load_kg";
+constexpr std::string_view kStopColumn = "stop";
+constexpr std::string_view kWaitColumn = "wait";
 
 // t, the velocity components within the speed limit, then the optional columns: `stop` (1: the
-// operator input was not valid from this row on), then `load_kg` (the simulated crane's load from
-// this row on; its range is checked by parse, an empty cell is filled in for the reader first).
+// operator input was not valid from this row on), `wait` (1: the run waits at this row for the
+// grapple to settle), then `load_kg` (the simulated crane's load from this row on; its range is
+// checked by parse, an empty cell is filled in for the reader first).
 // optional_stop: a header may leave out `stop` (the format for a file without a header).
 detail::CsvFormat replay_format(const ReplayLimits& limits, bool stop, bool load,
-                                bool optional_stop = false) {
+                                bool optional_stop = false, bool wait = false) {
   detail::CsvFormat format;
   format.columns = {{"t", detail::CsvKind::kTime},
                     {"v_x", detail::CsvKind::kNumber, limits.max_speed_m_s, "m/s"},
                     {"v_y", detail::CsvKind::kNumber, limits.max_speed_m_s, "m/s"},
                     {"v_z", detail::CsvKind::kNumber, limits.max_speed_m_s, "m/s"}};
-  if (stop) format.columns.emplace_back("stop", detail::CsvKind::kFlag);
+  if (stop) format.columns.emplace_back(std::string(kStopColumn), detail::CsvKind::kFlag);
+  if (wait) format.columns.emplace_back(std::string(kWaitColumn), detail::CsvKind::kFlag);
   if (load) format.columns.emplace_back(std::string(kLoadColumn), detail::CsvKind::kNumber);
   format.optional_columns = stop && optional_stop ? 1 : 0;
   format.max_rows = limits.max_rows;
@@ -47,8 +51,17 @@ std::size_t line_of(std::string_view text, std::string_view part) {
   return 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + offset, '\n'));
 }
 
+// The column of this name in the format (npos when it has none).
+std::size_t column_index(const detail::CsvFormat& format, std::string_view name) {
+  for (std::size_t i = 0; i < format.columns.size(); ++i) {
+    if (format.columns[i].name == name) return i;
+  }
+  return std::string_view::npos;
+}
+
 // The format of a file's header (the first line that is neither blank nor a comment): one of
-// t,v_x,v_y,v_z[,stop][,load_kg], names trimmed and compared exactly as the CSV reader does.
+// t,v_x,v_y,v_z[,stop][,wait][,load_kg], names trimmed and compared exactly as the CSV reader
+// does.
 // Throws FileError at the header's line for any other header. Without a header: the format whose
 // missing-header error the reader gives.
 detail::CsvFormat format_of_header(std::string_view text, std::string_view source_name,
@@ -62,23 +75,24 @@ detail::CsvFormat format_of_header(std::string_view text, std::string_view sourc
     if (comma == std::string_view::npos) break;
     rest.remove_prefix(comma + 1);
   }
-  std::string expected;
   for (const bool load : {false, true}) {
-    for (const bool stop : {false, true}) {
-      const detail::CsvFormat format = replay_format(limits, stop, load);
-      const std::vector<detail::CsvColumn>& columns = format.columns;
-      if (std::equal(names.begin(), names.end(), columns.begin(), columns.end(),
-                     [](std::string_view name, const detail::CsvColumn& column) {
-                       return name == column.name;
-                     })) {
-        return format;
+    for (const bool wait : {false, true}) {
+      for (const bool stop : {false, true}) {
+        const detail::CsvFormat format = replay_format(limits, stop, load, false, wait);
+        const std::vector<detail::CsvColumn>& columns = format.columns;
+        if (std::equal(names.begin(), names.end(), columns.begin(), columns.end(),
+                       [](std::string_view name, const detail::CsvColumn& column) {
+                         return name == column.name;
+                       })) {
+          return format;
+        }
       }
-      if (!expected.empty()) expected += " or ";
-      expected.append("'").append(detail::csv_header(format)).append("'");
     }
   }
   throw FileError(std::string(source_name), line_of(text, header), "",
-                  "expected the header " + expected + ", got " + detail::quoted(header));
+                  "expected the header 't,v_x,v_y,v_z', then any of the columns 'stop', 'wait' "
+                  "and 'load_kg' in this order (at most 't,v_x,v_y,v_z,stop,wait,load_kg'), got " +
+                      detail::quoted(header));
 }
 
 // The CSV reader wants a number in every field, but an empty load_kg cell is allowed (the load
@@ -167,15 +181,17 @@ Replay Replay::parse(std::string_view text, std::string_view source_name,
   }
   const detail::CsvFormat format = format_of_header(text, source_name, limits);
   const std::size_t columns = format.columns.size();
-  const bool stop_column = columns > 4 && format.columns[4].kind == detail::CsvKind::kFlag;
-  const bool load_column = columns > 4 && format.columns.back().name == kLoadColumn;
+  const std::size_t stop_column = column_index(format, kStopColumn);
+  const std::size_t wait_column = column_index(format, kWaitColumn);
+  const bool load_column = column_index(format, kLoadColumn) != std::string_view::npos;
   std::vector<bool> empty_load;  // per data row: its load_kg cell is empty
   const std::string filled = load_column ? fill_empty_load_cells(text, columns, empty_load) : "";
   std::vector<ReplayRow> rows;
   detail::read_csv(
       filled.empty() ? text : filled, source_name, format, [&](const detail::CsvRow& row) {
         ReplayRow r{row.values[0], {row.values[1], row.values[2], row.values[3]}};
-        r.stop = stop_column && row.values[4] == 1.0;
+        r.stop = stop_column < columns && row.values[stop_column] == 1.0;
+        r.wait = wait_column < columns && row.values[wait_column] == 1.0;
         for (std::size_t i = 1; r.stop && i <= 3; ++i) {
           if (row.values[i] != 0.0) {
             throw row.error(format.columns[i].name, "must be 0 in a stop row (stop = 1), got " +
@@ -201,6 +217,10 @@ Replay::Replay(std::vector<ReplayRow> rows, std::string source_name)
       loads_kg_(effective_loads(rows_)),
       source_name_(std::move(source_name)) {}
 
+bool Replay::has_waits() const noexcept {
+  return std::any_of(rows_.begin(), rows_.end(), [](const ReplayRow& row) { return row.wait; });
+}
+
 Replay Replay::load_file(const std::filesystem::path& path, const ReplayLimits& limits) {
   return parse(detail::read_file_text(path, "replay"), path.string(), limits);
 }
@@ -223,9 +243,12 @@ double ReplayCursor::load_at(double t_s) noexcept {
 void write_replay(std::ostream& out, const std::vector<ReplayRow>& rows) {
   const bool stop_column =
       std::any_of(rows.begin(), rows.end(), [](const ReplayRow& row) { return row.stop; });
+  const bool wait_column =
+      std::any_of(rows.begin(), rows.end(), [](const ReplayRow& row) { return row.wait; });
   const bool load_column = std::any_of(
       rows.begin(), rows.end(), [](const ReplayRow& row) { return !std::isnan(row.load_kg); });
-  out << detail::csv_header(replay_format({}, stop_column, load_column)) << '\n';
+  out << detail::csv_header(replay_format({}, stop_column, load_column, false, wait_column))
+      << '\n';
   std::array<char, kMaxNumberChars> buffer{};
   std::string line;
   for (const ReplayRow& row : rows) {
@@ -236,6 +259,7 @@ void write_replay(std::ostream& out, const std::vector<ReplayRow>& rows) {
       line += format_number(row.v_m_s[i], buffer);
     }
     if (stop_column) line += row.stop ? ",1" : ",0";
+    if (wait_column) line += row.wait ? ",1" : ",0";
     if (load_column) {
       line += ',';
       if (!std::isnan(row.load_kg)) line += format_number(row.load_kg, buffer);

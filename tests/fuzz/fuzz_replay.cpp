@@ -22,7 +22,7 @@ namespace {
 bool same_rows(const ReplayRow& a, const ReplayRow& b) {
   return same_bits(a.t_s, b.t_s) && same_bits(a.v_m_s.x(), b.v_m_s.x()) &&
          same_bits(a.v_m_s.y(), b.v_m_s.y()) && same_bits(a.v_m_s.z(), b.v_m_s.z()) &&
-         a.stop == b.stop && same_bits(a.load_kg, b.load_kg);
+         a.stop == b.stop && a.wait == b.wait && same_bits(a.load_kg, b.load_kg);
 }
 
 }  // namespace

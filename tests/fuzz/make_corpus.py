@@ -32,12 +32,15 @@ def files(pattern):
 
 
 # --- input files --------------------------------------------------------------------------------
-for path in files("examples/replays/*.csv") + files("examples/replays/suite/*.csv") + [
+for path in (files("examples/replays/*.csv") + files("examples/replays/suite/*.csv") +
+             files("examples/replays/loading/*.csv")) + [
         os.path.join(ROOT, "tests/data", n)
         for n in ("bad_replay.csv", "can_short.csv", "remote_short.csv")]:
     write("fuzz_replay", os.path.basename(path), open(path, "rb").read())
 write("fuzz_replay", "edge_crlf_bom_stop.csv",
       "\ufeff# comment\r\nt,v_x,v_y,v_z,stop\r\n0,0.1,0,0,0\r\n0.5,0,0,0,1\r\n1e9,0,-0.2,5,0\r\n")
+write("fuzz_replay", "edge_stop_wait_load.csv",
+      "t,v_x,v_y,v_z,stop,wait,load_kg\n0,0.1,0,0,0,0,\n0.5,0,0,0,1,1,300\n1,0,0,0,0,1,\n")
 write("fuzz_replay", "edge_numbers.csv",
       "t , v_x , v_y , v_z\n\n0,-0,+1e-308,4.9999999999999999\n1e-300,0x1p-3,5,-5\n")
 
@@ -76,6 +79,12 @@ for name, text in (("folded.txt", "lift=0 deg, tilt=-125 deg, extension=0.2 m"),
                    ("twice.txt", "lift=1 deg, lift=2 deg")):
     write("fuzz_joint_pose", name, text)
 write("fuzz_suite_manifest", "suite.yaml", read("examples/replays/suite.yaml"))
+write("fuzz_suite_manifest", "loading.yaml", read("examples/replays/loading.yaml"))
+write("fuzz_suite_manifest", "baseline_fields.yaml",
+      "format: craneassist-suite/1\nruns:\n  - replay: demo.csv\n    scaling: flow\n"
+      "    sway_damping: false\n    wait_swing: 3 deg\n"
+      "    targets: {residual_swing: 2 deg, cycle_time: 40 s, timed_out_waits: 0,"
+      " overload_cycles: 0}\n")
 write("fuzz_suite_manifest", "long_name.yaml",  # a name longer than NAME_MAX: once a crash
       "format: craneassist-suite/1\nruns:\n  - replay: " + "a" * 300 + ".csv\n")
 write("fuzz_suite_manifest", "payload_targets.yaml",

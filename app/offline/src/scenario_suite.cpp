@@ -33,15 +33,38 @@ class SuiteReader : public config::YamlReader {
     return v;
   }
 
+  std::optional<int> count(const YAML::Node& node, const std::string& key,
+                           const std::string& path) const {
+    if (!node[key].IsDefined()) return std::nullopt;
+    const YAML::Node n = node[key];
+    int v = -1;
+    if (!n.IsScalar() || !YAML::convert<int>::decode(n, v) || v < 0) {
+      fail(n, join(path, key), "expected a count (0, 1, ...)");
+    }
+    return v;
+  }
+
+  bool flag(const YAML::Node& node, const std::string& key, const std::string& path) const {
+    const std::string text = this->text(node, key, path);
+    if (text != "true" && text != "false") {
+      fail(node[key], join(path, key), "expected true or false, got '" + text + "'");
+    }
+    return text == "true";
+  }
+
   void targets(const YAML::Node& node, const std::string& path, SuiteTargets& t) const {
-    check_keys(node, path, {"stall_events", "lateral_speed", "peak_power", "direction_error"});
-    if (node["stall_events"].IsDefined()) {
-      const YAML::Node n = node["stall_events"];
-      int v = -1;
-      if (!n.IsScalar() || !YAML::convert<int>::decode(n, v) || v < 0) {
-        fail(n, join(path, "stall_events"), "expected a count (0, 1, ...)");
-      }
-      t.stall_events = v;
+    check_keys(node, path,
+               {"stall_events", "lateral_speed", "peak_power", "direction_error", "residual_swing",
+                "cycle_time", "timed_out_waits", "overload_cycles"});
+    if (auto v = count(node, "stall_events", path)) t.stall_events = v;
+    if (auto v = count(node, "timed_out_waits", path)) t.timed_out_waits = v;
+    if (auto v = count(node, "overload_cycles", path)) t.overload_cycles = v;
+    if (node["residual_swing"].IsDefined()) {
+      t.residual_swing_rad =
+          quantity(node, "residual_swing", path, config::Dimension::kAngle, 0.0, M_PI);
+    }
+    if (node["cycle_time"].IsDefined()) {
+      t.cycle_time_s = quantity(node, "cycle_time", path, config::Dimension::kTime, 0.0, 1e6);
     }
     if (node["lateral_speed"].IsDefined()) {
       t.lateral_speed_m_s =
@@ -63,6 +86,10 @@ void merge(const SuiteTargets& over, SuiteTargets& t) {
   if (over.lateral_speed_m_s) t.lateral_speed_m_s = over.lateral_speed_m_s;
   if (over.peak_power_share) t.peak_power_share = over.peak_power_share;
   if (over.direction_error_rad) t.direction_error_rad = over.direction_error_rad;
+  if (over.residual_swing_rad) t.residual_swing_rad = over.residual_swing_rad;
+  if (over.cycle_time_s) t.cycle_time_s = over.cycle_time_s;
+  if (over.timed_out_waits) t.timed_out_waits = over.timed_out_waits;
+  if (over.overload_cycles) t.overload_cycles = over.overload_cycles;
 }
 
 std::string figure(const char* format, double value) {
@@ -72,6 +99,20 @@ std::string figure(const char* format, double value) {
 }
 
 }  // namespace
+
+std::string SuiteRun::name() const {
+  std::string n = replay_text + " @" + pose;
+  const bool undamped = sway_damping.has_value() && !*sway_damping;
+  if (scaling != control::ScalingMode::kFull || undamped) {
+    n += " (";
+    if (scaling != control::ScalingMode::kFull) {
+      n += std::string("scaling ") + control::to_string(scaling) + (undamped ? ", " : "");
+    }
+    if (undamped) n += "no sway damping";
+    n += ")";
+  }
+  return n;
+}
 
 Suite parse_suite(std::string_view yaml_text, std::string_view source_name,
                   const std::filesystem::path& base_dir) {
@@ -111,7 +152,9 @@ Suite parse_suite(std::string_view yaml_text, std::string_view source_name,
     for (std::size_t k = 0; k < runs.size(); ++k) {
       const YAML::Node node = runs[k];
       const std::string path = "runs[" + std::to_string(k) + "]";
-      r.check_keys(node, path, {"replay", "poses", "payload", "payload_known", "targets"});
+      r.check_keys(node, path,
+                   {"replay", "poses", "payload", "payload_known", "scaling", "sway_damping",
+                    "wait_swing", "targets"});
       SuiteRun run;
       run.line = node.Mark().line + 1;
       run.replay_text = r.text(node, "replay", path);
@@ -129,13 +172,21 @@ Suite parse_suite(std::string_view yaml_text, std::string_view source_name,
       if (node["payload"].IsDefined()) {
         run.payload_kg = r.quantity(node, "payload", path, config::Dimension::kMass, 0.0, 1e5);
       }
-      if (node["payload_known"].IsDefined()) {
-        const std::string known = r.text(node, "payload_known", path);
-        if (known != "true" && known != "false") {
-          r.fail(node["payload_known"], path + ".payload_known",
-                 "expected true or false, got '" + known + "'");
+      if (node["payload_known"].IsDefined())
+        run.payload_known = r.flag(node, "payload_known", path);
+      if (node["sway_damping"].IsDefined()) run.sway_damping = r.flag(node, "sway_damping", path);
+      if (node["scaling"].IsDefined()) {
+        const std::string mode = r.text(node, "scaling", path);
+        const auto parsed = control::parse_scaling_mode(mode);
+        if (!parsed) {
+          r.fail(node["scaling"], path + ".scaling",
+                 "expected full, flow or none, got '" + mode + "'");
         }
-        run.payload_known = known == "true";
+        run.scaling = *parsed;
+      }
+      if (node["wait_swing"].IsDefined()) {
+        run.wait_swing_rad =
+            r.quantity(node, "wait_swing", path, config::Dimension::kAngle, 1e-4, M_PI / 2.0);
       }
       run.targets = defaults;
       if (node["targets"].IsDefined()) {
@@ -199,12 +250,15 @@ SuiteOutcome run_suite_run(const config::CraneConfig& base, const SuiteRun& run,
         config::parse_joint_pose(cfg.model, run.pose_text, cfg.simulation.q_initial);
   }
   if (!resolution.empty()) config::set_resolution(cfg, resolution);
+  if (run.sway_damping) cfg.scaling.sway_damping = *run.sway_damping;
   const auto replay = input::Replay::load_file(run.replay);
   sim_backend::SimBackend machine(cfg.model, sim_settings(cfg));
   std::optional<control::CsvLog> log;
   if (!log_file.empty()) log.emplace(log_file, cfg.model.dof());
   control::RunOptions options;
   options.controller.payload_known = run.payload_known;
+  options.controller.mode = run.scaling;
+  options.waits = control::wait_settings(cfg, run.wait_swing_rad);
   SuiteOutcome out;
   out.summary = control::run_replay(cfg, replay, machine, options, log ? &*log : nullptr);
   out.p_max_w = cfg.model.pump.prime_mover_power_w;
@@ -226,6 +280,24 @@ SuiteOutcome run_suite_run(const config::CraneConfig& base, const SuiteRun& run,
   if (t.direction_error_rad && s.max_direction_error_deg * M_PI / 180.0 > *t.direction_error_rad) {
     out.missed.push_back(figure("direction error %.2f deg", s.max_direction_error_deg) +
                          figure(" > %.2f", *t.direction_error_rad * 180.0 / M_PI));
+  }
+  const double residual = s.waits.residual_swing_deg;
+  if (t.residual_swing_rad && std::isfinite(residual) &&
+      residual * M_PI / 180.0 > *t.residual_swing_rad) {
+    out.missed.push_back(figure("residual swing %.2f deg", residual) +
+                         figure(" > %.2f", *t.residual_swing_rad * 180.0 / M_PI));
+  }
+  if (t.cycle_time_s && s.waits.waits > 0 && s.cycle_time_s > *t.cycle_time_s) {
+    out.missed.push_back(figure("cycle time %.2f s", s.cycle_time_s) +
+                         figure(" > %.2f", *t.cycle_time_s));
+  }
+  if (t.timed_out_waits && s.waits.timed_out > *t.timed_out_waits) {
+    out.missed.push_back("timed-out waits " + std::to_string(s.waits.timed_out) + " > " +
+                         std::to_string(*t.timed_out_waits));
+  }
+  if (t.overload_cycles && s.load.overload_cycles > *t.overload_cycles) {
+    out.missed.push_back("overload cycles " + std::to_string(s.load.overload_cycles) + " > " +
+                         std::to_string(*t.overload_cycles));
   }
   return out;
 }

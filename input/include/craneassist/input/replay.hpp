@@ -21,12 +21,16 @@ namespace craneassist::input {
 // valid from t_s on (the file's optional `stop` column); v_m_s is then zero and the loop gives the
 // controller a non-finite command: a jerk-limited stop, then neutral valves. load_kg: the mass in
 // the simulated crane's grapple from t_s on (the file's optional `load_kg` column); NaN when this
-// row does not set it (an empty cell: the load stays what it was).
+// row does not set it (an empty cell: the load stays what it was). wait: a scripted operator's
+// pause (the file's optional `wait` column): the run holds this row's command until the hanging
+// grapple has settled, and every later row comes that much later (control::ReplayInput;
+// docs/replay-format.md).
 struct ReplayRow {
   double t_s;
   Eigen::Vector3d v_m_s;
   bool stop = false;
   double load_kg = std::numeric_limits<double>::quiet_NaN();
+  bool wait = false;
 };
 
 // Sanity limits enforced while reading.
@@ -43,7 +47,7 @@ class Replay {
   static constexpr double kMaxLoad_kg = 100000.0;
 
   // Reads and validates a file; the source name in errors is path.string(). Throws FileError
-  // (the field is the column: "t", "v_x", "v_y", "v_z", "stop", "load_kg"), and
+  // (the field is the column: "t", "v_x", "v_y", "v_z", "stop", "wait", "load_kg"), and
   // std::invalid_argument if limits.max_speed_m_s is negative or NaN.
   static Replay load_file(const std::filesystem::path& path, const ReplayLimits& limits = {});
   // Validates text in the replay format; source_name is used in error messages. Throws as
@@ -57,6 +61,8 @@ class Replay {
   std::string_view source_name() const noexcept { return source_name_; }
   // Some row sets a load (the file has a load_kg column with at least one number in it).
   bool has_load() const noexcept { return !loads_kg_.empty(); }
+  // Some row waits for the grapple to settle (the file's wait column).
+  bool has_waits() const noexcept;
 
  private:
   friend class ReplayCursor;
@@ -100,7 +106,8 @@ class ReplayCursor {
 
 // Writes the header and rows in the replay format ('\n' line endings, shortest round-trip number
 // form): parse() reads them back bit-exactly. The stop column is written only when some row has
-// stop set, the load_kg column (after stop; an empty cell for a NaN load) only when some row has a
+// stop set, the wait column only when some row waits, the load_kg column (last; an empty cell for
+// a NaN load) only when some row has a
 // load, so a file without either keeps the 4-column form. Does not validate; rows that break the
 // rules (e.g. non-increasing times) produce a file that parse() rejects.
 void write_replay(std::ostream& out, const std::vector<ReplayRow>& rows);

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <limits>
 
 #include "craneassist/control/control_loop.hpp"
 #include "craneassist/control/controller.hpp"
@@ -59,6 +60,16 @@ struct SwingSummary {
   bool released = false;
   double after_release_deg = 0.0;
   double end_deg = 0.0;  // the largest over the run's last second (what still swings)
+};
+
+// A replay's waits over a run (its wait rows; ReplayInput, docs/replay-format.md#waits).
+struct WaitSummary {
+  long waits = 0;      // wait rows reached
+  long timed_out = 0;  // waits that ended at the timeout, not settled
+  double total_s = 0.0, longest_s = 0.0;
+  // The largest swing from 1 s after a wait began to its end (the swing the stop before it left,
+  // which the wait is for; docs/sway.md), deg; NaN when nothing measured the swing.
+  double residual_swing_deg = std::numeric_limits<double>::quiet_NaN();
 };
 
 // How the run's stops ended (docs/safety.md): a stop runs from its first cycle not running
@@ -120,6 +131,10 @@ struct RunSummary {
   StopSummary stop;
   SwingSummary swing;
   double peak_spool_step = 0.0;  // largest command change from one cycle to the next, whole run
+  // A replay's wait rows (ReplayInput) and its cycle time: the last row's time plus the time
+  // waited (the time a scripted operator took; run_replay fills them).
+  WaitSummary waits;
+  double cycle_time_s = 0.0;
 };
 
 class RunStatistics final : public CycleObserver {

@@ -5,6 +5,7 @@
 // power, direction error; app/motion_quality.hpp).
 #pragma once
 
+#include <cmath>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -21,6 +22,12 @@ struct SuiteTargets {
   std::optional<double> lateral_speed_m_s;    // one-line replays only, over 50 ms
   std::optional<double> peak_power_share;     // measured pump power over P_max
   std::optional<double> direction_error_rad;  // commanded vs measured, steady cycles
+  // Replays with wait rows (docs/replay-format.md#waits): the residual swing (the largest from
+  // 1 s into a wait), the cycle time (the last row's time plus the waits), waits that timed out.
+  std::optional<double> residual_swing_rad;
+  std::optional<double> cycle_time_s;
+  std::optional<int> timed_out_waits;
+  std::optional<int> overload_cycles;  // the rated capacity limiter tripped (docs/loads.md)
 };
 
 struct SuiteRun {
@@ -30,10 +37,20 @@ struct SuiteRun {
   std::string pose_text;         // NAME=VALUE UNIT, ...; empty for default
   double payload_kg = 0.0;
   bool payload_known = false;  // tell the controller (else the crane scale weighs the load)
+  // The run's scaling and sway damping (a baseline: flow, false); unset: full, the config's.
+  control::ScalingMode scaling = control::ScalingMode::kFull;
+  std::optional<bool> sway_damping;
+  double wait_swing_rad = 2.0 * M_PI / 180.0;  // how its wait rows wait
   SuiteTargets targets;
   int line = 0;       // of the run in the manifest
   int pose_line = 0;  // of its pose
-  std::string name() const { return replay_text + " @" + pose; }
+  // "replay @pose", with "(scaling flow, no sway damping)" for a run other than the default.
+  std::string name() const;
+  // The same run but for its scaling and sway damping (a baseline and the run it is for).
+  bool same_motion(const SuiteRun& other) const {
+    return replay == other.replay && pose == other.pose && payload_kg == other.payload_kg &&
+           payload_known == other.payload_known && wait_swing_rad == other.wait_swing_rad;
+  }
 };
 
 struct Suite {
