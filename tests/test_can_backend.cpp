@@ -473,6 +473,49 @@ TEST(CanBackend, PumpPressureAndFlowFromTheBus) {
   EXPECT_FALSE(backend.faulted());  // informational, never a fault
 }
 
+// The grapple's swing sensor (docs/can.md, "Swing sensor"): both angles in SI, the swing from the
+// vertical as the simulator measures it; unmeasured (NaN) before the first frame, once the frames
+// stop and after a malformed frame, never a fault.
+TEST(CanBackend, SwingSensorFromTheBus) {
+  Rig r;
+  ASSERT_TRUE(r.map.grapple.swing_radial && r.map.grapple.swing_tangential);
+  CanBackend backend(r.map, r.cfg.model, r.backend_end);
+  valves::MachineState state;
+  r.feedback();
+  backend.read(state);
+  EXPECT_TRUE(std::isnan(state.swing_rad));  // no swing frame yet
+  CanFrame f;
+  f.id = r.map.grapple.swing_radial->id;
+  f.dlc = 4;
+  const double radial = 3.0 * M_PI / 180.0, tangential = -4.0 * M_PI / 180.0;
+  ASSERT_EQ(encode(*r.map.grapple.swing_radial, radial, f), SignalStatus::kOk);
+  ASSERT_EQ(encode(*r.map.grapple.swing_tangential, tangential, f), SignalStatus::kOk);
+  r.feedback();
+  r.sensors.send(f);
+  backend.read(state);
+  const double bit = 0.01 * M_PI / 180.0;
+  EXPECT_NEAR(state.swing_radial_rad, radial, bit);
+  EXPECT_NEAR(state.swing_tangential_rad, tangential, bit);
+  EXPECT_NEAR(state.swing_rad, std::atan(std::hypot(std::tan(radial), std::tan(tangential))),
+              2.0 * bit);
+  EXPECT_TRUE(state.valid);
+  // A frame too short for the tangential angle: counted, the swing not updated by it.
+  CanFrame shorter = f;
+  shorter.dlc = 2;
+  r.feedback();
+  r.sensors.send(shorter);
+  backend.read(state);
+  EXPECT_FALSE(backend.faulted());
+  // The frames stop: unmeasured after the feedback timeout, never a fault.
+  std::this_thread::sleep_for(60ms);
+  r.feedback();
+  backend.read(state);
+  EXPECT_TRUE(std::isnan(state.swing_rad));
+  EXPECT_TRUE(std::isnan(state.swing_radial_rad));
+  EXPECT_TRUE(state.valid);
+  EXPECT_FALSE(backend.faulted());
+}
+
 TEST(HeartbeatMonitor, AliveOnlyWhileTheCounterAdvancesInStateEnabled) {
   const HeartbeatSpec spec{0x18FF0080, true, 0.02, 0.1};
   HeartbeatMonitor mon(spec);

@@ -72,6 +72,13 @@ void expect_same(const CanMapping& a, const CanMapping& b) {
   ASSERT_EQ(a.pump.flow.has_value(), b.pump.flow.has_value());
   if (a.pump.pressure) expect_same(*a.pump.pressure, *b.pump.pressure, "pump.pressure");
   if (a.pump.flow) expect_same(*a.pump.flow, *b.pump.flow, "pump.flow");
+  ASSERT_EQ(a.grapple.swing_radial.has_value(), b.grapple.swing_radial.has_value());
+  ASSERT_EQ(a.grapple.swing_tangential.has_value(), b.grapple.swing_tangential.has_value());
+  if (a.grapple.swing_radial) {
+    expect_same(*a.grapple.swing_radial, *b.grapple.swing_radial, "grapple.swing_radial");
+    expect_same(*a.grapple.swing_tangential, *b.grapple.swing_tangential,
+                "grapple.swing_tangential");
+  }
 }
 
 std::string read(const std::string& path) {

@@ -308,6 +308,35 @@ TEST(CanMapping, PumpSignals) {
   EXPECT_NE(std::string(e.what()).find("overlaps"), std::string::npos) << e.what();
 }
 
+TEST(CanMapping, SwingSensorSignals) {
+  const CanMapping m = load_can_mapping(kExample);
+  ASSERT_TRUE(m.grapple.swing_radial.has_value());
+  ASSERT_TRUE(m.grapple.swing_tangential.has_value());
+  EXPECT_NEAR(m.grapple.swing_radial->scale, 0.01 * M_PI / 180.0, 1e-15);  // 0.01 deg/bit in rad
+  EXPECT_TRUE(m.grapple.swing_tangential->is_signed);
+  const std::string joints = "joints:\n  - name: slew\n" + kValve + kPosition;
+  const std::string radial =
+      "  swing_radial: {id: 0x320, start_bit: 0, length: 16, byte_order: intel, signed: true, "
+      "scale: 0.01, unit: deg}\n";
+  // Both axes or none: a two-axis sensor.
+  auto e = error_of("format: craneassist-can-map/1\ngrapple:\n" + radial + joints);
+  EXPECT_EQ(e.field(), "grapple.swing_tangential");
+  e = error_of(
+      "format: craneassist-can-map/1\ngrapple:\n  swing_radial: {id: 0x320, start_bit: 0, "
+      "length: 16, byte_order: intel, scale: 1, unit: mm}\n" +
+      joints);
+  EXPECT_EQ(e.field(), "grapple.swing_radial.unit");
+  EXPECT_NE(std::string(e.what()).find("an angle"), std::string::npos) << e.what();
+  e = error_of("format: craneassist-can-map/1\ngrapple:\n" + radial +
+               "  swing_tangential: {id: 0x320, start_bit: 8, length: 16, byte_order: intel, "
+               "signed: true, scale: 0.01, unit: deg}\n" +
+               joints);
+  EXPECT_EQ(e.field(), "grapple.swing_tangential");
+  EXPECT_NE(std::string(e.what()).find("overlaps"), std::string::npos) << e.what();
+  e = error_of("format: craneassist-can-map/1\ngrapple: {swing: 1}\n" + joints);
+  EXPECT_EQ(e.field(), "grapple.swing");
+}
+
 TEST(CanMapping, IsobusValveGroupExampleLoads) {
   const CanMapping m = load_can_mapping(std::string(CRANEASSIST_SOURCE_DIR) +
                                         "/config/can/pvg32_isobus_example.yaml");

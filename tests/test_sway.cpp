@@ -12,6 +12,7 @@
 #include "craneassist/dynamics/pendulum.hpp"
 #include "craneassist/scaling/scaling_filter.hpp"
 #include "craneassist/scaling/sway_shaper.hpp"
+#include "craneassist/scaling/swing_frequency.hpp"
 #include "craneassist/sim_backend/sim_backend.hpp"
 
 using namespace craneassist;
@@ -232,4 +233,78 @@ TEST(CraneConfig, GrappleSection) {
       test::crane_config_error_after_edit(kK70m, "sway_damping: true", "sway_damping: maybe");
   EXPECT_NE(std::string(bad_switch.what()).find("scaling.sway_damping"), std::string::npos)
       << bad_switch.what();
+}
+
+// The swing period from the swing sensor (scaling/swing_frequency.hpp): a free swing's period
+// through the sensor's noise, and nothing from a driven swing, the noise alone or a gap.
+namespace {
+
+struct SwingSignal {
+  double period_s = 2.3, amplitude_rad = 0.05, zeta = 0.02, noise_rad = 0.0002;
+  double radial(double t) const {
+    const double w = 2.0 * M_PI / period_s;
+    return amplitude_rad * std::exp(-zeta * w * t) * std::sin(w * t);
+  }
+};
+
+}  // namespace
+
+TEST(SwingFrequency, MeasuresAFreeSwingsPeriodThroughTheNoise) {
+  const SwingSignal s;
+  const double model_period = 1.9;
+  scaling::SwingFrequencyEstimator e;
+  EXPECT_EQ(e.ratio(), 1.0);  // the model's until measured
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, s.noise_rad);
+  for (int k = 0; k < 1500; ++k) {
+    const double t = k * kPeriod;
+    e.update(t, s.radial(t) + noise(rng), 0.5 * s.radial(t) + noise(rng), 0.0, model_period);
+  }
+  EXPECT_GE(e.measured(), 8);  // both axes, a period each
+  EXPECT_NEAR(e.ratio(), model_period / s.period_s, 0.005 * model_period / s.period_s);
+  EXPECT_NEAR(e.last_period_s(), s.period_s, 0.01);
+}
+
+TEST(SwingFrequency, NothingFromADrivenSwingTheNoiseAloneAGapOrAnImplausiblePeriod) {
+  const SwingSignal s;
+  std::mt19937 rng(4);
+  std::normal_distribution<double> noise(0.0, 0.001);  // 0.06 deg
+  // The tip's reference accelerating throughout: the swing is driven, not free.
+  scaling::SwingFrequencyEstimator driven;
+  // The sensor's noise alone, no swing.
+  scaling::SwingFrequencyEstimator quiet;
+  // A gap in the measurement every second.
+  scaling::SwingFrequencyEstimator gaps;
+  // The model's period so far off that the measured one is not believed.
+  scaling::SwingFrequencyEstimator implausible;
+  for (int k = 0; k < 1500; ++k) {
+    const double t = k * kPeriod;
+    driven.update(t, s.radial(t), s.radial(t), 0.2, 1.9);
+    quiet.update(t, noise(rng), noise(rng), 0.0, 1.9);
+    const bool gap = k % 100 == 50;
+    gaps.update(t, gap ? NAN : s.radial(t), gap ? NAN : s.radial(t), 0.0, 1.9);
+    implausible.update(t, s.radial(t), s.radial(t), 0.0, 0.9);
+  }
+  EXPECT_EQ(driven.measured(), 0);
+  EXPECT_EQ(quiet.measured(), 0);
+  EXPECT_EQ(gaps.measured(), 0);
+  EXPECT_EQ(implausible.measured(), 0);
+  for (const auto* e : {&driven, &quiet, &gaps, &implausible}) EXPECT_EQ(e->ratio(), 1.0);
+}
+
+TEST(SwingFrequency, TheNewestPeriodsCountAndResetForgets) {
+  scaling::SwingFrequencyEstimator e;
+  double t = 0.0;
+  const auto swing = [&](double period, int cycles) {
+    for (int k = 0; k < cycles; ++k, t += kPeriod) {
+      e.update(t, 0.05 * std::sin(2.0 * M_PI * t / period), NAN, 0.0, 2.0);
+    }
+  };
+  swing(2.5, 1200);
+  EXPECT_NEAR(e.ratio(), 2.0 / 2.5, 0.005);
+  swing(1.6, 700);  // the grapple changed (a longer log): the newest two periods count
+  EXPECT_NEAR(e.ratio(), 2.0 / 1.6, 0.02);
+  e.reset();
+  EXPECT_EQ(e.measured(), 0);
+  EXPECT_EQ(e.ratio(), 1.0);
 }

@@ -89,7 +89,9 @@ std::int64_t mono_ns() {
 struct FeedbackSignal {
   std::size_t frame = 0;
   int joint = 0;
-  int kind = 0;  // 0 position, 1 pressure a, 2 pressure b, 3 pump pressure, 4 pump flow
+  // 0 position, 1 pressure a, 2 pressure b, 3 pump pressure, 4 pump flow, 5 and 6 the grapple's
+  // swing towards and across the reach
+  int kind = 0;
   const can::SignalSpec* spec = nullptr;
 };
 
@@ -174,6 +176,9 @@ int run_emulate_command(const EmulateArgs& args) {
     }
     if (mapping.pump.pressure) add(0, 3, *mapping.pump.pressure);
     if (mapping.pump.flow) add(0, 4, *mapping.pump.flow);
+    if (mapping.grapple.swing_radial) add(0, 5, *mapping.grapple.swing_radial);
+    if (mapping.grapple.swing_tangential) add(0, 6, *mapping.grapple.swing_tangential);
+    std::vector<char> unmeasured(frames.size(), 0);  // a frame with a signal the sim lacks
     std::signal(SIGTERM, on_signal);
     std::signal(SIGINT, on_signal);
 
@@ -285,6 +290,7 @@ int run_emulate_command(const EmulateArgs& args) {
         if (next_feedback <= now) next_feedback = now + feedback_ns;
         sim.read(state);
         for (auto& f : frames) f.data.fill(0);
+        std::fill(unmeasured.begin(), unmeasured.end(), 0);
         for (const auto& s : signals) {
           double value = state.q[s.joint];
           // The emulated machine's chamber pressure transmitters (with the simulator's sensor
@@ -293,9 +299,20 @@ int run_emulate_command(const EmulateArgs& args) {
           if (s.kind == 2) value = state.pressure_b_pa[s.joint];
           if (s.kind == 3) value = state.pump.pressure_pa;
           if (s.kind == 4) value = state.pump.flow_m3_s;
+          // The swing sensor (the simulator's, with its noise and resolution); a swing the
+          // simulator does not measure (a rigid grapple, simulation.swing_sensor: none) is not
+          // sent.
+          if (s.kind == 5) value = state.swing_radial_rad;
+          if (s.kind == 6) value = state.swing_tangential_rad;
+          if (!std::isfinite(value)) {
+            unmeasured[s.frame] = 1;
+            continue;
+          }
           can::encode(*s.spec, value, frames[s.frame]);
         }
-        for (const auto& f : frames) {
+        for (std::size_t i = 0; i < frames.size(); ++i) {
+          const auto& f = frames[i];
+          if (unmeasured[i]) continue;
           if (bus.send(f) == can::SendStatus::kOk) {
             ++sent;
           } else {

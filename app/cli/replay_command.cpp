@@ -130,8 +130,15 @@ void print_swing_line(const control::SwingSummary& s, const config::CraneConfig&
   std::printf("  swing: peak %.1f deg", s.peak_deg);
   if (s.released)
     std::printf(", %.1f deg from 1 s after the stick's last release", s.after_release_deg);
-  std::printf(", %.1f deg in the last second (sway damping %s)\n", s.end_deg,
+  std::printf(", %.1f deg in the last second (sway damping %s", s.end_deg,
               damped ? "on" : "off: --no-sway-damping or scaling.sway_damping");
+  if (damped && s.measured_periods > 0) {
+    std::printf(", tuned to the measured swing: period %.2f s, the model's %.2f s, %d measured",
+                s.period_s, s.model_period_s, s.measured_periods);
+  } else if (damped && s.model_period_s > 0.0) {
+    std::printf(", on the model's period %.2f s", s.model_period_s);
+  }
+  std::printf(")\n");
 }
 
 void print_wait_lines(const control::RunSummary& s, const control::WaitSettings& settings,

@@ -530,6 +530,48 @@ void read_grapple(Reader& r, const YAML::Node& root, dynamics::CraneModel& model
                                    "between 0 and 1000 kN*m*s/rad");
 }
 
+// The simulated machine's swing sensor and grapple, where they differ from the default (an exact
+// sensor) and the controller's model (docs/sway.md).
+void read_simulated_grapple(Reader& r, const YAML::Node& sim, CraneConfig& cfg) {
+  const std::string sp = "simulation.swing_sensor";
+  if (sim["swing_sensor"].IsDefined() && sim["swing_sensor"].IsScalar()) {
+    const std::string text = r.text(sim, "swing_sensor", "simulation");
+    if (text != "none") {
+      r.fail(sim["swing_sensor"], sp, "expected none or {noise, resolution}, got '" + text + "'");
+    }
+    cfg.simulation.swing_sensor = false;
+  } else if (const auto sensor =
+                 r.optional_section(sim, "swing_sensor", "simulation", {"noise", "resolution"})) {
+    const YAML::Node& ss = *sensor;
+    cfg.simulation.swing_noise_rad =
+        r.value_in(ss, "noise", sp, Dimension::kAngle, 0.0, 0.1, "between 0 and 5.7 deg");
+    cfg.simulation.swing_resolution_rad =
+        r.value_in(ss, "resolution", sp, Dimension::kAngle, 0.0, 0.1, "between 0 and 5.7 deg");
+  }
+  const std::string gp = "simulation.grapple";
+  const auto section =
+      r.optional_section(sim, "grapple", "simulation", {"hanger_length", "load_below", "damping"});
+  if (!section) return;
+  const YAML::Node& node = *section;
+  if (!cfg.model.grapple.hangs()) {
+    r.fail(node, gp, "the crane has no hanging grapple (no grapple section) to differ from");
+  }
+  dynamics::HangingGrapple g = cfg.model.grapple;
+  if (node["hanger_length"].IsDefined()) {
+    g.com_below_m = r.value_in(node, "hanger_length", gp, Dimension::kLength, 0.05, 10.0,
+                               "between 5 cm and 10 m");
+  }
+  if (node["load_below"].IsDefined()) {
+    g.load_below_m =
+        r.value_in(node, "load_below", gp, Dimension::kLength, 0.05, 10.0, "between 5 cm and 10 m");
+  }
+  if (node["damping"].IsDefined()) {
+    g.damping_n_m_s_rad = r.value_in(node, "damping", gp, Dimension::kRotaryDamping, 0.0, 1e6,
+                                     "between 0 and 1000 kN*m*s/rad");
+  }
+  cfg.simulation.grapple = g;
+}
+
 // Optional rated load against reach (docs/loads.md).
 void read_load_chart(Reader& r, const YAML::Node& root, LoadChart& chart) {
   const auto section = r.optional_section(root, "load_chart", "", {"reach", "rated_load"});
@@ -651,7 +693,7 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   r.check_keys(scaling, sp,
                {"jerk_max", "acceleration_max", "deceleration_max", "direction_change_acceleration",
                 "tracking_error_ok", "tracking_error_filter", "power_bound", "power_reserve",
-                "sway_damping"});
+                "sway_damping", "sway_frequency"});
   auto& sc = cfg.scaling;
   sc.jerk_max_m_s3 =
       r.value_in(scaling, "jerk_max", sp, Dimension::kJerk, 1e-3, 1e4, "between 0.001 and 10000");
@@ -670,6 +712,14 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
                                 "between 0 and 0.5");
   sc.power_bound = r.one_of(scaling, "power_bound", sp, dynamics::kPowerBounds);
   sc.sway_damping = r.flag(scaling, "sway_damping", sp, true);
+  if (scaling["sway_frequency"].IsDefined()) {
+    const std::string f = r.text(scaling, "sway_frequency", sp);
+    if (f != "model" && f != "measured") {
+      r.fail(scaling["sway_frequency"], "scaling.sway_frequency",
+             "expected model or measured, got '" + f + "'");
+    }
+    sc.sway_frequency_measured = f == "measured";
+  }
 
   const YAML::Node redundancy = r.child(root, "redundancy", "");
   r.check_keys(redundancy, "redundancy", {"resolution"});
@@ -682,7 +732,8 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
 
   const YAML::Node sim = r.child(root, "simulation", "");
   r.check_keys(sim, "simulation",
-               {"step", "initial", "pressure_sensors", "return_pressure", "spool_time_constant"});
+               {"step", "initial", "pressure_sensors", "return_pressure", "spool_time_constant",
+                "swing_sensor", "grapple"});
   cfg.simulation.step_s =
       r.value_in(sim, "step", "simulation", Dimension::kTime, 1e-5, 1e-2, "between 0.01 and 10 ms");
   const double period = 1.0 / cfg.control.rate_hz;
@@ -728,6 +779,7 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
     cfg.simulation.spool_time_constant_s = r.value_in(
         sim, "spool_time_constant", "simulation", Dimension::kTime, 0.0, 5.0, "between 0 and 5 s");
   }
+  read_simulated_grapple(r, sim, cfg);
   read_load_chart(r, root, cfg.load_chart);
   read_backend(r, root, cfg.backend);
   cfg.unsourced_quantities = r.unsourced();

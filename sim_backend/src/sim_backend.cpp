@@ -45,11 +45,18 @@ dynamics::CraneModel without_tip_load(const dynamics::CraneModel& m) {
   return out;
 }
 
+// The machine's model: the controller's, with the machine's own grapple where it differs.
+dynamics::CraneModel with_plant_grapple(const dynamics::CraneModel& m, const SimSettings& s) {
+  dynamics::CraneModel out = m;
+  if (s.grapple) out.grapple = *s.grapple;
+  return out;
+}
+
 }  // namespace
 
 struct SimBackend::Impl {
   Impl(const dynamics::CraneModel& m, const SimSettings& s)
-      : model(m), settings(s), pump(m.pump), world(make_world(m)) {
+      : model(with_plant_grapple(m, s)), settings(s), pump(m.pump), world(make_world(m)) {
     // A threading implementation of this world's own: ODE's shared default aborts when two
     // worlds step at the same time in different threads.
     threading = dThreadingAllocateSelfThreadedImplementation();
@@ -59,6 +66,7 @@ struct SimBackend::Impl {
     crane->enable_end_stops(true);
     make_load_body(s.q_initial);
     rng.seed(s.noise_seed);
+    swing_rng.seed(s.noise_seed + 1);
     const int n = model.dof();
     feedback.resize(static_cast<std::size_t>(n) + 1);
     dynamics::ValveSections valves = model.valves;
@@ -198,9 +206,19 @@ struct SimBackend::Impl {
     Eigen::Vector3d radial, tangential;
     dynamics::swing_axes(Eigen::Vector3d(anchor[0], anchor[1], anchor[2]), radial, tangential);
     const double vertical = r.dot(down);
-    state.swing_rad = std::atan2((r - vertical * down).norm(), vertical);
-    state.swing_radial_rad = std::atan2(r.dot(radial), vertical);
-    state.swing_tangential_rad = std::atan2(r.dot(tangential), vertical);
+    if (!settings.swing_sensor) return;  // the machine measures no swing (NaN)
+    // The two-axis sensor: each angle with its noise and resolution; the swing from them.
+    double angles[2] = {std::atan2(r.dot(radial), vertical),
+                        std::atan2(r.dot(tangential), vertical)};
+    for (double& a : angles) {
+      if (settings.swing_noise_rad > 0.0) a += settings.swing_noise_rad * swing_normal(swing_rng);
+      if (settings.swing_resolution_rad > 0.0) {
+        a = settings.swing_resolution_rad * std::round(a / settings.swing_resolution_rad);
+      }
+    }
+    state.swing_radial_rad = angles[0];
+    state.swing_tangential_rad = angles[1];
+    state.swing_rad = std::atan(std::hypot(std::tan(angles[0]), std::tan(angles[1])));
   }
 
   // Holds every joint for a few steps so feedback carries the static loads.
@@ -388,6 +406,10 @@ struct SimBackend::Impl {
   double payload_kg = 0.0;
   std::mt19937 rng{1};
   std::normal_distribution<double> normal{0.0, 1.0};
+  // The swing sensor's own noise (the pressure sensors' sequence unchanged); measured in a const
+  // read, like a sensor.
+  mutable std::mt19937 swing_rng{2};
+  mutable std::normal_distribution<double> swing_normal{0.0, 1.0};
   bool active = true;  // inactive: the spools are commanded neutral
   PumpResult pump_result;
   double load_alpha = 1.0;

@@ -54,6 +54,10 @@ stop_capture
 kill "$emu"; wait "$emu"
 cat /tmp/can.out /tmp/emu.log
 ./can_backend_check compare /tmp/sim.csv /tmp/can.csv 0.05 pump || fail "tip paths or pump differ"
+# The grapple's swing sensor over the bus (the emulator sends the simulator's swing on the
+# mapping's grapple frame): the CAN run measures the swing as the sim run does.
+grep -q "swing: peak" /tmp/can.out || fail "no swing measured over the bus"
+grep "swing:" /tmp/sim.out /tmp/can.out
 echo "--- the independent candump capture"
 ./can_backend_check traffic /tmp/cap1.log || fail "traffic"
 echo "--- the backend's own candump log"

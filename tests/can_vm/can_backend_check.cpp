@@ -427,8 +427,8 @@ int traffic(const char* path) {
     } else if (is_machine_j1939(r.frame)) {
       ++machine_j1939;
     } else if (!((r.frame.extended && (r.frame.id & 0xFFFFFFF0u) == 0x18FF1020u) ||
-                 (!r.frame.extended &&
-                  ((r.frame.id >= 0x301 && r.frame.id <= 0x304) || r.frame.id == 0x310)))) {
+                 (!r.frame.extended && ((r.frame.id >= 0x301 && r.frame.id <= 0x304) ||
+                                        r.frame.id == 0x310 || r.frame.id == 0x320)))) {
       ++unknown;
     }
   }

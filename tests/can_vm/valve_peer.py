@@ -12,8 +12,8 @@ What it does, on a SocketCAN interface (vcan0 by default):
     outputs such as `extension_valve_command` in mA (spool = value / full scale of the signal);
   - integrates a kinematic model of each joint (joint rate from the spool through the valve's
     dead zone, times a maximum rate per joint; the K70M's values, see JOINTS below) and sends
-    every position, pressure and pump message of the DBC every --period (10 ms) through
-    canmatrix's encoder;
+    every position, pressure, pump and swing-sensor message of the DBC every --period (10 ms)
+    through canmatrix's encoder (the swing sensor reads 0: the peer's grapple hangs still);
   - puts a section in fail-safe (spool 0) when its commands stop for --command-timeout, and every
     section when craneassist's heartbeat stops advancing for its timeout (read from the DBC's
     comment on the heartbeat message, else 100 ms), as a valve's own supervision would.
@@ -318,6 +318,8 @@ class Peer:
             return self._pump_pressure
         if name == "pump_flow":
             return self._pump_flow
+        if name in ("grapple_swing_radial", "grapple_swing_tangential"):
+            return lambda: 0.0  # the peer's grapple hangs still (a swing sensor reading 0 deg)
         sys.exit(f"valve_peer: machine signal '{name}': the peer does not know what to send")
 
     def _pump_pressure(self):

@@ -119,6 +119,7 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
   deceleration_max_ = config.scaling.deceleration_max_m_s2;
   jerk_max_ = config.scaling.jerk_max_m_s3;
   sway_damping_ = config.scaling.sway_damping && model_.grapple.hangs();
+  sway_measured_ = config.scaling.sway_frequency_measured;
   known_payload_kg_ = dynamics::payload_mass_kg(model_);
   dynamics::PayloadEstimatorSettings scale;
   scale.period_s = period_s_;
@@ -336,12 +337,23 @@ void Controller::update_full(const valves::MachineState& state, const Eigen::Vec
   scaling::TipScalerInput in = tip_scaler_input(v_cmd, u, tip_out_, stale);
   in.tracking_factor = scaling::tracking_factor(tip_error_filtered_m_, tracking_error_ok_m_);
   if (sway_damping_) {
-    // The swing's frequency with the load the scale has found (the rated load before it has).
+    // The swing's frequency with the load the scale has found (the rated load before it has),
+    // tuned to the swing the machine's sensor measures (where it has one, and until then the
+    // model's): the model's times the ratio of its period to the measured one.
     const double load_kg =
         std::isfinite(out.load.estimate_kg) ? out.load.estimate_kg : out.load.model_kg;
     const dynamics::Pendulum pendulum = dynamics::grapple_pendulum(model_, load_kg);
-    in.sway_omega_rad_s = pendulum.omega_rad_s;
+    const double model_period = pendulum.period_s();
+    if (sway_measured_) {
+      swing_frequency_.update(state.t_s, state.swing_radial_rad, state.swing_tangential_rad,
+                              scaler_out_.acceleration.norm(), model_period);
+    }
+    const double tuned = sway_measured_ ? swing_frequency_.ratio() : 1.0;
+    in.sway_omega_rad_s = pendulum.omega_rad_s * tuned;
     in.sway_zeta = pendulum.zeta;
+    out.sway_model_period_s = model_period;
+    out.sway_period_s = model_period / tuned;
+    out.sway_measured_periods = sway_measured_ ? swing_frequency_.measured() : 0;
   }
   // The rated capacity limiter: a motion that takes the load further out (raises the load
   // moment) slows to rest when the crane is overloaded, or when the moment would pass the chart

@@ -89,6 +89,9 @@ void RunStatistics::on_cycle(const CycleRecord& c) noexcept {
 
   const ControllerOutput* out = c.controller;
   if (out == nullptr) return;
+  s_.swing.model_period_s = out->sway_model_period_s;
+  s_.swing.period_s = out->sway_period_s;
+  s_.swing.measured_periods = out->sway_measured_periods;
   s_.peak_path_jerk = std::max(s_.peak_path_jerk, std::abs(out->sdddot));
   add_load(t, speed, c.state, *out);
   ++s_.limit_cycles[static_cast<std::size_t>(out->limit)];

@@ -74,6 +74,7 @@ CanBackend::CanBackend(const CanMapping& mapping, const dynamics::CraneModel& mo
     impl_->joints.push_back(std::move(j));
   }
   impl_->pump_map = mapping.pump;
+  impl_->grapple_map = mapping.grapple;
   if (mapping.heartbeat) {
     impl_->heartbeat = *mapping.heartbeat;
     impl_->heartbeat_cycle_us =
@@ -306,6 +307,18 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
       (which == 0 ? m.pump_pressure_pa : m.pump_flow_m3_s) = value;
       m.pump_last_us = taken_us;
     }
+    for (int axis = 0; axis < 2; ++axis) {
+      const auto& spec = axis == 0 ? m.grapple_map.swing_radial : m.grapple_map.swing_tangential;
+      if (!spec || spec->id != f.id || spec->extended != f.extended) continue;
+      known = true;
+      double value = 0.0;
+      if (decode(*spec, f, value) != SignalStatus::kOk) {  // counted: the swing goes unmeasured
+        m.counters.bad_frames.fetch_add(1, std::memory_order_relaxed);
+        continue;
+      }
+      m.swing_rad[axis] = value;
+      m.swing_last_us[axis] = taken_us;
+    }
     if (!known) m.counters.unknown_frames.fetch_add(1, std::memory_order_relaxed);
   }
 
@@ -344,6 +357,19 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
   }
   state.t_s = static_cast<double>(mono_us() - m.start_us) * 1e-6;
   read_pump(state.pump, now, timeout_us);
+  // The swing, where the mapping has the sensor and both its angles are fresh; else not measured
+  // (NaN: the controller damps on its model, docs/sway.md). Not a fault: the crane moves safely
+  // without it.
+  constexpr double kNoSwing = std::numeric_limits<double>::quiet_NaN();
+  state.swing_rad = state.swing_radial_rad = state.swing_tangential_rad = kNoSwing;
+  const auto fresh_swing = [&](int axis) {
+    return m.swing_last_us[axis] != 0 && now - m.swing_last_us[axis] <= timeout_us;
+  };
+  if (fresh_swing(0) && fresh_swing(1)) {
+    state.swing_radial_rad = m.swing_rad[0];
+    state.swing_tangential_rad = m.swing_rad[1];
+    state.swing_rad = std::atan(std::hypot(std::tan(m.swing_rad[0]), std::tan(m.swing_rad[1])));
+  }
   // Until the address is claimed the valves are not commanded: no state to control from.
   state.valid = fresh && !faulted() && m.claimed();
   if (faulted()) return valves::BackendStatus::kFault;

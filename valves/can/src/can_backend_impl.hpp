@@ -142,7 +142,12 @@ struct CanBackend::Impl {
   // Pump measurements (when the mapping has them): control thread only.
   PumpMapping pump_map;
   double pump_pressure_pa = 0.0, pump_flow_m3_s = 0.0, pump_energy_j = 0.0;
-  std::int64_t pump_last_us = 0;        // newest pump frame, taken (CLOCK_MONOTONIC)
+  std::int64_t pump_last_us = 0;  // newest pump frame, taken (CLOCK_MONOTONIC)
+  // The grapple's swing sensor (mapping.grapple): the last radial and tangential angles, rad,
+  // and when each was taken.
+  GrappleMapping grapple_map;
+  double swing_rad[2] = {0.0, 0.0};
+  std::int64_t swing_last_us[2] = {0, 0};
   std::int64_t pump_integrated_us = 0;  // mono time of the last energy step
   // The heartbeat (when the mapping has one): control thread only.
   std::optional<HeartbeatSpec> heartbeat;

@@ -830,6 +830,24 @@ std::string write_dbc(const CanMapping& mapping, std::string_view title) {
                   {}},
                  "machine", 0.0);
   }
+  if (mapping.grapple.swing_radial && mapping.grapple.swing_tangential) {
+    messages.add({"grapple_swing_radial",
+                  "grapple",
+                  "swing_radial",
+                  in_file_units(*mapping.grapple.swing_radial),
+                  "craneassist",
+                  "grapple swing from the vertical towards the reach",
+                  {}},
+                 "machine", 0.0);
+    messages.add({"grapple_swing_tangential",
+                  "grapple",
+                  "swing_tangential",
+                  in_file_units(*mapping.grapple.swing_tangential),
+                  "craneassist",
+                  "grapple swing from the vertical across the reach (towards a positive slew)",
+                  {}},
+                 "machine", 0.0);
+  }
   const std::vector<OutMessage> list = messages.finish();
   const bool j1939 = std::any_of(list.begin(), list.end(), [](const auto& m) { return m.j1939; });
 

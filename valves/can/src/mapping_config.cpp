@@ -25,7 +25,7 @@ using config::ConfigError;
 using config::Dimension;
 
 // What a signal measures or commands; decides which units its `unit` may name.
-enum class SignalUse { kPosition, kPressure, kCommand, kFlow };
+enum class SignalUse { kPosition, kPressure, kCommand, kFlow, kAngle };
 
 class Reader : public config::YamlReader {
  public:
@@ -167,6 +167,13 @@ bool unit_factor(const std::string& unit, SignalUse use, double& factor, Positio
         return true;
       }
       return false;
+    case SignalUse::kAngle:
+      if (auto q = config::parse_quantity("1 " + unit, Dimension::kAngle, error)) {
+        factor = q->si_values[0];
+        kind = PositionKind::kAngle;
+        return true;
+      }
+      return false;
     case SignalUse::kCommand:
       if (unit == "A")
         factor = 1.0;
@@ -193,6 +200,8 @@ const char* units_text(SignalUse use) {
       return "a current (A, mA) or a ratio (%, 1)";
     case SignalUse::kFlow:
       return "a volume flow (L/min, m^3/s)";
+    case SignalUse::kAngle:
+      return "an angle (rad, deg)";
   }
   return "";
 }
@@ -542,9 +551,9 @@ void check_claimed_address(const Reader& r, const YAML::Node& root, const CanMap
 }
 
 CanMapping read_mapping(Reader& r, const YAML::Node& root) {
-  r.check_keys(
-      root, "",
-      {"format", "note", "dbc", "joints", "heartbeat", "pump", "address_claim", "diagnostics"});
+  r.check_keys(root, "",
+               {"format", "note", "dbc", "joints", "heartbeat", "pump", "grapple", "address_claim",
+                "diagnostics"});
   const YAML::Node format = r.child(root, "format", "");
   if (r.text(format, "format") != kMappingFormat) {
     r.fail(format, "format", std::string("expected ") + kMappingFormat);
@@ -637,6 +646,19 @@ CanMapping read_mapping(Reader& r, const YAML::Node& root) {
       const auto& sp = *mapping.pump.flow;
       occupancy.push_back(
           {sp.id, sp.extended, occupied_bits(sp), "pump.flow", pump["flow"], false});
+    }
+  }
+  if (root["grapple"].IsDefined()) {
+    // A two-axis swing sensor on the grapple's link: both components or none.
+    const YAML::Node grapple = root["grapple"];
+    r.check_keys(grapple, "grapple", {"swing_radial", "swing_tangential"});
+    for (const char* key : {"swing_radial", "swing_tangential"}) {
+      const std::string p = std::string("grapple.") + key;
+      const SignalSpec sp = read_signal(r, r.child(grapple, key, "grapple"), p, SignalUse::kAngle,
+                                        kSignalKeys, nullptr);
+      occupancy.push_back({sp.id, sp.extended, occupied_bits(sp), p, grapple[key], false});
+      (std::string(key) == "swing_radial" ? mapping.grapple.swing_radial
+                                          : mapping.grapple.swing_tangential) = sp;
     }
   }
   if (root["heartbeat"].IsDefined()) {

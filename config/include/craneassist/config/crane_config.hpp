@@ -45,6 +45,10 @@ struct ScalingSettings {
   // Sway damping of the hanging grapple (docs/sway.md): the goal velocity input-shaped to the
   // pendulum (a crane whose grapple does not hang has nothing to damp).
   bool sway_damping = true;
+  // The shaper's frequency: the model's (false), or the model's tuned to the swing the machine's
+  // swing sensor measures (true, `sway_frequency: measured`; the model's until it has measured,
+  // and on a machine without a sensor).
+  bool sway_frequency_measured = true;
 };
 
 struct RedundancySettings {
@@ -66,6 +70,15 @@ struct SimulationSettings {
   // The simulated valves' spool lag when it differs from the controller's model
   // (hydraulics.valves.time_constant); negative: the model's.
   double spool_time_constant_s = -1.0;
+  // The simulated machine's swing sensor on the grapple's link (docs/sway.md): white noise of
+  // this standard deviation on each of its two angles, then rounded to the resolution (zero:
+  // exact); swing_sensor false (`swing_sensor: none`): the machine has none.
+  bool swing_sensor = true;
+  double swing_noise_rad = 0.0;
+  double swing_resolution_rad = 0.0;
+  // The simulated machine's grapple when it differs from the controller's model (`grapple`):
+  // the model's values for those left out.
+  std::optional<dynamics::HangingGrapple> grapple;
 };
 
 // Rated load against reach, the horizontal distance from the slew axis to the tip (EN 12999's

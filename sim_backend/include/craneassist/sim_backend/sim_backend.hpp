@@ -21,6 +21,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 
 #include "craneassist/dynamics/model.hpp"
 #include "craneassist/valves/machine_interface.hpp"
@@ -41,6 +42,16 @@ struct SimSettings {
   // The spools' first-order lag when the machine's differs from the controller's model
   // (hydraulics.valves.time_constant); negative: the model's.
   double spool_time_constant_s = -1.0;
+  // The machine's two-axis swing sensor on the grapple's link (MachineState::swing_*;
+  // docs/sway.md): white noise of this standard deviation on each angle, then rounded to the
+  // resolution (0: exact). false: the machine has none (the swing is NaN, as on a machine without
+  // one).
+  bool swing_sensor = true;
+  double swing_noise_rad = 0.0;
+  double swing_resolution_rad = 0.0;
+  // The machine's grapple when it differs from the controller's model (the model's grapple
+  // otherwise): a longer rotator link, another brake.
+  std::optional<dynamics::HangingGrapple> grapple;
 };
 
 class SimBackend final : public valves::MachineInterface {

@@ -35,6 +35,7 @@
 #include "craneassist/dynamics/rigid_body_terms.hpp"
 #include "craneassist/scaling/active_limit.hpp"
 #include "craneassist/scaling/flow_prescaling.hpp"
+#include "craneassist/scaling/swing_frequency.hpp"
 #include "craneassist/scaling/tip_path.hpp"
 #include "craneassist/scaling/tip_scaler.hpp"
 #include "craneassist/valves/machine_interface.hpp"
@@ -126,6 +127,12 @@ struct ControllerOutput {
   LoadOutput load;
   // A stop: how its settling ended (kNone until the valves start to go neutral).
   StopEnd stop_end = StopEnd::kNone;
+  // The sway damping's pendulum (docs/sway.md): the model's period with the load the scale has
+  // found, the period the shaper is tuned to (the model's tuned to the measured swing), and the
+  // periods the swing sensor measured so far (0 while damped on the model; all 0 without a
+  // hanging grapple or with the damping off).
+  double sway_model_period_s = 0.0, sway_period_s = 0.0;
+  int sway_measured_periods = 0;
 };
 
 // The controller's status is the cycle status of the loop (control_loop.hpp).
@@ -228,7 +235,9 @@ class Controller {
   bool overload_ = false;
   bool refusing_ = false;  // the limiter refuses the outward motion (held while pushed on)
   double deceleration_max_ = 1.0, jerk_max_ = 1.0;  // the scaling's, for the stop ahead
-  bool sway_damping_ = false;  // the grapple hangs and scaling.sway_damping is on
+  bool sway_damping_ = false;   // the grapple hangs and scaling.sway_damping is on
+  bool sway_measured_ = false;  // scaling.sway_frequency: measured
+  scaling::SwingFrequencyEstimator swing_frequency_;
 };
 
 }  // namespace craneassist::control

@@ -60,6 +60,9 @@ struct SwingSummary {
   bool released = false;
   double after_release_deg = 0.0;
   double end_deg = 0.0;  // the largest over the run's last second (what still swings)
+  // The sway damping's tuning on the last cycle (ControllerOutput::sway_*; 0: not damping).
+  double model_period_s = 0.0, period_s = 0.0;
+  int measured_periods = 0;
 };
 
 // A replay's waits over a run (its wait rows; ReplayInput, docs/replay-format.md#waits).

@@ -15,6 +15,10 @@ inline sim_backend::SimSettings sim_settings(const config::CraneConfig& cfg) {
   s.pressure_resolution_pa = cfg.simulation.pressure_resolution_pa;
   s.return_pressure_pa = cfg.simulation.return_pressure_pa;
   s.spool_time_constant_s = cfg.simulation.spool_time_constant_s;
+  s.swing_sensor = cfg.simulation.swing_sensor;
+  s.swing_noise_rad = cfg.simulation.swing_noise_rad;
+  s.swing_resolution_rad = cfg.simulation.swing_resolution_rad;
+  s.grapple = cfg.simulation.grapple;
   return s;
 }
 

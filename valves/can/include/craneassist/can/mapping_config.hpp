@@ -102,6 +102,16 @@ struct PumpMapping {
   std::optional<SignalSpec> flow;      // m^3/s (unit L/min, m^3/s, ...)
 };
 
+// The grapple's swing sensor on the bus (optional; docs/can.md, "Swing sensor"): a two-axis
+// inclination of the hanger from the vertical, towards the reach (radial) and across it
+// (tangential, towards a positive slew), as MachineState::swing_* has it. The controller tunes its
+// sway damping to the swing it measures (docs/sway.md); a machine without it is damped on the
+// model alone.
+struct GrappleMapping {
+  std::optional<SignalSpec> swing_radial;      // rad
+  std::optional<SignalSpec> swing_tangential;  // rad
+};
+
 // J1939-81 address claim of craneassist's source address before it sends anything from it
 // (docs/can.md, "Address claim"). Every AVC command and a J1939 (29-bit) heartbeat are sent from
 // `address`.
@@ -122,6 +132,7 @@ struct CanMapping {
   std::vector<JointMapping> joints;
   std::optional<HeartbeatSpec> heartbeat;
   PumpMapping pump;
+  GrappleMapping grapple;
   std::optional<AddressClaimSpec> address_claim;
   std::optional<Dm1Supervision> dm1;  // `diagnostics: {dm1: ...}`
 };
