@@ -153,9 +153,19 @@ TEST(Controller, CycleDoesNotAllocate) {
   state.pressure_b_pa = dynamics::JointVector::Constant(4, 0.3e6);
   controller.update(state, Eigen::Vector3d(0.1, 0.1, 0.1), out);  // first call sizes the output
   const long before = craneassist::test::heap_allocations();
-  for (int k = 0; k < 200; ++k) {
-    state.pressure_a_pa.setConstant(5e6 + 2e4 * k);
-    controller.update(state, Eigen::Vector3d(0.3, 0.2 * (k % 3), -0.4), out);
+  for (int k = 0; k < 600; ++k) {
+    state.pressure_a_pa.setConstant(5e6 + 2e4 * (k % 200));
+    // The swing sensor measures a swing (the period is measured), and a dropout in the middle
+    // hands the shaped reference over (shaping starts again after it on a seeded past).
+    state.t_s = 0.01 * k;
+    state.swing_radial_rad = 0.03 * std::sin(3.3 * state.t_s);
+    state.swing_tangential_rad = 0.02 * std::cos(3.3 * state.t_s);
+    const bool dropout = k >= 250 && k < 260;
+    controller.update(state,
+                      dropout ? Eigen::Vector3d(NAN, 0, 0)
+                              : Eigen::Vector3d(0.3 * std::cos(0.01 * k), 0.2 * (k % 3),
+                                                -0.4 * std::sin(0.01 * k)),
+                      out);
     state.q = out.q_ref;
   }
   controller.update(state, Eigen::Vector3d(NAN, 0, 0), out);
