@@ -38,6 +38,7 @@ TEST(TelemetryConfig, ShippedDefaults) {
   // ROS 2 topics off; when on, ROS 2's default QoS (reliable, volatile) at 50 Hz.
   EXPECT_FALSE(c.ros2.enabled);
   EXPECT_EQ(c.ros2.ros_namespace, "");
+  EXPECT_EQ(c.ros2.node_name, "craneassist");
   expect_topic(c.ros2.joint_states, 50.0, Reliability::kReliable, Durability::kVolatile);
   expect_topic(c.ros2.tip_velocity, 50.0, Reliability::kReliable, Durability::kVolatile);
   EXPECT_EQ(c.ros2.dds_topic("joint_states"), "rt/joint_states");
@@ -49,12 +50,14 @@ TEST(TelemetryConfig, Ros2Settings) {
 ros2:
   enabled: true
   namespace: /site_3/loader7
+  node_name: loader_7
   joint_states: {rate: 20 Hz, reliability: best_effort}
   tip_velocity: {rate: 5 Hz, depth: 4}
 )",
                                                    "r.yaml");
   EXPECT_TRUE(c.ros2.enabled);
   EXPECT_EQ(c.ros2.dds_topic("joint_states"), "rt/site_3/loader7/joint_states");
+  EXPECT_EQ(c.ros2.node_name, "loader_7");
   expect_topic(c.ros2.joint_states, 20.0, Reliability::kBestEffort, Durability::kVolatile);
   expect_topic(c.ros2.tip_velocity, 5.0, Reliability::kReliable, Durability::kVolatile);
   EXPECT_EQ(c.ros2.tip_velocity.depth, 4);
@@ -145,6 +148,9 @@ TEST(TelemetryConfig, ErrorsNameFileLineAndField) {
   expect_error("domian_id: 3\n", 2, "domian_id", "unknown field");
   expect_error("ros2:\n  namespace: crane1\n", 3, "ros2.namespace", "must start with '/'");
   expect_error("ros2:\n  enabled: on\n", 3, "ros2.enabled", "true or false");
+  expect_error("ros2:\n  node_name: crane-1\n", 3, "ros2.node_name", "letters, digits and '_'");
+  expect_error("ros2:\n  node_name: 7crane\n", 3, "ros2.node_name", "not start with a digit");
+  expect_error("ros2:\n  node_name: \"\"\n", 3, "ros2.node_name", "must not be empty");
   expect_error("ros2:\n  joint_states:\n    rate: 2000 Hz\n", 4, "ros2.joint_states.rate",
                "(0, 1000]");
   expect_error("ros2:\n  jointstates: {}\n", 3, "ros2.jointstates", "unknown field");

@@ -166,11 +166,18 @@ TelemetryConfig read_config(const Reader& r, const YAML::Node& root, std::string
     }
   }
   if (const YAML::Node ros = root["ros2"]; ros.IsDefined() && !ros.IsNull()) {
-    r.check_keys(ros, "ros2", {"enabled", "namespace", "joint_states", "tip_velocity"});
+    r.check_keys(ros, "ros2",
+                 {"enabled", "namespace", "node_name", "joint_states", "tip_velocity"});
     c.ros2.enabled = r.flag(ros, "enabled", "ros2", c.ros2.enabled);
     c.ros2.ros_namespace = r.optional_text(ros, "namespace", "ros2");
     if (const std::string why = ros_namespace_error(c.ros2.ros_namespace); !why.empty()) {
       r.fail(ros["namespace"], "ros2.namespace", why);
+    }
+    if (ros["node_name"].IsDefined()) {
+      c.ros2.node_name = r.text(ros, "node_name", "ros2");
+      if (const std::string why = ros_node_name_error(c.ros2.node_name); !why.empty()) {
+        r.fail(ros["node_name"], "ros2.node_name", why);
+      }
     }
     const std::pair<const char*, TopicSettings*> all[] = {{"joint_states", &c.ros2.joint_states},
                                                           {"tip_velocity", &c.ros2.tip_velocity}};
@@ -185,6 +192,19 @@ TelemetryConfig read_config(const Reader& r, const YAML::Node& root, std::string
 }
 
 }  // namespace
+
+std::string ros_node_name_error(std::string_view text) {
+  const std::string hint = " (e.g. craneassist or crane_1)";
+  if (text.empty()) return "must not be empty" + hint;
+  if (text.front() >= '0' && text.front() <= '9') return "must not start with a digit" + hint;
+  for (const char ch : text) {
+    const bool letter = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z');
+    if (!(letter || (ch >= '0' && ch <= '9') || ch == '_')) {
+      return "may hold only letters, digits and '_'" + hint;
+    }
+  }
+  return "";
+}
 
 std::string ros_namespace_error(std::string_view text) {
   if (text.empty()) return "";

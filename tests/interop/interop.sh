@@ -186,8 +186,16 @@ topics:
   joints: {reliability: reliable}   # the last sample compared with joint_states' must arrive
 ros2:
   namespace: /crane1
+  node_name: crane_one
 YAML
-  start_reader 40 /crane1 "$joints" "$command_base"
+  # The type hashes rosidl computes from ROS 2's own .msg files (ros2_type_hash.py): what each
+  # endpoint's USER_DATA must carry.
+  hashes=$(python3 "$(dirname "$0")/ros2_type_hash.py" "$ROS2_MSGDEFS" sensor_msgs/JointState \
+    geometry_msgs/TwistStamped rmw_dds_common/ParticipantEntitiesInfo)
+  hash_of() { echo "$hashes" | awk -v t="$1" '$1 == t { print $2 }'; }
+  start_reader 40 /crane1 "$joints" "$command_base" crane_one \
+    "$(hash_of sensor_msgs/msg/JointState)" "$(hash_of geometry_msgs/msg/TwistStamped)" \
+    "$(hash_of rmw_dds_common/msg/ParticipantEntitiesInfo)"
   run_replay --ros2 --telemetry-config "$work/telemetry.yaml"
   finish_reader telemetry
   [ "$reader_rc" = 0 ] || fail "cyclone ros2 reader: exit $reader_rc"
@@ -195,6 +203,8 @@ YAML
   has reader.out " 0 failed checks"
   has reader.out "last positions = last craneassist q: yes"
   has reader.out "2 hanger joints, swinging"   # the K70M's grapple hangs: the URDF's hanger
+  has reader.out "type hashes as expected: yes; participant enclave=/;: yes"
+  has reader.out "node /crane1/crane_one with the three writers: yes"
   echo "joints: $joints; command in base_link: $command_base"
   echo "ros2 OK"
   ;;

@@ -23,6 +23,10 @@ ParticipantOptions participant_options(const config::TelemetryConfig& c) {
   o.name = c.participant_name;
   o.transport = c.transport;
   o.type_propagation = c.type_propagation;
+  if (c.ros2.enabled) {
+    const char enclave[] = "enclave=/;";  // with its NUL
+    o.user_data.assign(enclave, enclave + sizeof enclave);
+  }
   return o;
 }
 
@@ -53,6 +57,10 @@ ParticipantPtr make_participant(const ParticipantOptions& options) {
 
   fdds::DomainParticipantQos qos = fdds::PARTICIPANT_QOS_DEFAULT;
   qos.name(options.name);
+  if (!options.user_data.empty()) {
+    qos.user_data().data_vec(std::vector<eprosima::fastrtps::rtps::octet>(options.user_data.begin(),
+                                                                          options.user_data.end()));
+  }
   // TYPE_INFORMATION names the types; the TypeLookup service answers a remote reader that asks
   // for them (and for the nested ones) from it.
   qos.wire_protocol().builtin.typelookup_config.use_server =

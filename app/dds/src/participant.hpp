@@ -10,6 +10,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "craneassist/config/telemetry_config.hpp"
 #include "craneassist/dds/topics.hpp"
@@ -29,6 +30,9 @@ struct ParticipantOptions {
   // false: no craneassist type is registered (a test's raw writer registers its own under the
   // same name).
   bool register_types = true;
+  // The participant's USER_DATA (empty: none). With the ROS 2 topics on, ROS 2's `enclave=/;`
+  // (and its NUL, as rmw writes it): ROS 2's graph takes only participants that carry it.
+  std::vector<unsigned char> user_data;
 };
 
 ParticipantOptions participant_options(const config::TelemetryConfig& c);

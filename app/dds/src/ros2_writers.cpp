@@ -3,10 +3,14 @@
 #include <time.h>
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
+#include <iterator>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "craneassist/dds/telemetry_publisher.hpp"
 #include "participant.hpp"
@@ -24,6 +28,24 @@ constexpr const char* kTopicNames[Ros2Writers::kTopics] = {
 constexpr const char* kTypeNames[Ros2Writers::kTopics] = {
     "sensor_msgs::msg::dds_::JointState_", "geometry_msgs::msg::dds_::TwistStamped_",
     "geometry_msgs::msg::dds_::TwistStamped_"};
+constexpr const char* kTypeHashes[Ros2Writers::kTopics] = {
+    kJointStateTypeHash, kTwistStampedTypeHash, kTwistStampedTypeHash};
+
+// An endpoint's USER_DATA as ROS 2 writes it: "typehash=RIHS01_<hex>;" (no NUL).
+void set_type_hash(fdds::DataWriterQos& qos, const char* hash) {
+  const std::string text = std::string("typehash=") + hash + ";";
+  qos.user_data().data_vec(std::vector<eprosima::fastrtps::rtps::octet>(text.begin(), text.end()));
+}
+
+// A GUID as ROS 2's 16-byte Gid: the prefix, then the entity id.
+rmw_dds_common::msg::dds_::Gid_ gid_of(const eprosima::fastrtps::rtps::GUID_t& guid) {
+  rmw_dds_common::msg::dds_::Gid_ gid;
+  std::array<std::uint8_t, 16> data{};
+  std::copy(std::begin(guid.guidPrefix.value), std::end(guid.guidPrefix.value), data.begin());
+  std::copy(std::begin(guid.entityId.value), std::end(guid.entityId.value), data.begin() + 12);
+  gid.data(data);
+  return gid;
+}
 
 // The frame's monotonic stamp on the wall clock (ROS 2 stamps messages with the system time).
 builtin_interfaces::msg::dds_::Time_ wall_stamp(std::int64_t monotonic_stamp_ns) {
@@ -44,6 +66,8 @@ void register_ros2_types(fdds::DomainParticipant& p, const config::TypePropagati
   std::call_once(type_objects, [] { registerros2_msgsTypes(); });
   register_type_support<sensor_msgs::msg::dds_::JointState_PubSubType>(p, propagation);
   register_type_support<geometry_msgs::msg::dds_::TwistStamped_PubSubType>(p, propagation);
+  register_type_support<rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_PubSubType>(p,
+                                                                                       propagation);
 }
 
 Ros2Writers::Ros2Writers(fdds::DomainParticipant& participant, fdds::Publisher& publisher,
@@ -56,7 +80,9 @@ Ros2Writers::Ros2Writers(fdds::DomainParticipant& participant, fdds::Publisher& 
   for (int i = 0; i < kTopics; ++i) {
     const std::string name = settings.dds_topic(kTopicNames[i]);
     fdds::Topic* topic = find_or_create_topic(participant, name, kTypeNames[i]);
-    writers_[i] = publisher.create_datawriter(topic, writer_qos(*qos[i]));
+    fdds::DataWriterQos wqos = writer_qos(*qos[i]);
+    set_type_hash(wqos, kTypeHashes[i]);
+    writers_[i] = publisher.create_datawriter(topic, wqos);
     if (writers_[i] == nullptr)
       throw std::runtime_error("DDS: cannot create the writer of " + name);
   }
@@ -64,6 +90,35 @@ Ros2Writers::Ros2Writers(fdds::DomainParticipant& participant, fdds::Publisher& 
   names.insert(names.end(), info.hanger_joint_names.begin(), info.hanger_joint_names.end());
   joint_state_.name(names);
   hangers_ = std::min(info.hanger_joint_names.size(), std::size_t{2});
+  announce_node(participant, publisher, settings);
+}
+
+void Ros2Writers::announce_node(fdds::DomainParticipant& participant, fdds::Publisher& publisher,
+                                const config::Ros2Settings& settings) {
+  // As rmw_fastrtps does: the DDS topic without the rt/ prefix, reliable, transient local, keep
+  // last 1, the type's hash in USER_DATA; one node, named by the settings, with the three writers.
+  fdds::Topic* topic = find_or_create_topic(participant, "ros_discovery_info",
+                                            "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_");
+  fdds::DataWriterQos qos = fdds::DATAWRITER_QOS_DEFAULT;
+  qos.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
+  qos.durability().kind = fdds::TRANSIENT_LOCAL_DURABILITY_QOS;
+  qos.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+  qos.history().depth = 1;
+  set_type_hash(qos, kParticipantEntitiesInfoTypeHash);
+  discovery_ = publisher.create_datawriter(topic, qos);
+  if (discovery_ == nullptr) {
+    throw std::runtime_error("DDS: cannot create the writer of ros_discovery_info");
+  }
+  rmw_dds_common::msg::dds_::NodeEntitiesInfo_ node;
+  node.node_namespace(settings.ros_namespace.empty() ? "/" : settings.ros_namespace);
+  node.node_name(settings.node_name);
+  for (auto* w : writers_) node.writer_gid_seq().push_back(gid_of(w->guid()));
+  rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_ info;
+  info.gid(gid_of(participant.guid()));
+  info.node_entities_info_seq().push_back(node);
+  if (!discovery_->write(&info)) {
+    throw std::runtime_error("DDS: cannot write ros_discovery_info");
+  }
   twist_.header().frame_id("base_link");
 }
 

@@ -17,6 +17,17 @@
 
 namespace craneassist::dds {
 
+// The RIHS01 type hashes of the ROS 2 (Jazzy) types craneassist publishes, as rosidl computes
+// them: ROS 2 Iron and later read them from each endpoint's USER_DATA (`typehash=...;`).
+// tests/interop/ros2_type_hash.py computes them from ROS 2's .msg files and checks them against
+// published values (docs/ros.md).
+inline constexpr const char* kJointStateTypeHash =
+    "RIHS01_a13ee3a330e346c9d87b5aa18d24e11690752bd33a0350f11c5882bc9179260e";
+inline constexpr const char* kTwistStampedTypeHash =
+    "RIHS01_5f0fcd4f81d5d06ad9b4c4c63e3ea51b82d6ae4d0558f1d475229b1121db6f64";
+inline constexpr const char* kParticipantEntitiesInfoTypeHash =
+    "RIHS01_91a0593bacdcc50ea9bdcf849a938b128412cc1ea821245c663bcd26f83c295e";
+
 // Registers the ROS 2 types on the participant (as `propagation` says).
 void register_ros2_types(eprosima::fastdds::dds::DomainParticipant& p,
                          const config::TypePropagation& propagation);
@@ -42,7 +53,14 @@ class Ros2Writers {
   bool write_joint_states(const TelemetryFrame& f, const Stamp& stamp);
   bool write_twist(int topic, const std::array<double, 3>& v_crane, const Stamp& stamp);
 
+  // ROS 2's graph: the participant's nodes and their endpoints on ros_discovery_info (one
+  // sample, transient local: a ROS 2 tool started later gets it too).
+  void announce_node(eprosima::fastdds::dds::DomainParticipant& participant,
+                     eprosima::fastdds::dds::Publisher& publisher,
+                     const config::Ros2Settings& settings);
+
   eprosima::fastdds::dds::DataWriter* writers_[kTopics] = {};
+  eprosima::fastdds::dds::DataWriter* discovery_ = nullptr;
   TopicPacer pacers_[kTopics];
   std::array<double, 9> base_from_crane_;
   sensor_msgs::msg::dds_::JointState_ joint_state_;

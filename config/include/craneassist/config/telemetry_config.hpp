@@ -115,6 +115,9 @@ struct Ros2Settings {
   bool enabled = false;
   // The ROS 2 namespace of the topics: "" or "/name[/name...]" (ROS name characters).
   std::string ros_namespace;
+  // The node ROS 2 sees the topics belong to (`ros2 node list`: <namespace>/<node_name>), named
+  // on the graph's ros_discovery_info topic: letters, digits and '_', not starting with a digit.
+  std::string node_name = "craneassist";
   // /joint_states: sensor_msgs/msg/JointState, the joints by their URDF names.
   TopicSettings joint_states{50.0, Reliability::kReliable, Durability::kVolatile, 1};
   // /craneassist/tip_velocity/command and .../reference: geometry_msgs/msg/TwistStamped in
@@ -126,6 +129,10 @@ struct Ros2Settings {
     return "rt" + ros_namespace + "/" + std::string(ros_name);
   }
 };
+
+// Why `text` is not a ROS 2 node name (letters, digits and '_', not empty, not starting with a
+// digit); "" when it is one.
+std::string ros_node_name_error(std::string_view text);
 
 // Why `text` is not a ROS 2 namespace ("" or "/a/b" from letters, digits and '_', no segment
 // starting with a digit, no empty segment, no trailing '/'); "" when it is one.
