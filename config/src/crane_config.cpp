@@ -116,15 +116,6 @@ class Reader : public YamlReader {
     return v;
   }
 
-  // One of `values` by its name (required); else a failure "expected A, B or C, got 'X'".
-  template <typename Enum, std::size_t N>
-  Enum one_of(const YAML::Node& map, const std::string& key, const std::string& path,
-              const std::array<Enum, N>& values) const {
-    const std::string name = text(map, key, path);
-    if (const auto value = parse_name(values, name)) return *value;
-    fail(map[key], join(path, key), "expected " + alternatives(values) + ", got '" + name + "'");
-  }
-
   int unsourced() const { return unsourced_; }
 
  private:

@@ -44,14 +44,6 @@ class SuiteReader : public config::YamlReader {
     return v;
   }
 
-  bool flag(const YAML::Node& node, const std::string& key, const std::string& path) const {
-    const std::string text = this->text(node, key, path);
-    if (text != "true" && text != "false") {
-      fail(node[key], join(path, key), "expected true or false, got '" + text + "'");
-    }
-    return text == "true";
-  }
-
   void targets(const YAML::Node& node, const std::string& path, SuiteTargets& t) const {
     check_keys(node, path,
                {"stall_events", "lateral_speed", "peak_power", "direction_error", "residual_swing",
@@ -172,17 +164,12 @@ Suite parse_suite(std::string_view yaml_text, std::string_view source_name,
       if (node["payload"].IsDefined()) {
         run.payload_kg = r.quantity(node, "payload", path, config::Dimension::kMass, 0.0, 1e5);
       }
-      if (node["payload_known"].IsDefined())
-        run.payload_known = r.flag(node, "payload_known", path);
-      if (node["sway_damping"].IsDefined()) run.sway_damping = r.flag(node, "sway_damping", path);
+      run.payload_known = r.flag(node, "payload_known", path, false);
+      if (node["sway_damping"].IsDefined()) {
+        run.sway_damping = r.flag(node, "sway_damping", path, true);
+      }
       if (node["scaling"].IsDefined()) {
-        const std::string mode = r.text(node, "scaling", path);
-        const auto parsed = control::parse_scaling_mode(mode);
-        if (!parsed) {
-          r.fail(node["scaling"], path + ".scaling",
-                 "expected full, flow or none, got '" + mode + "'");
-        }
-        run.scaling = *parsed;
+        run.scaling = r.one_of(node, "scaling", path, control::kScalingModes);
       }
       if (node["wait_swing"].IsDefined()) {
         run.wait_swing_rad =

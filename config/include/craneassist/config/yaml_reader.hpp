@@ -5,6 +5,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <array>
+#include <cstddef>
 #include <filesystem>
 #include <initializer_list>
 #include <optional>
@@ -13,6 +15,7 @@
 #include <utility>
 
 #include "craneassist/config/config_error.hpp"
+#include "craneassist/dynamics/enum_names.hpp"
 
 namespace craneassist::config {
 
@@ -76,7 +79,8 @@ class YamlReader {
     return node.Scalar();
   }
 
-  // true or false; fallback when the key is absent.
+  // true or false; fallback when the key is absent. Else a failure "expected true or false"
+  // (", got 'X'" for a single value).
   bool flag(const YAML::Node& map, const std::string& key, const std::string& path,
             bool fallback) const {
     const YAML::Node node = map[key];
@@ -84,7 +88,18 @@ class YamlReader {
     if (node.IsScalar() && (node.Scalar() == "true" || node.Scalar() == "false")) {
       return node.Scalar() == "true";
     }
-    fail(node, join(path, key), "expected true or false");
+    fail(node, join(path, key),
+         node.IsScalar() ? "expected true or false, got '" + node.Scalar() + "'"
+                         : std::string("expected true or false"));
+  }
+
+  // One of `values` by its name (required); else a failure "expected A, B or C, got 'X'".
+  template <typename Enum, std::size_t N>
+  Enum one_of(const YAML::Node& map, const std::string& key, const std::string& path,
+              const std::array<Enum, N>& values) const {
+    const std::string name = text(map, key, path);
+    if (const auto value = parse_name(values, name)) return *value;
+    fail(map[key], join(path, key), "expected " + alternatives(values) + ", got '" + name + "'");
   }
 
   static std::string join(const std::string& path, const std::string& key) {
