@@ -505,20 +505,31 @@ void read_hydraulics(Reader& r, const YAML::Node& root, dynamics::CraneModel& mo
   }
 }
 
+// The hanging grapple's values in `node` (at `path`) into g: all of them (required), or those the
+// node names (the others stay).
+void read_grapple_values(Reader& r, const YAML::Node& node, const std::string& path, bool required,
+                         dynamics::HangingGrapple& g) {
+  const auto given = [&](const char* key) { return required || node[key].IsDefined(); };
+  if (given("hanger_length")) {
+    g.com_below_m = r.value_in(node, "hanger_length", path, Dimension::kLength, 0.05, 10.0,
+                               "between 5 cm and 10 m");
+  }
+  if (given("load_below")) {
+    g.load_below_m = r.value_in(node, "load_below", path, Dimension::kLength, 0.05, 10.0,
+                                "between 5 cm and 10 m");
+  }
+  if (given("damping")) {
+    g.damping_n_m_s_rad = r.value_in(node, "damping", path, Dimension::kRotaryDamping, 0.0, 1e6,
+                                     "between 0 and 1000 kN*m*s/rad");
+  }
+}
+
 // Optional hanging grapple (docs/sway.md): the bodies at the tip and the payload hang from it on a
 // two-axis link in the simulator.
 void read_grapple(Reader& r, const YAML::Node& root, dynamics::CraneModel& model) {
   const auto section =
       r.optional_section(root, "grapple", "", {"hanger_length", "load_below", "damping"});
-  if (!section) return;
-  const YAML::Node& node = *section;
-  auto& g = model.grapple;
-  g.com_below_m = r.value_in(node, "hanger_length", "grapple", Dimension::kLength, 0.05, 10.0,
-                             "between 5 cm and 10 m");
-  g.load_below_m = r.value_in(node, "load_below", "grapple", Dimension::kLength, 0.05, 10.0,
-                              "between 5 cm and 10 m");
-  g.damping_n_m_s_rad = r.value_in(node, "damping", "grapple", Dimension::kRotaryDamping, 0.0, 1e6,
-                                   "between 0 and 1000 kN*m*s/rad");
+  if (section) read_grapple_values(r, *section, "grapple", true, model.grapple);
 }
 
 // The simulated machine's swing sensor and grapple, where they differ from the default (an exact
@@ -539,27 +550,15 @@ void read_simulated_grapple(Reader& r, const YAML::Node& sim, CraneConfig& cfg) 
     cfg.simulation.swing_resolution_rad =
         r.value_in(ss, "resolution", sp, Dimension::kAngle, 0.0, 0.1, "between 0 and 5.7 deg");
   }
-  const std::string gp = "simulation.grapple";
   const auto section =
       r.optional_section(sim, "grapple", "simulation", {"hanger_length", "load_below", "damping"});
   if (!section) return;
-  const YAML::Node& node = *section;
   if (!cfg.model.grapple.hangs()) {
-    r.fail(node, gp, "the crane has no hanging grapple (no grapple section) to differ from");
+    r.fail(*section, "simulation.grapple",
+           "the crane has no hanging grapple (no grapple section) to differ from");
   }
   dynamics::HangingGrapple g = cfg.model.grapple;
-  if (node["hanger_length"].IsDefined()) {
-    g.com_below_m = r.value_in(node, "hanger_length", gp, Dimension::kLength, 0.05, 10.0,
-                               "between 5 cm and 10 m");
-  }
-  if (node["load_below"].IsDefined()) {
-    g.load_below_m =
-        r.value_in(node, "load_below", gp, Dimension::kLength, 0.05, 10.0, "between 5 cm and 10 m");
-  }
-  if (node["damping"].IsDefined()) {
-    g.damping_n_m_s_rad = r.value_in(node, "damping", gp, Dimension::kRotaryDamping, 0.0, 1e6,
-                                     "between 0 and 1000 kN*m*s/rad");
-  }
+  read_grapple_values(r, *section, "simulation.grapple", false, g);
   cfg.simulation.grapple = g;
 }
 

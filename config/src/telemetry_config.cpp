@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -193,15 +194,25 @@ TelemetryConfig read_config(const Reader& r, const YAML::Node& root, std::string
 
 }  // namespace
 
+namespace {
+
+bool is_digit(char ch) {
+  return ch >= '0' && ch <= '9';
+}
+
+// A character of a ROS 2 name (a node name, a namespace's segment): an ASCII letter, digit or '_'.
+bool is_ros_name_char(char ch) {
+  return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || is_digit(ch) || ch == '_';
+}
+
+}  // namespace
+
 std::string ros_node_name_error(std::string_view text) {
   const std::string hint = " (e.g. craneassist or crane_1)";
   if (text.empty()) return "must not be empty" + hint;
-  if (text.front() >= '0' && text.front() <= '9') return "must not start with a digit" + hint;
-  for (const char ch : text) {
-    const bool letter = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z');
-    if (!(letter || (ch >= '0' && ch <= '9') || ch == '_')) {
-      return "may hold only letters, digits and '_'" + hint;
-    }
+  if (is_digit(text.front())) return "must not start with a digit" + hint;
+  if (!std::all_of(text.begin(), text.end(), is_ros_name_char)) {
+    return "may hold only letters, digits and '_'" + hint;
   }
   return "";
 }
@@ -219,12 +230,8 @@ std::string ros_namespace_error(std::string_view text) {
       segment_start = true;
       continue;
     }
-    const bool letter = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z');
-    const bool digit = ch >= '0' && ch <= '9';
-    if (!(letter || digit || ch == '_')) {
-      return "may hold only letters, digits, '_' and '/'" + hint;
-    }
-    if (segment_start && digit) return "a segment may not start with a digit" + hint;
+    if (!is_ros_name_char(ch)) return "may hold only letters, digits, '_' and '/'" + hint;
+    if (segment_start && is_digit(ch)) return "a segment may not start with a digit" + hint;
     segment_start = false;
   }
   return "";
