@@ -42,6 +42,10 @@ Eigen::Vector3d grapple_position(const CraneModel& m, const Eigen::Vector3d& tip
   return tip_base + m.grapple.com_below_m * along.normalized();
 }
 
+double swing_angle(double radial_rad, double tangential_rad) noexcept {
+  return std::atan(std::hypot(std::tan(radial_rad), std::tan(tangential_rad)));
+}
+
 double Pendulum::period_s() const {
   if (!(omega_rad_s > 0.0) || !(zeta < 1.0)) return std::numeric_limits<double>::infinity();
   return 2.0 * M_PI / (omega_rad_s * std::sqrt(1.0 - zeta * zeta));

@@ -45,6 +45,15 @@ dynamics::CraneModel without_tip_load(const dynamics::CraneModel& m) {
   return out;
 }
 
+// What a sensor reads of x: with white noise of this standard deviation, then rounded to the
+// resolution (each 0: none).
+double sensed(double x, double noise, double resolution, std::mt19937& rng,
+              std::normal_distribution<double>& normal) {
+  if (noise > 0.0) x += noise * normal(rng);
+  if (resolution > 0.0) x = resolution * std::round(x / resolution);
+  return x;
+}
+
 // The machine's model: the controller's, with the machine's own grapple where it differs.
 dynamics::CraneModel with_plant_grapple(const dynamics::CraneModel& m, const SimSettings& s) {
   dynamics::CraneModel out = m;
@@ -197,7 +206,8 @@ struct SimBackend::Impl {
 
   // The hanger's swing from the vertical and its components towards and across the reach.
   void measure_swing(valves::MachineState& state) const {
-    if (payload_body == nullptr) return;
+    // Nothing hangs, or the machine measures no swing (NaN).
+    if (payload_body == nullptr || !settings.swing_sensor) return;
     dVector3 anchor;
     dJointGetUniversalAnchor(load_joint, anchor);
     const dReal* c = dBodyGetPosition(load_body);
@@ -206,19 +216,13 @@ struct SimBackend::Impl {
     Eigen::Vector3d radial, tangential;
     dynamics::swing_axes(Eigen::Vector3d(anchor[0], anchor[1], anchor[2]), radial, tangential);
     const double vertical = r.dot(down);
-    if (!settings.swing_sensor) return;  // the machine measures no swing (NaN)
     // The two-axis sensor: each angle with its noise and resolution; the swing from them.
-    double angles[2] = {std::atan2(r.dot(radial), vertical),
-                        std::atan2(r.dot(tangential), vertical)};
-    for (double& a : angles) {
-      if (settings.swing_noise_rad > 0.0) a += settings.swing_noise_rad * swing_normal(swing_rng);
-      if (settings.swing_resolution_rad > 0.0) {
-        a = settings.swing_resolution_rad * std::round(a / settings.swing_resolution_rad);
-      }
-    }
-    state.swing_radial_rad = angles[0];
-    state.swing_tangential_rad = angles[1];
-    state.swing_rad = std::atan(std::hypot(std::tan(angles[0]), std::tan(angles[1])));
+    state.swing_radial_rad = sensed(std::atan2(r.dot(radial), vertical), settings.swing_noise_rad,
+                                    settings.swing_resolution_rad, swing_rng, swing_normal);
+    state.swing_tangential_rad =
+        sensed(std::atan2(r.dot(tangential), vertical), settings.swing_noise_rad,
+               settings.swing_resolution_rad, swing_rng, swing_normal);
+    state.swing_rad = dynamics::swing_angle(state.swing_radial_rad, state.swing_tangential_rad);
   }
 
   // Holds every joint for a few steps so feedback carries the static loads.
@@ -365,10 +369,8 @@ struct SimBackend::Impl {
   }
 
   double sensor(double p) {
-    if (settings.pressure_noise_pa > 0.0) p += settings.pressure_noise_pa * normal(rng);
-    const double res = settings.pressure_resolution_pa;
-    if (res > 0.0) p = res * std::round(p / res);
-    return std::max(p, 0.0);
+    return std::max(
+        sensed(p, settings.pressure_noise_pa, settings.pressure_resolution_pa, rng, normal), 0.0);
   }
 
   void step() {

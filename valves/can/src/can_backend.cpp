@@ -7,12 +7,14 @@
 #include <cstdarg>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 
 #include "can_backend_impl.hpp"
 #include "craneassist/can/heartbeat.hpp"
 #include "craneassist/can/valve_frames.hpp"
 #include "craneassist/config/config_error.hpp"
+#include "craneassist/dynamics/pendulum.hpp"
 
 namespace craneassist::can {
 
@@ -294,31 +296,24 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
         (side == 0 ? j.pa : j.pb) = value;
       }
     }
-    for (int which = 0; which < 2; ++which) {
-      const auto& spec = which == 0 ? m.pump_map.pressure : m.pump_map.flow;
-      if (!spec || spec->id != f.id || spec->extended != f.extended) continue;
+    // The informational signals (pump, swing sensor): a frame that does not decode is counted,
+    // not a fault (the measurement goes stale).
+    const auto informational = [&](const std::optional<SignalSpec>& spec, double& value,
+                                   std::int64_t& last_us) {
+      if (!spec || spec->id != f.id || spec->extended != f.extended) return;
       known = true;
-      double value = 0.0;
-      const auto st = decode(*spec, f, value);
-      if (st != SignalStatus::kOk) {  // informational: counted, not a fault
+      double decoded = 0.0;
+      if (decode(*spec, f, decoded) != SignalStatus::kOk) {
         m.counters.bad_frames.fetch_add(1, std::memory_order_relaxed);
-        continue;
+        return;
       }
-      (which == 0 ? m.pump_pressure_pa : m.pump_flow_m3_s) = value;
-      m.pump_last_us = taken_us;
-    }
-    for (int axis = 0; axis < 2; ++axis) {
-      const auto& spec = axis == 0 ? m.grapple_map.swing_radial : m.grapple_map.swing_tangential;
-      if (!spec || spec->id != f.id || spec->extended != f.extended) continue;
-      known = true;
-      double value = 0.0;
-      if (decode(*spec, f, value) != SignalStatus::kOk) {  // counted: the swing goes unmeasured
-        m.counters.bad_frames.fetch_add(1, std::memory_order_relaxed);
-        continue;
-      }
-      m.swing_rad[axis] = value;
-      m.swing_last_us[axis] = taken_us;
-    }
+      value = decoded;
+      last_us = taken_us;
+    };
+    informational(m.pump_map.pressure, m.pump_pressure_pa, m.pump_last_us);
+    informational(m.pump_map.flow, m.pump_flow_m3_s, m.pump_last_us);
+    informational(m.grapple_map.swing_radial, m.swing_rad[0], m.swing_last_us[0]);
+    informational(m.grapple_map.swing_tangential, m.swing_rad[1], m.swing_last_us[1]);
     if (!known) m.counters.unknown_frames.fetch_add(1, std::memory_order_relaxed);
   }
 
@@ -368,7 +363,7 @@ valves::BackendStatus CanBackend::read(valves::MachineState& state) {
   if (fresh_swing(0) && fresh_swing(1)) {
     state.swing_radial_rad = m.swing_rad[0];
     state.swing_tangential_rad = m.swing_rad[1];
-    state.swing_rad = std::atan(std::hypot(std::tan(m.swing_rad[0]), std::tan(m.swing_rad[1])));
+    state.swing_rad = dynamics::swing_angle(m.swing_rad[0], m.swing_rad[1]);
   }
   // Until the address is claimed the valves are not commanded: no state to control from.
   state.valid = fresh && !faulted() && m.claimed();

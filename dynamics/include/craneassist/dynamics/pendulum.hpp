@@ -31,6 +31,11 @@ void swing_axes(const Eigen::Vector3d& tip_base, Eigen::Vector3d& radial,
 Eigen::Vector3d grapple_position(const CraneModel& m, const Eigen::Vector3d& tip_base,
                                  double radial_rad, double tangential_rad) noexcept;
 
+// The swing from the vertical of a hanger whose angles towards the reach and across it are
+// radial_rad and tangential_rad (each in its vertical plane, as a two-axis sensor measures them):
+// atan(hypot(tan radial, tan tangential)). NaN where either is.
+double swing_angle(double radial_rad, double tangential_rad) noexcept;
+
 struct Pendulum {
   double omega_rad_s = 0.0;  // undamped natural frequency; 0: nothing hangs
   double zeta = 0.0;         // damping ratio of the link's damping
