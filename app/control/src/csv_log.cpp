@@ -2,28 +2,16 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
+#include <type_traits>
+
+#include "craneassist/control/log_fields.hpp"
 
 namespace craneassist::control {
 
 std::string CsvLog::header(int dof, bool base) {
-  std::string h =
-      "t,cmd_vx,cmd_vy,cmd_vz,ref_vx,ref_vy,ref_vz,tip_x,tip_y,tip_z,tip_vx,tip_vy,tip_vz";
-  for (int i = 1; i <= dof; ++i) h += ",q" + std::to_string(i);
-  for (int i = 1; i <= dof; ++i) h += ",q" + std::to_string(i) + "_ref";
-  h += ",pump_flow_m3s,pump_pressure_pa,pump_power_w,energy_j,active_limit,scale,flow_demand_m3s,"
-       "pump_limit";
-  h += ",s,sdot,sddot,sdddot,sddot_min,sddot_max,tip_error_m,ref_power_w";
-  h += ",avail_speed_m_s,avail_speed_resolved_m_s,polytope_volume_m3s3";
-  for (int i = 1; i <= dof; ++i) h += ",spool" + std::to_string(i);
-  for (int i = 1; i <= dof; ++i) h += ",p_load" + std::to_string(i) + "_pa";
-  h += ",load_kg,payload_estimate_kg,load_moment_ratio,status";
-  h += ",swing_deg,swing_radial_deg,swing_tangential_deg";
-  if (base) {
-    h += ",base_x,base_y,base_phi,base_v,base_omega,base_v_cmd,base_omega_cmd,base_flow_fl_m3s,"
-         "base_flow_fr_m3s,base_flow_rl_m3s,base_flow_rr_m3s,base_flow_sum_m3s,base_flow_max_m3s";
-  }
-  return h;
+  return csv_header(dof, base);
 }
 
 CsvLog::CsvLog(const std::filesystem::path& path, int dof, std::size_t capacity_rows, bool base)
@@ -41,56 +29,43 @@ CsvLog::~CsvLog() {
 }
 
 bool CsvLog::push(const LogRow& row) noexcept {
-  const std::size_t head = head_.load(std::memory_order_relaxed);
-  const std::size_t next = (head + 1) % ring_.size();
-  if (next == tail_.load(std::memory_order_acquire)) {
-    dropped_.fetch_add(1, std::memory_order_relaxed);
-    return false;
-  }
-  ring_[head] = row;
-  head_.store(next, std::memory_order_release);
-  return true;
+  if (ring_.push(row)) return true;
+  dropped_.fetch_add(1, std::memory_order_relaxed);
+  return false;
 }
 
 void CsvLog::write_row(const LogRow& r) {
-  std::fprintf(file_, "%.4f,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6f,%.6f,%.6f,%.6g,%.6g,%.6g", r.t,
-               r.cmd[0], r.cmd[1], r.cmd[2], r.ref_v[0], r.ref_v[1], r.ref_v[2], r.tip[0], r.tip[1],
-               r.tip[2], r.tip_v[0], r.tip_v[1], r.tip_v[2]);
-  for (int i = 0; i < dof_; ++i) std::fprintf(file_, ",%.7f", r.q[static_cast<std::size_t>(i)]);
-  for (int i = 0; i < dof_; ++i) std::fprintf(file_, ",%.7f", r.q_ref[static_cast<std::size_t>(i)]);
-  std::fprintf(file_, ",%.6g,%.6g,%.6g,%.6g,%s,%.6g,%.6g,%s", r.pump_flow_m3s, r.pump_pressure_pa,
-               r.pump_power_w, r.energy_j, r.active_limit, r.scale, r.flow_demand_m3s,
-               r.pump_limit);
-  std::fprintf(file_, ",%.6f,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g", r.s, r.sdot, r.sddot, r.sdddot,
-               r.sddot_min, r.sddot_max, r.tip_error_m, r.ref_power_w);
-  std::fprintf(file_, ",%.6g,%.6g,%.6g", r.avail_speed_m_s, r.avail_speed_resolved_m_s,
-               r.polytope_volume_m3s3);
-  for (int i = 0; i < dof_; ++i) std::fprintf(file_, ",%.5f", r.spool[static_cast<std::size_t>(i)]);
-  for (int i = 0; i < dof_; ++i) {
-    std::fprintf(file_, ",%.6g", r.load_pressure[static_cast<std::size_t>(i)]);
-  }
-  // The simulator's truth is empty on a machine (NaN).
-  if (std::isfinite(r.load_kg)) {
-    std::fprintf(file_, ",%.6g", r.load_kg);
-  } else {
-    std::fputc(',', file_);
-  }
-  std::fprintf(file_, ",%.6g,%.6g,%s", r.payload_estimate_kg, r.load_moment_ratio, r.status);
-  // Empty where nothing measures the swing (a rigid tip, a machine without a swing sensor).
-  for (const double rad : {r.swing_rad, r.swing_radial_rad, r.swing_tangential_rad}) {
-    if (std::isfinite(rad)) {
-      std::fprintf(file_, ",%.4f", rad * 180.0 / M_PI);
-    } else {
-      std::fputc(',', file_);
+  bool first = true;
+  const auto cell = [&](const Field& f, double x, std::size_t component) {
+    if (!first) std::fputc(',', file_);
+    first = false;
+    if (f.csv_empty_if_nan && !std::isfinite(x)) return;
+    // The component's format where the field lists one per component.
+    const char* format = f.csv_format;
+    for (std::size_t k = 0; k < component && std::strchr(format, ',') != nullptr; ++k) {
+      format = std::strchr(format, ',') + 1;
     }
-  }
-  if (base_) {
-    std::fprintf(file_, ",%.6f,%.6f,%.7f,%.6g,%.6g,%.6g,%.6g", r.base_pose[0], r.base_pose[1],
-                 r.base_pose[2], r.base_velocity[0], r.base_velocity[1], r.base_command[0],
-                 r.base_command[1]);
-    for (double q : r.base_motor_flow) std::fprintf(file_, ",%.6g", q);
-    std::fprintf(file_, ",%.6g,%.6g", r.base_flow_sum_m3s, r.base_flow_max_m3s);
-  }
+    char one[16];
+    const std::size_t length = std::strcspn(format, ",");
+    if (length >= sizeof one) return;
+    std::memcpy(one, format, length);
+    one[length] = '\0';
+    std::fprintf(file_, one, x * f.csv_scale);
+  };
+  visit_fields(r, [&](const Field& f, const auto& value) {
+    using T = std::decay_t<decltype(value)>;
+    if (f.csv == nullptr || (f.base_only && !base_)) return;
+    if constexpr (std::is_same_v<T, const char*>) {
+      if (!first) std::fputc(',', file_);
+      first = false;
+      std::fputs(value, file_);
+    } else if constexpr (std::is_arithmetic_v<T>) {
+      cell(f, static_cast<double>(value), 0);
+    } else {
+      const std::size_t n = f.per_joint ? static_cast<std::size_t>(dof_) : value.size();
+      for (std::size_t k = 0; k < n; ++k) cell(f, value[k], f.per_joint ? 0 : k);
+    }
+  });
   std::fputc('\n', file_);
   written_.fetch_add(1, std::memory_order_relaxed);
 }
@@ -98,12 +73,9 @@ void CsvLog::write_row(const LogRow& r) {
 void CsvLog::writer_loop() {
   for (;;) {
     const bool stopping = stop_.load(std::memory_order_acquire);
-    std::size_t tail = tail_.load(std::memory_order_relaxed);
-    const std::size_t head = head_.load(std::memory_order_acquire);
-    while (tail != head) {
-      write_row(ring_[tail]);
-      tail = (tail + 1) % ring_.size();
-      tail_.store(tail, std::memory_order_release);
+    while (const LogRow* row = ring_.front()) {
+      write_row(*row);
+      ring_.pop();
     }
     if (stopping) return;  // everything pushed before stop_ was set has been written
     std::this_thread::sleep_for(std::chrono::milliseconds(2));

@@ -87,6 +87,8 @@ void LogRowBuilder::fill(LogRow& row, double t, const Eigen::Vector3d& cmd,
   row.load_moment_ratio = out.load.moment_ratio;
   row.rated_load_kg = out.load.rated_kg;
   row.load_reach_m = out.load.reach_m;
+  row.flow_limit_m3s = model_.pump.max_flow_m3_s;
+  row.power_limit_w = model_.pump.prime_mover_power_w;
   row.payload_converged = out.load.converged;
   row.load_warning = out.load.warning;
   row.load_overload = out.load.overload;

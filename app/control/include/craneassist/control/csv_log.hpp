@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "craneassist/control/spsc_ring.hpp"
 #include "craneassist/dynamics/model.hpp"
 #include "craneassist/valves/machine_interface.hpp"
 
@@ -49,6 +50,9 @@ struct LogRow {
   // Live and telemetry only (not in the CSV): the chart's rated load at the reach, the reach,
   // and the scale's and limiter's state.
   double rated_load_kg = 0.0, load_reach_m = 0.0;
+  // The pump's limits (the model's; live and telemetry only): what pump_flow_m3s and
+  // pump_power_w are plotted against.
+  double flow_limit_m3s = 0.0, power_limit_w = 0.0;
   bool payload_converged = false, load_warning = false, load_overload = false;
   const char* active_limit = "";  // static strings only (to_string of the enums)
   const char* pump_limit = "";
@@ -116,9 +120,7 @@ class CsvLog {
   int dof_;
   bool base_ = false;
   std::FILE* file_ = nullptr;
-  std::vector<LogRow> ring_;
-  std::atomic<std::size_t> head_{0};  // next slot the producer writes
-  std::atomic<std::size_t> tail_{0};  // next slot the consumer reads
+  SpscRing<LogRow> ring_;
   std::atomic<bool> stop_{false};
   std::atomic<std::size_t> dropped_{0};
   std::atomic<std::size_t> written_{0};
