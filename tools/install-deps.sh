@@ -16,6 +16,7 @@ packages=(
   liburdfdom-dev liburdfdom-tools  # reads back the URDF of craneassist urdf (docs/ros.md)
   python3-can python3-canmatrix  # decode craneassist's CAN logs through its DBC (docs/can.md)
   libnlopt-dev  # the MHSB planner's optimal posture table (SLSQP; docs/mhsb.md)
+  libzstd-dev  # the MCAP recordings' chunk compression (docs/foxglove.md)
 )
 # npm bundles the web page at build time (Debian's npm, unless node and npm are already there).
 command -v npm >/dev/null || packages+=(npm)

@@ -17,6 +17,7 @@
 #include "energy_command.hpp"
 #include "exit_codes.hpp"
 #include "experiment_command.hpp"
+#include "fields_command.hpp"
 #include "follow_command.hpp"
 #include "plan_command.hpp"
 #include "polytope_command.hpp"
@@ -68,6 +69,7 @@ int main(int argc, char** argv) {
   add(commands, cli, add_suite_command, run_suite_command);
   add(commands, cli, add_bound_command, run_bound_command);
   add(commands, cli, add_urdf_command, run_urdf_command);
+  add(commands, cli, add_fields_command, run_fields_command);
   add(commands, cli, add_polytope_command, run_polytope_command);
   add(commands, cli, add_follow_command, run_follow_command);
   add(commands, cli, add_ptp_command, run_ptp_command);

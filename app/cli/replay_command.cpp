@@ -385,10 +385,15 @@ int run_replay_command(const ReplayArgs& args) {
     if (!args.no_log) log.emplace(args.log_file, cfg.model.dof());
     control::RunOptions options;
     if (control::CycleObserver* o = telemetry.observer()) options.observers.push_back(o);
+    options.realtime = args.realtime || machine.real_time();
+    FoxgloveOutputs foxglove;
+    if (const int rc = foxglove.open(args.foxglove, cfg, false, options.realtime); rc != kExitOk) {
+      return rc;
+    }
+    foxglove.add_observers(options.observers);
     options.controller.mode = args.no_scaling ? control::ScalingMode::kNone
                                               : control::parse_scaling_mode(args.scaling).value();
     options.controller.payload_known = args.payload_known;
-    options.realtime = args.realtime || machine.real_time();
     options.settle_s = args.settle_s;
     options.freeze_at_s = args.freeze_at_s;
     options.freeze_for_s = args.freeze_for_s;
@@ -401,6 +406,7 @@ int run_replay_command(const ReplayArgs& args) {
     print_summary(summary, cfg, replay_name, options, replay.end_time_s(), log ? &*log : nullptr,
                   machine.name());
     telemetry.finish();
+    if (const int rc = foxglove.finish(); rc != kExitOk) return rc;
     if (summary.log_rows_dropped > 0) {
       spdlog::warn("the log writer fell behind: {} rows dropped", summary.log_rows_dropped);
     }
@@ -428,6 +434,7 @@ CLI::App* add_replay_command(CLI::App& cli, ReplayArgs& args) {
   add_config_option(*replay, args.config_file);
   add_backend_options(*replay, args.machine);
   add_telemetry_options(*replay, args.telemetry, false);
+  add_foxglove_options(*replay, args.foxglove);
   replay->add_option("--test-freeze-at", args.freeze_at_s)->check(FiniteNumber())->group("");
   replay->add_option("--test-freeze-for", args.freeze_for_s)->check(FiniteNumber())->group("");
   replay->add_option("--log", args.log_file, "Per-cycle CSV log (docs/log-format.md)")

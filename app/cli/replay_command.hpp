@@ -10,6 +10,7 @@
 #include "craneassist/control/controller.hpp"
 #include "craneassist/control/replay_runner.hpp"
 #include "craneassist/control/run_statistics.hpp"
+#include "foxglove_setup.hpp"
 #include "machine_setup.hpp"
 #include "telemetry_setup.hpp"
 
@@ -21,6 +22,7 @@ struct ReplayArgs {
   std::string config_file;      // empty: the embedded reference crane
   BackendArgs machine;          // the machine (empty values: the config's backend: and can:)
   TelemetryArgs telemetry;      // --telemetry: publish DDS telemetry during the replay
+  FoxgloveArgs foxglove;        // --mcap FILE, --foxglove [HOST:]PORT (docs/foxglove.md)
   double freeze_at_s = -1.0;    // test hook: freeze the loop at this machine time
   double freeze_for_s = 0.0;
   std::string log_file = "craneassist-log.csv";

@@ -240,6 +240,7 @@ CLI::App* add_sim_command(CLI::App& cli, SimArgs& args) {
                   "the drive first) or separate (default: the base config's)")
       ->check(CLI::IsMember({"shared", "separate"}));
   add_telemetry_options(*sim, args.telemetry, true);
+  add_foxglove_options(*sim, args.foxglove);
   add_web_options(*sim, args.web);
   return sim;
 }
@@ -446,6 +447,12 @@ int run_sim_command(const SimArgs& args) {
     options.realtime_setup.cpu = args.cpu;
     if (control::CycleObserver* o = telemetry.observer()) options.observers.push_back(o);
     if (control::CycleObserver* o = web.observer()) options.observers.push_back(o);
+    FoxgloveOutputs foxglove;
+    if (const int rc = foxglove.open(args.foxglove, cfg, base.has_value(), options.realtime);
+        rc != kExitOk) {
+      return rc;
+    }
+    foxglove.add_observers(options.observers);
     if (!args.record_file.empty()) {
       options.record = &record;
       if (options.duration_s > 0.0) {
@@ -552,6 +559,7 @@ int run_sim_command(const SimArgs& args) {
                   s.record_rows_dropped > 0 ? ", SOME DROPPED" : "");
     }
     telemetry.finish();
+    if (const int rc = foxglove.finish(); rc != kExitOk) return rc;
     if (s.log_rows_dropped > 0) spdlog::warn("{} log rows dropped", s.log_rows_dropped);
     if (s.machine_fault) spdlog::error("the machine reported a fault: run stopped");
     if (const int rc = machines.finish(); rc != kExitOk) return rc;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "foxglove_setup.hpp"
 #include "machine_setup.hpp"
 #include "telemetry_setup.hpp"
 #include "web_view.hpp"
@@ -38,6 +39,7 @@ struct SimArgs {
   std::string base_file;  // --base FILE (implies --drive); empty: the embedded base
   std::string pump;       // --pump shared|separate; empty: the base config's
   TelemetryArgs telemetry;
+  FoxgloveArgs foxglove;  // --mcap FILE, --foxglove [HOST:]PORT (docs/foxglove.md)
   WebArgs web;
   // --input goal (docs/mhsb.md#the-k70m-a-goal-for-sim): the first goal, later ones, the
   // planner's weights, grid and posture table file.

@@ -198,6 +198,49 @@ std::array<double, 2> hanger_joint_angles(const CraneModel& model, const HangerA
           -std::asin(std::clamp(h.dot(axes.across), -1.0, 1.0))};
 }
 
+std::vector<UrdfFrame> urdf_frames(const CraneModel& model) {
+  std::vector<UrdfFrame> frames;
+  const int n = model.dof();
+  for (int i = 0; i < n; ++i) {
+    frames.push_back(
+        {i == 0 ? "base_link" : model.joints[static_cast<std::size_t>(i - 1)].name + "_link",
+         model.joints[static_cast<std::size_t>(i)].name + "_link"});
+  }
+  if (n > 0)
+    frames.push_back({model.joints[static_cast<std::size_t>(n - 1)].name + "_link", "tip_link"});
+  if (n > 0 && model.grapple.hangs()) {
+    frames.push_back({"tip_link", "hanger_link"});
+    frames.push_back({"hanger_link", "grapple_link"});
+  }
+  return frames;
+}
+
+void urdf_transforms(const CraneModel& model, const HangerAxes& axes, const double* q,
+                     const std::array<double, 2>& hanger, Eigen::Isometry3d* out) noexcept {
+  const int n = model.dof();
+  if (n == 0) return;
+  // As to_urdf(): joint i's origin is the fixed part of DH transform i-1, its motion about (or
+  // along) its z axis.
+  const auto fixed = [&](int i) {
+    return dh_transform(model.joints[static_cast<std::size_t>(i)], 0.0);
+  };
+  for (int i = 0; i < n; ++i) {
+    const auto& j = model.joints[static_cast<std::size_t>(i)];
+    Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+    if (j.type == JointType::kPrismatic) {
+      motion.translation() = Eigen::Vector3d(0.0, 0.0, q[i]);
+    } else {
+      motion.linear() = Eigen::AngleAxisd(q[i], Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    }
+    out[i] = (i == 0 ? Eigen::Isometry3d::Identity() : fixed(i - 1)) * motion;
+  }
+  out[n] = fixed(n - 1);
+  if (model.grapple.hangs()) {
+    out[n + 1] = Eigen::Isometry3d(Eigen::AngleAxisd(hanger[0], axes.across));
+    out[n + 2] = Eigen::Isometry3d(Eigen::AngleAxisd(hanger[1], axes.along));
+  }
+}
+
 std::string to_urdf(const CraneModel& model, const std::string& robot_name) {
   const int n = model.dof();
   std::string out = "<?xml version=\"1.0\"?>\n<!-- " + model.name +

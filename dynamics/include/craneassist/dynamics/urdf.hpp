@@ -20,6 +20,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <string>
+#include <vector>
 
 #include "craneassist/dynamics/model.hpp"
 
@@ -49,6 +50,20 @@ HangerAxes hanger_axes(const CraneModel& model);
 std::array<double, 2> hanger_joint_angles(const CraneModel& model, const HangerAxes& axes,
                                           const Eigen::Isometry3d& tip, double radial_rad,
                                           double tangential_rad) noexcept;
+
+// The URDF's joints as a transform tree (what robot_state_publisher would put on /tf, so that a
+// viewer without it, Foxglove's 3-D panel, moves the URDF): each joint's parent and child link,
+// in to_urdf()'s order (the crane's joints, "tip", then the hanger's two when the grapple hangs).
+struct UrdfFrame {
+  std::string parent, child;
+};
+std::vector<UrdfFrame> urdf_frames(const CraneModel& model);
+
+// The parent-to-child transform of each of urdf_frames() at the joint positions q[0..dof) and
+// the hanger angles (hanger_joint_angles(); axes: hanger_axes(model)), into
+// out[0..urdf_frames().size()). No allocation.
+void urdf_transforms(const CraneModel& model, const HangerAxes& axes, const double* q,
+                     const std::array<double, 2>& hanger, Eigen::Isometry3d* out) noexcept;
 
 // The URDF text (XML). Joint limits: the config's ranges; velocity: the cylinder's speed limit
 // over its arm at mid-range; effort: the cylinder's piston area at the pump's pressure ceiling

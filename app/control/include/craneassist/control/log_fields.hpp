@@ -65,7 +65,7 @@ void visit_fields(Row& r, Visitor&& v) {
   using G = FieldGroup;
   using field_detail::kXyz;
   // clang-format off
-  v(Field{"t", "s", "loop", "machine time of the cycle since the start", G::kStatus, "t", "%.4f"}, r.t);
+  v(Field{"t", "s", "loop", "machine time of the cycle since the start", G::kStatus, "t", "%.4f", 1.0, false, "Header.t_s"}, r.t);
   v(Field{"cmd", "m/s", "input", "commanded tip velocity (crane frame: x forward, y up, z lateral); NaN while the input is not valid", G::kCommand, "cmd_vx,cmd_vy,cmd_vz", "%.6g", 1.0, false, "CommandPath.command_m_s", false, kXyz}, r.cmd);
   v(Field{"ref_v", "m/s", "controller", "reference tip velocity after redundancy resolution and scaling, parallel to the command", G::kCommand, "ref_vx,ref_vy,ref_vz", "%.6g", 1.0, false, "CommandPath.reference_m_s", false, kXyz}, r.ref_v);
   v(Field{"tip", "m", "measured", "tip position from the measured joints (forward kinematics), crane frame", G::kJoints, "tip_x,tip_y,tip_z", "%.6f", 1.0, false, "JointState.tip_m", false, kXyz}, r.tip);

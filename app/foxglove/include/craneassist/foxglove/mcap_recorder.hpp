@@ -1,0 +1,73 @@
+// `--mcap FILE` (replay, sim): the loop's cycles recorded as an MCAP file with the channels of
+// channels.hpp, every cycle. A CycleObserver: on the loop thread it copies the row into a
+// preallocated ring and returns (no lock, no allocation, no I/O; a full ring drops the cycle
+// and counts it); a writer thread encodes the messages and writes the chunks (McapWriter).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <thread>
+
+#include "craneassist/control/control_loop.hpp"
+#include "craneassist/control/spsc_ring.hpp"
+#include "craneassist/foxglove/channels.hpp"
+#include "craneassist/foxglove/mcap_writer.hpp"
+
+namespace craneassist::foxglove {
+
+struct McapRecorderOptions {
+  McapOptions file;
+  // true (a real-time run): message times on the wall clock (its reading at the first cycle
+  // plus machine time); false: machine time.
+  bool wall_clock = false;
+  std::size_t ring_rows = 1 << 12;
+};
+
+// Message time of a cycle at machine time t_s (ns; the epoch offset added, never negative).
+std::uint64_t message_time_ns(std::int64_t epoch_ns, double t_s) noexcept;
+// The wall clock now, ns since the Unix epoch.
+std::int64_t wall_clock_ns() noexcept;
+
+class McapRecorder : public control::CycleObserver {
+ public:
+  // Opens the file (throws std::runtime_error naming it) and starts the writer thread.
+  McapRecorder(const std::filesystem::path& path, const dynamics::CraneModel& model, bool base,
+               const McapRecorderOptions& options = {});
+  ~McapRecorder() override;
+
+  void on_cycle(const control::CycleRecord& cycle) noexcept override;
+  // Writes what is left, the summary and the footer.
+  void on_finish(const control::CycleTime& last, const valves::MachineState& state) override;
+
+  // "  mcap: FILE, N messages on C channels in K chunks, B bytes (D cycles dropped)"
+  std::string report() const;
+  std::uint64_t dropped() const noexcept { return dropped_.load(); }
+  McapStats stats() const;
+
+ private:
+  struct Slot {
+    control::LogRow row;
+    double t_s = 0.0;
+  };
+  void run();
+  void write_slot(const Slot& slot);
+  void finish();
+
+  McapRecorderOptions options_;
+  ChannelSet channels_;
+  McapWriter writer_;
+  std::vector<std::uint16_t> ids_;
+  std::vector<std::uint8_t> message_;
+  control::SpscRing<Slot> ring_;
+  std::int64_t epoch_ns_ = 0;
+  bool epoch_set_ = false;  // loop thread only
+  bool description_written_ = false;
+  std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> dropped_{0};
+  std::string error_;  // the writer thread's, after it stopped
+  std::thread thread_;
+};
+
+}  // namespace craneassist::foxglove

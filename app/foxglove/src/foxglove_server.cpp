@@ -1,0 +1,621 @@
+#include "craneassist/foxglove/foxglove_server.hpp"
+
+#include <atomic>
+#include <boost/asio.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <deque>
+#include <fstream>
+#include <future>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <stdexcept>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include "craneassist/control/spsc_ring.hpp"
+#include "craneassist/foxglove/channels.hpp"
+#include "craneassist/foxglove/mcap_recorder.hpp"
+
+namespace craneassist::foxglove {
+
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+namespace net = boost::asio;
+using tcp = net::ip::tcp;
+using json = nlohmann::json;
+
+namespace {
+
+constexpr const char* kSubprotocols[] = {"foxglove.sdk.v1", "foxglove.websocket.v1"};
+constexpr std::uint8_t kMessageData = 0x01;
+constexpr std::uint8_t kTime = 0x02;
+
+// The first subprotocol of ours that the client's Sec-WebSocket-Protocol list offers, or "".
+std::string pick_subprotocol(std::string_view offered) {
+  for (const char* ours : kSubprotocols) {
+    std::string_view rest = offered;
+    while (!rest.empty()) {
+      const auto comma = rest.find(',');
+      std::string_view item = rest.substr(0, comma);
+      while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
+      while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
+      if (item == ours) return ours;
+      if (comma == std::string_view::npos) break;
+      rest.remove_prefix(comma + 1);
+    }
+  }
+  return {};
+}
+
+std::string random_session_id() {
+  unsigned char bytes[8] = {};
+  std::ifstream urandom("/dev/urandom", std::ios::binary);
+  urandom.read(reinterpret_cast<char*>(bytes), sizeof bytes);
+  std::string id;
+  char hex[3];
+  for (const unsigned char b : bytes) {
+    std::snprintf(hex, sizeof hex, "%02x", b);
+    id += hex;
+  }
+  return id;
+}
+
+template <class T>
+void put_le(std::vector<std::uint8_t>& out, T v) {
+  for (std::size_t i = 0; i < sizeof(T); ++i)
+    out.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+}
+
+struct Outgoing {
+  std::vector<std::uint8_t> bytes;
+  bool text = false;
+};
+using OutgoingPtr = std::shared_ptr<const Outgoing>;
+
+OutgoingPtr text_message(const std::string& s) {
+  auto m = std::make_shared<Outgoing>();
+  m->bytes.assign(s.begin(), s.end());
+  m->text = true;
+  return m;
+}
+
+}  // namespace
+
+bool parse_listen_address(const std::string& text, ServerOptions& options, std::string& why) {
+  std::string host = options.address, port = text;
+  if (const auto colon = text.rfind(':'); colon != std::string::npos) {
+    host = text.substr(0, colon);
+    port = text.substr(colon + 1);
+    if (host.size() >= 2 && host.front() == '[' && host.back() == ']') {
+      host = host.substr(1, host.size() - 2);
+    }
+    if (host.empty()) {
+      why = "no host before ':' in '" + text + "' (give PORT or HOST:PORT)";
+      return false;
+    }
+  }
+  if (port.empty() || port.size() > 5 ||
+      port.find_first_not_of("0123456789") != std::string::npos || std::stoul(port) > 65535) {
+    why = "'" + text + "' is not a port (0..65535) or HOST:PORT";
+    return false;
+  }
+  beast::error_code ec;
+  net::ip::make_address(host, ec);
+  if (ec) {
+    why = "'" + host + "' is not an IP address";
+    return false;
+  }
+  options.address = host;
+  options.port = static_cast<unsigned short>(std::stoul(port));
+  return true;
+}
+
+class FoxgloveSession;
+
+struct FoxgloveServer::Impl {
+  Impl(const ServerOptions& o, const dynamics::CraneModel& model)
+      : options(o),
+        channels(model, o.base),
+        ring(o.ring_rows),
+        session_id(random_session_id()),
+        acceptor(ioc),
+        timer(ioc) {
+    // serverInfo and advertise: the same for every client.
+    json info = {{"op", "serverInfo"},
+                 {"name", "craneassist"},
+                 {"capabilities", o.sim_time ? json::array({"time"}) : json::array()},
+                 {"supportedEncodings", json::array()},
+                 {"metadata", {{"crane", model.name}}},
+                 {"sessionId", session_id}};
+    server_info = text_message(info.dump());
+    json list = json::array();
+    for (std::size_t k = 0; k < channels.size(); ++k) {
+      const Channel& c = channels.channels()[k];
+      list.push_back({{"id", k + 1},
+                      {"topic", c.topic},
+                      {"encoding", c.message_encoding},
+                      {"schemaName", c.schema_name},
+                      {"schema", c.schema},
+                      {"schemaEncoding", c.schema_encoding}});
+    }
+    advertise = text_message(json{{"op", "advertise"}, {"channels", list}}.dump());
+    subscribers.assign(channels.size(), 0);
+  }
+
+  struct Slot {
+    control::LogRow row;
+    double t_s = 0.0;
+  };
+
+  class Observer : public control::CycleObserver {
+   public:
+    explicit Observer(Impl& impl) : impl_(impl) {}
+    void on_cycle(const control::CycleRecord& cycle) noexcept override {
+      if (!epoch_set_) {
+        epoch_set_ = true;
+        if (!impl_.options.sim_time) {
+          impl_.epoch_ns.store(wall_clock_ns() -
+                               static_cast<std::int64_t>(std::llround(cycle.time.t_s * 1e9)));
+        }
+      }
+      slot_.row = cycle.row;
+      slot_.t_s = cycle.time.t_s;
+      if (!impl_.ring.push(slot_)) impl_.cycles_dropped.fetch_add(1, std::memory_order_relaxed);
+    }
+
+   private:
+    Impl& impl_;
+    bool epoch_set_ = false;
+    Slot slot_;
+  };
+
+  void start();
+  void tick();
+  void drain();
+  void on_text(FoxgloveSession& s, std::string_view text);
+  void on_binary(FoxgloveSession& s);
+  void status(FoxgloveSession& s, int level, const std::string& message);
+  void shutdown();
+
+  ServerOptions options;
+  ChannelSet channels;
+  control::SpscRing<Slot> ring;
+  std::string session_id;
+  OutgoingPtr server_info, advertise;
+  net::io_context ioc{1};
+  tcp::acceptor acceptor;
+  net::steady_timer timer;
+  std::thread thread;
+  std::promise<void> stopped;
+  std::atomic<std::int64_t> epoch_ns{0};
+  // I/O thread only.
+  std::vector<std::weak_ptr<FoxgloveSession>> sessions;
+  std::vector<int> subscribers;  // per channel, over all sessions
+  std::vector<std::uint8_t> encoded;
+  std::optional<OutgoingPtr> description;  // the latched /robot_description, once encoded
+  Observer observer{*this};
+  // Counters (any thread reads them).
+  std::atomic<std::uint64_t> clients_connected{0}, subscriptions_made{0}, messages_sent{0},
+      messages_dropped{0}, cycles_dropped{0}, client_malformed{0}, client_unsupported{0},
+      refused{0};
+};
+
+// One client: message frames out (a queue bounded in bytes; a client behind loses frames),
+// subscribe and unsubscribe in.
+class FoxgloveSession : public std::enable_shared_from_this<FoxgloveSession> {
+ public:
+  FoxgloveSession(tcp::socket&& socket, FoxgloveServer::Impl& impl)
+      : ws_(std::move(socket)), impl_(impl) {}
+
+  void run(http::request<http::string_body> req, std::string subprotocol) {
+    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    ws_.set_option(websocket::stream_base::decorator([subprotocol](websocket::response_type& res) {
+      res.set(http::field::sec_websocket_protocol, subprotocol);
+      res.set(http::field::server, "craneassist");
+    }));
+    ws_.read_message_max(64 << 10);
+    ws_.async_accept(req, [self = shared_from_this()](beast::error_code ec) {
+      if (ec) return;
+      self->impl_.clients_connected.fetch_add(1);
+      self->impl_.sessions.push_back(self);
+      self->send(self->impl_.server_info, true);
+      self->send(self->impl_.advertise, true);
+      self->read();
+    });
+  }
+
+  // Queues a message; false (dropped) when the client is behind. `always`: the handshake's
+  // messages and statuses, queued whatever the backlog.
+  bool send(const OutgoingPtr& m, bool always = false) {
+    if (closed_) return false;
+    if (!always && queued_bytes_ + m->bytes.size() > impl_.options.max_queue_bytes) return false;
+    queued_bytes_ += m->bytes.size();
+    queue_.push_back(m);
+    if (queue_.size() == 1) write();
+    return true;
+  }
+
+  void close() {
+    if (closed_) return;
+    closed_ = true;
+    release();
+    ws_.async_close(websocket::close_code::going_away,
+                    [self = shared_from_this()](beast::error_code) {});
+  }
+
+  // subscription id -> channel index
+  std::map<std::uint32_t, std::size_t> subscriptions;
+  bool closed() const { return closed_; }
+
+  // The channels this session no longer counts as subscribed (on close).
+  void release() {
+    for (const auto& [id, k] : subscriptions) --impl_.subscribers[k];
+    subscriptions.clear();
+  }
+
+ private:
+  void read() {
+    ws_.async_read(buffer_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+      if (ec) {
+        if (!self->closed_) {
+          self->closed_ = true;
+          self->release();
+        }
+        return;
+      }
+      const auto data = self->buffer_.data();
+      if (self->ws_.got_text()) {
+        self->impl_.on_text(*self,
+                            std::string_view(static_cast<const char*>(data.data()), data.size()));
+      } else {
+        self->impl_.on_binary(*self);
+      }
+      self->buffer_.consume(self->buffer_.size());
+      self->read();
+    });
+  }
+
+  void write() {
+    const Outgoing& m = *queue_.front();
+    ws_.text(m.text);
+    ws_.binary(!m.text);
+    ws_.async_write(net::buffer(m.bytes),
+                    [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                      if (ec) {
+                        self->queue_.clear();
+                        self->queued_bytes_ = 0;
+                        return;
+                      }
+                      self->queued_bytes_ -= self->queue_.front()->bytes.size();
+                      self->queue_.pop_front();
+                      if (!self->queue_.empty()) self->write();
+                    });
+  }
+
+  websocket::stream<beast::tcp_stream> ws_;
+  beast::flat_buffer buffer_;
+  std::deque<OutgoingPtr> queue_;
+  std::size_t queued_bytes_ = 0;
+  FoxgloveServer::Impl& impl_;
+  bool closed_ = false;
+};
+
+namespace {
+
+// One HTTP connection: the WebSocket upgrade with a Foxglove subprotocol, or a plain answer.
+class HttpSession : public std::enable_shared_from_this<HttpSession> {
+ public:
+  HttpSession(tcp::socket&& socket, FoxgloveServer::Impl& impl)
+      : stream_(std::move(socket)), impl_(impl) {}
+
+  void read() {
+    parser_.emplace();
+    parser_->header_limit(8192);
+    parser_->body_limit(8192);
+    stream_.expires_after(std::chrono::seconds(30));
+    http::async_read(stream_, buffer_, *parser_,
+                     [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                       if (ec) return;
+                       self->handle(self->parser_->release());
+                     });
+  }
+
+ private:
+  void handle(http::request<http::string_body> req) {
+    std::string subprotocol;
+    if (websocket::is_upgrade(req)) {
+      const auto offered = req[http::field::sec_websocket_protocol];
+      subprotocol = pick_subprotocol(std::string_view(offered.data(), offered.size()));
+      if (!subprotocol.empty()) {
+        stream_.expires_never();
+        std::make_shared<FoxgloveSession>(stream_.release_socket(), impl_)
+            ->run(std::move(req), subprotocol);
+        return;
+      }
+    }
+    impl_.refused.fetch_add(1);
+    auto res = std::make_shared<http::response<http::string_body>>(http::status::bad_request,
+                                                                   req.version());
+    res->set(http::field::server, "craneassist");
+    res->set(http::field::content_type, "text/plain");
+    res->body() =
+        "craneassist: a Foxglove WebSocket server (subprotocol foxglove.sdk.v1 or "
+        "foxglove.websocket.v1): open it in Foxglove, Open connection, Foxglove WebSocket "
+        "(docs/foxglove.md)\n";
+    res->keep_alive(false);
+    res->prepare_payload();
+    http::async_write(stream_, *res,
+                      [self = shared_from_this(), res](beast::error_code, std::size_t) {
+                        beast::error_code ignored;
+                        self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+                      });
+  }
+
+  beast::tcp_stream stream_;
+  beast::flat_buffer buffer_;
+  std::optional<http::request_parser<http::string_body>> parser_;
+  FoxgloveServer::Impl& impl_;
+};
+
+void accept(FoxgloveServer::Impl& impl) {
+  impl.acceptor.async_accept([&impl](beast::error_code ec, tcp::socket socket) {
+    if (ec == net::error::operation_aborted) return;
+    if (!ec) std::make_shared<HttpSession>(std::move(socket), impl)->read();
+    accept(impl);
+  });
+}
+
+}  // namespace
+
+void FoxgloveServer::Impl::start() {
+  beast::error_code ec;
+  const auto address = net::ip::make_address(options.address, ec);
+  if (ec) throw std::runtime_error("foxglove: bad listen address '" + options.address + "'");
+  const tcp::endpoint endpoint(address, options.port);
+  auto fail = [&](const char* what) {
+    throw std::runtime_error("foxglove: cannot listen on " + options.address + ":" +
+                             std::to_string(options.port) + ": " + what + ": " + ec.message());
+  };
+  acceptor.open(endpoint.protocol(), ec);
+  if (ec) fail("open");
+  acceptor.set_option(net::socket_base::reuse_address(true), ec);
+  acceptor.bind(endpoint, ec);
+  if (ec) fail("bind");
+  acceptor.listen(net::socket_base::max_listen_connections, ec);
+  if (ec) fail("listen");
+  accept(*this);
+  tick();
+  thread = std::thread([this] {
+    for (;;) {
+      try {
+        ioc.run();
+        break;
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "craneassist: foxglove: %s\n", e.what());
+      }
+    }
+    stopped.set_value();
+  });
+}
+
+void FoxgloveServer::Impl::tick() {
+  drain();
+  timer.expires_after(std::chrono::milliseconds(2));
+  timer.async_wait([this](beast::error_code ec) {
+    if (!ec) tick();
+  });
+}
+
+void FoxgloveServer::Impl::drain() {
+  // Drop the sessions that have closed.
+  std::size_t live = 0;
+  for (auto& weak : sessions) {
+    auto s = weak.lock();
+    if (s && !s->closed()) sessions[live++] = weak;
+  }
+  sessions.resize(live);
+  while (const Slot* slot = ring.front()) {
+    if (!sessions.empty()) {
+      const std::uint64_t t_ns = message_time_ns(epoch_ns.load(), slot->t_s);
+      if (options.sim_time) {
+        auto m = std::make_shared<Outgoing>();
+        m->bytes.push_back(kTime);
+        put_le(m->bytes, t_ns);
+        for (auto& weak : sessions) {
+          if (auto s = weak.lock()) s->send(m);
+        }
+      }
+      for (std::size_t k = 0; k < channels.size(); ++k) {
+        if (subscribers[k] == 0 || channels.channels()[k].latched) continue;
+        channels.encode(k, slot->row, static_cast<std::int64_t>(t_ns), encoded);
+        for (auto& weak : sessions) {
+          auto s = weak.lock();
+          if (!s) continue;
+          for (const auto& [id, channel] : s->subscriptions) {
+            if (channel != k) continue;
+            auto m = std::make_shared<Outgoing>();
+            m->bytes.reserve(13 + encoded.size());
+            m->bytes.push_back(kMessageData);
+            put_le(m->bytes, id);
+            put_le(m->bytes, t_ns);
+            m->bytes.insert(m->bytes.end(), encoded.begin(), encoded.end());
+            if (s->send(m)) {
+              messages_sent.fetch_add(1, std::memory_order_relaxed);
+            } else {
+              messages_dropped.fetch_add(1, std::memory_order_relaxed);
+            }
+          }
+        }
+      }
+    }
+    ring.pop();
+  }
+}
+
+void FoxgloveServer::Impl::status(FoxgloveSession& s, int level, const std::string& message) {
+  s.send(text_message(json{{"op", "status"}, {"level", level}, {"message", message}}.dump()), true);
+}
+
+void FoxgloveServer::Impl::on_binary(FoxgloveSession& s) {
+  client_unsupported.fetch_add(1);
+  status(s, 2, "craneassist takes no client messages (no clientPublish): dropped");
+}
+
+void FoxgloveServer::Impl::on_text(FoxgloveSession& s, std::string_view text) {
+  const json m = json::parse(text, nullptr, false);
+  if (m.is_discarded() || !m.is_object() || !m.contains("op") || !m["op"].is_string()) {
+    client_malformed.fetch_add(1);
+    status(s, 2, "not a JSON object with an \"op\": dropped");
+    return;
+  }
+  const std::string op = m["op"].get<std::string>();
+  const auto valid_id = [](const json& v) {
+    return v.is_number_unsigned() && v.get<std::uint64_t>() <= 0xFFFFFFFFULL;
+  };
+  if (op == "subscribe") {
+    if (!m.contains("subscriptions") || !m["subscriptions"].is_array()) {
+      client_malformed.fetch_add(1);
+      status(s, 2, "subscribe: no \"subscriptions\" array: dropped");
+      return;
+    }
+    for (const json& sub : m["subscriptions"]) {
+      if (!sub.is_object() || !sub.contains("id") || !sub.contains("channelId") ||
+          !valid_id(sub["id"]) || !valid_id(sub["channelId"])) {
+        client_malformed.fetch_add(1);
+        status(s, 2, "subscribe: each subscription needs an \"id\" and a \"channelId\"");
+        continue;
+      }
+      const auto id = sub["id"].get<std::uint32_t>();
+      const auto channel = sub["channelId"].get<std::uint64_t>();
+      if (channel == 0 || channel > channels.size()) {
+        client_malformed.fetch_add(1);
+        status(s, 1, "subscribe: no channel " + std::to_string(channel));
+        continue;
+      }
+      if (s.subscriptions.count(id) != 0) {
+        client_malformed.fetch_add(1);
+        status(s, 1, "subscribe: subscription id " + std::to_string(id) + " is taken");
+        continue;
+      }
+      const std::size_t k = channel - 1;
+      s.subscriptions[id] = k;
+      ++subscribers[k];
+      subscriptions_made.fetch_add(1);
+      if (channels.channels()[k].latched) {
+        // The latched description: now, to this subscription.
+        channels.encode(k, control::LogRow{}, 0, encoded);
+        auto out = std::make_shared<Outgoing>();
+        out->bytes.push_back(kMessageData);
+        put_le(out->bytes, id);
+        put_le(out->bytes, message_time_ns(epoch_ns.load(), 0.0));
+        out->bytes.insert(out->bytes.end(), encoded.begin(), encoded.end());
+        s.send(out, true);
+      }
+    }
+    return;
+  }
+  if (op == "unsubscribe") {
+    if (!m.contains("subscriptionIds") || !m["subscriptionIds"].is_array()) {
+      client_malformed.fetch_add(1);
+      status(s, 2, "unsubscribe: no \"subscriptionIds\" array: dropped");
+      return;
+    }
+    for (const json& id : m["subscriptionIds"]) {
+      if (!valid_id(id)) {
+        client_malformed.fetch_add(1);
+        continue;
+      }
+      const auto it = s.subscriptions.find(id.get<std::uint32_t>());
+      if (it == s.subscriptions.end()) continue;
+      --subscribers[it->second];
+      s.subscriptions.erase(it);
+    }
+    return;
+  }
+  client_unsupported.fetch_add(1);
+  status(s, 2, "craneassist does not offer '" + op + "' (no command input here): dropped");
+}
+
+void FoxgloveServer::Impl::shutdown() {
+  drain();
+  beast::error_code ignored;
+  acceptor.close(ignored);
+  timer.cancel();
+  for (auto& weak : sessions) {
+    if (auto s = weak.lock()) s->close();
+  }
+  sessions.clear();
+}
+
+FoxgloveServer::FoxgloveServer(const ServerOptions& options, const dynamics::CraneModel& model)
+    : impl_(std::make_unique<Impl>(options, model)) {
+  impl_->start();
+}
+
+FoxgloveServer::~FoxgloveServer() {
+  stop();
+}
+
+void FoxgloveServer::stop(double drain_s) {
+  if (!impl_->thread.joinable()) return;
+  net::post(impl_->ioc, [impl = impl_.get()] { impl->shutdown(); });
+  if (impl_->stopped.get_future().wait_for(std::chrono::duration<double>(drain_s)) !=
+      std::future_status::ready) {
+    impl_->ioc.stop();
+  }
+  impl_->thread.join();
+}
+
+bool FoxgloveServer::wait_for_subscriber(double timeout_s) const {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (impl_->subscriptions_made.load() == 0) {
+    if (std::chrono::steady_clock::now() >= until) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return true;
+}
+
+unsigned short FoxgloveServer::port() const {
+  beast::error_code ec;
+  return impl_->acceptor.local_endpoint(ec).port();
+}
+
+std::string FoxgloveServer::url() const {
+  std::string host = impl_->options.address;
+  if (host == "0.0.0.0" || host == "::") host = "127.0.0.1";
+  if (host.find(':') != std::string::npos) host = "[" + host + "]";
+  return "ws://" + host + ":" + std::to_string(port());
+}
+
+control::CycleObserver& FoxgloveServer::observer() {
+  return impl_->observer;
+}
+
+ServerCounters FoxgloveServer::counters() const {
+  const Impl& i = *impl_;
+  return {i.clients_connected.load(),  i.subscriptions_made.load(),
+          i.messages_sent.load(),      i.messages_dropped.load(),
+          i.cycles_dropped.load(),     i.client_malformed.load(),
+          i.client_unsupported.load(), i.refused.load()};
+}
+
+std::string FoxgloveServer::report() const {
+  const ServerCounters c = counters();
+  using std::to_string;
+  return "  foxglove: " + to_string(c.clients_connected) + " clients, " +
+         to_string(c.subscriptions) + " subscriptions, " + to_string(c.messages_sent) +
+         " messages sent (" + to_string(c.messages_dropped) + " dropped: a client behind; " +
+         to_string(c.cycles_dropped) + " cycles dropped), client messages " +
+         to_string(c.client_malformed) + " malformed, " + to_string(c.client_unsupported) +
+         " unsupported, " + to_string(c.refused) + " connections refused";
+}
+
+}  // namespace craneassist::foxglove

@@ -1,0 +1,200 @@
+// craneassist's Foxglove WebSocket server (docs/foxglove.md) against independent clients: npm's
+// @foxglove/ws-protocol FoxgloveClient over the `ws` package, once with each subprotocol
+// (foxglove.websocket.v1, foxglove.sdk.v1), /joint_states decoded with
+// @foxglove/rosmsg2-serialization from the advertised ros2msg schema and checked against the CSV
+// log of the same run, the JSON channels validated against their advertised JSON Schemas (ajv).
+//
+//   node ws_check.mjs NODE_MODULES CRANEASSIST REPLAY.csv PORT OUTDIR live
+//     a real-time replay; clients reading at full speed (each subprotocol), at 100 Hz and at
+//     10 Hz (their socket read that often: a slow client loses frames, the run does not slow),
+//     and one that sends garbage; prints each client's frame rate and latency
+//   node ws_check.mjs NODE_MODULES CRANEASSIST REPLAY.csv PORT OUTDIR simtime
+//     a replay as fast as possible (--foxglove-wait): the `time` capability, machine time
+import { spawn } from "node:child_process";
+import { readFileSync } from "node:fs";
+import { createRequire } from "node:module";
+
+const [modules, craneassist, replay, port, outdir, mode] = process.argv.slice(2);
+const require = createRequire(`${modules}/`);
+const { FoxgloveClient } = require("@foxglove/ws-protocol");
+const { parse: parseMsgDef } = require("@foxglove/rosmsg");
+const { MessageReader } = require("@foxglove/rosmsg2-serialization");
+const WebSocket = require("ws");
+const Ajv2020 = require("ajv/dist/2020").default;
+
+let failures = 0;
+const check = (ok, what) => {
+  console.log(`${ok ? "ok  " : "FAIL"} ${what}`);
+  if (!ok) failures += 1;
+};
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+const url = `ws://127.0.0.1:${port}`;
+const csvPath = `${outdir}/foxglove_${mode}.csv`;
+const realtime = mode === "live";
+
+const args = ["replay", replay, "--log", csvPath, "--foxglove", `127.0.0.1:${port}`,
+  "--foxglove-wait", "15", "--settle", "1"];
+if (realtime) args.push("--realtime");
+const run = spawn(craneassist, args, { stdio: ["ignore", "pipe", "pipe"] });
+let output = "";
+run.stdout.on("data", (d) => { output += d; });
+run.stderr.on("data", (d) => { output += d; });
+const exited = new Promise((done) => run.on("exit", (code) => done(code)));
+
+// A client: connects with `subprotocol`, subscribes to every channel, keeps what arrives.
+// readHz: its socket is read only that often (0: as fast as it comes).
+function client(name, subprotocol, readHz = 0) {
+  const ws = new WebSocket(url, [subprotocol]);
+  const c = { name, subprotocol, ws, info: null, channels: [], bySub: new Map(), messages: [],
+    times: [], statuses: [], closed: false, negotiated: "" };
+  ws.on("upgrade", (res) => { c.negotiated = res.headers["sec-websocket-protocol"] ?? ""; });
+  const fc = new FoxgloveClient({ ws });
+  fc.on("serverInfo", (i) => { c.info = i; });
+  fc.on("status", (s) => c.statuses.push(s));
+  fc.on("advertise", (channels) => {
+    c.channels.push(...channels);
+    for (const ch of channels) c.bySub.set(fc.subscribe(ch.id), ch);
+    if (readHz > 0) {
+      const socket = ws._socket;
+      socket.pause();
+      c.pacer = setInterval(() => {
+        socket.resume();
+        setImmediate(() => socket.pause());
+      }, 1000 / readHz);
+    }
+  });
+  fc.on("message", ({ subscriptionId, timestamp, data }) => {
+    c.messages.push({ channel: c.bySub.get(subscriptionId), timestamp, data,
+      received: BigInt(Date.now()) * 1000000n });
+  });
+  fc.on("time", ({ timestamp }) => c.times.push(timestamp));
+  c.done = new Promise((done) => fc.on("close", () => {
+    c.closed = true;
+    clearInterval(c.pacer);
+    done();
+  }));
+  fc.on("error", () => {});
+  return c;
+}
+
+// The server's address is up once the process says so.
+for (let i = 0; i < 150 && !output.includes("foxglove: ws://"); ++i) await sleep(100);
+check(output.includes("foxglove: ws://"), `craneassist listens (${url})`);
+
+const clients = realtime
+  ? [client("websocket.v1", "foxglove.websocket.v1"), client("sdk.v1", "foxglove.sdk.v1"),
+     client("100 Hz", "foxglove.sdk.v1", 100), client("10 Hz", "foxglove.websocket.v1", 10)]
+  : [client("sim time", "foxglove.sdk.v1")];
+
+// A client that sends what a server must survive: not JSON, an unknown op, a bad subscription,
+// a binary frame (client publish, not offered), and a request without a Foxglove subprotocol.
+const garbage = new WebSocket(url, ["foxglove.websocket.v1"]);
+const garbageStatuses = [];
+garbage.on("message", (d, binary) => {
+  if (!binary) {
+    const m = JSON.parse(d.toString());
+    if (m.op === "status") garbageStatuses.push(m);
+  }
+});
+garbage.on("open", () => {
+  garbage.send("{not json");
+  garbage.send(JSON.stringify({ op: "setParameters", parameters: [] }));
+  garbage.send(JSON.stringify({ op: "subscribe", subscriptions: [{ id: 1, channelId: 999 }] }));
+  garbage.send(JSON.stringify({ op: "subscribe", subscriptions: "x" }));
+  garbage.send(Buffer.from([0x01, 0, 0, 0, 0, 1, 2, 3]));
+});
+garbage.on("error", () => {});
+const refused = await new Promise((done) => {
+  const plain = new WebSocket(url, ["not.foxglove"]);
+  plain.on("unexpected-response", (_req, res) => done(res.statusCode));
+  plain.on("open", () => done("opened"));
+  plain.on("error", () => done("error"));
+});
+check(refused === 400, `a client without a Foxglove subprotocol is refused (HTTP ${refused})`);
+
+const code = await exited;
+await Promise.all(clients.map((c) => Promise.race([c.done, sleep(3000)])));
+check(code === 0, `the replay exits 0 (${code})`);
+
+// The CSV log: rows by machine time.
+const csv = readFileSync(csvPath, "utf8").trim().split("\n");
+const header = csv[0].split(",");
+const col = (n) => header.indexOf(n);
+const rowsByT = new Map(csv.slice(1).map((l) => {
+  const r = l.split(",");
+  return [Number(r[col("t")]).toFixed(4), r];
+}));
+const dof = header.filter((h) => /^q\d+$/.test(h)).length;
+
+const ajv = new Ajv2020({ strict: false, allErrors: true });
+for (const c of clients) {
+  check(c.negotiated === c.subprotocol, `${c.name}: subprotocol ${c.negotiated}`);
+  check(c.info?.name === "craneassist", `${c.name}: serverInfo from craneassist`);
+  check((c.info?.capabilities ?? []).includes("time") === !realtime,
+        `${c.name}: capabilities [${c.info?.capabilities}] (time only when not real time)`);
+  const topics = c.channels.map((ch) => ch.topic);
+  for (const t of ["/joint_states", "/tf", "/robot_description", "/craneassist/tip_velocity/command",
+                   "/craneassist/tip_velocity/reference", "/craneassist/status",
+                   "/craneassist/hydraulics", "/craneassist/limits", "/craneassist/polytope",
+                   "/craneassist/loads"]) {
+    check(topics.includes(t), `${c.name}: advertises ${t}`);
+  }
+  const of = (topic) => c.messages.filter((m) => m.channel.topic === topic);
+  const reader = (topic) => new MessageReader(
+    parseMsgDef(c.channels.find((ch) => ch.topic === topic).schema, { ros2: true }));
+  // Machine time of each stamp, from the status channel's t.
+  const tOf = new Map();
+  for (const m of of("/craneassist/status")) {
+    tOf.set(m.timestamp, JSON.parse(new TextDecoder().decode(m.data)).t);
+  }
+  const js = of("/joint_states");
+  const jsReader = reader("/joint_states");
+  let worst = 0, compared = 0;
+  for (const m of js) {
+    const t = tOf.get(m.timestamp);
+    if (t === undefined) continue;
+    const row = rowsByT.get(Number(t).toFixed(4));
+    if (!row) continue;
+    const msg = jsReader.readMessage(m.data);
+    for (let i = 0; i < dof; ++i) worst = Math.max(worst, Math.abs(msg.position[i] - Number(row[col(`q${i + 1}`)])));
+    ++compared;
+  }
+  check(compared > 0 && worst < 1e-6,
+        `${c.name}: /joint_states ${compared} messages equal the CSV's q (|diff| <= ${worst.toExponential(2)})`);
+  const urdf = of("/robot_description");
+  check(urdf.length === 1 && reader("/robot_description").readMessage(urdf[0].data).data.includes("<robot"),
+        `${c.name}: /robot_description once, a URDF`);
+  let jsonOk = 0, jsonBad = "";
+  for (const ch of c.channels.filter((x) => x.encoding === "json")) {
+    const validate = ajv.compile(JSON.parse(ch.schema));
+    for (const m of of(ch.topic)) {
+      if (validate(JSON.parse(new TextDecoder().decode(m.data)))) ++jsonOk;
+      else jsonBad = `${ch.topic}: ${ajv.errorsText(validate.errors)}`;
+    }
+  }
+  check(jsonOk > 0 && jsonBad === "", `${c.name}: ${jsonOk} JSON messages valid against their schemas ${jsonBad}`);
+  if (realtime && js.length > 1) {
+    // Frame rate of /joint_states and latency (arrival minus the message's wall-clock stamp).
+    const span = Number(js[js.length - 1].received - js[0].received) / 1e9;
+    const lat = js.map((m) => Number(m.received - m.timestamp) / 1e6).sort((a, b) => a - b);
+    const q = (p) => lat[Math.min(lat.length - 1, Math.floor(p * lat.length))].toFixed(1);
+    console.log(`rate ${c.name}: /joint_states ${js.length} messages in ${span.toFixed(2)} s = ` +
+                `${(js.length / span).toFixed(1)} Hz; latency median ${q(0.5)} ms, p95 ${q(0.95)} ms, max ${q(1)} ms`);
+  }
+  if (!realtime) {
+    const monotonic = c.times.every((t, i) => i === 0 || t >= c.times[i - 1]);
+    check(c.times.length > 0 && monotonic, `${c.name}: ${c.times.length} time messages, machine time, in order`);
+  }
+}
+check(garbageStatuses.length >= 4, `garbage client: ${garbageStatuses.length} status replies (${garbageStatuses.map((s) => s.message.slice(0, 30)).join(" | ")})`);
+const report = output.split("\n").find((l) => l.includes("foxglove:") && l.includes("clients")) ?? "";
+console.log(report);
+check(/client messages [1-9]\d* malformed, [1-9]\d* unsupported/.test(report), "the server counted the malformed and unsupported messages");
+garbage.close();
+if (failures > 0) {
+  console.log(output);
+  console.log(`${failures} FAILED`);
+  process.exit(1);
+}
+console.log(`foxglove ${mode} OK`);
+process.exit(0);
