@@ -95,6 +95,15 @@ msg::BaseState base_sample(std::uint64_t cycle) {
   return m;
 }
 
+msg::FieldValues fields_sample(std::uint64_t cycle) {
+  msg::FieldValues m;
+  m.header(header_of(cycle));
+  m.names({"t", "q.1", "tip.x"});
+  m.units({"s", "rad or m", "m"});
+  m.values({0.01 * static_cast<double>(cycle), 0.2, 3.5});
+  return m;
+}
+
 msg::CommandPath command_path_sample(std::uint64_t cycle) {
   msg::CommandPath m;
   m.header(header_of(cycle));
@@ -150,7 +159,8 @@ Payload bad_bool(dds::Topic topic) {
       break;
     }
     case dds::Topic::kHydraulics:
-      throw std::invalid_argument("hydraulics has no boolean");
+    case dds::Topic::kFields:
+      throw std::invalid_argument("hydraulics and the fields have no boolean");
   }
   p[differing_byte(p, q)] = 2;
   return p;
@@ -211,6 +221,8 @@ Payload telemetry_payload(dds::Topic topic, std::uint64_t cycle) {
       return serialized<msg::CommandPathPubSubType>(command_path_sample(cycle));
     case dds::Topic::kBase:
       return serialized<msg::BaseStatePubSubType>(base_sample(cycle));
+    case dds::Topic::kFields:
+      return serialized<msg::FieldValuesPubSubType>(fields_sample(cycle));
     case dds::Topic::kOperatorCommand:
       break;
   }
@@ -233,7 +245,10 @@ const char* to_string(Malformation m) {
 
 std::vector<Malformation> malformations_of(dds::Topic topic) {
   std::vector<Malformation> m = {Malformation::kBadEncapsulation, Malformation::kTruncated};
-  if (topic != dds::Topic::kHydraulics) m.push_back(Malformation::kBadBool);
+  // Hydraulics and the fields have no boolean.
+  if (topic != dds::Topic::kHydraulics && topic != dds::Topic::kFields) {
+    m.push_back(Malformation::kBadBool);
+  }
   if (topic == dds::Topic::kJoints) m.push_back(Malformation::kOverBound);
   return m;
 }

@@ -77,6 +77,10 @@ void Telemetry::finish() {
         "reader that left, or a slow network): watchers may not show it\n",
         s.end_unacknowledged);
   }
+  std::printf(
+      "  telemetry fields: %llu samples on craneassist/fields (every value of craneassist "
+      "fields)\n",
+      static_cast<unsigned long long>(s.samples_written[5]));
   if (s.samples_written[4] > 0) {  // a run with a wheeled base (sim --drive)
     std::printf("  telemetry base: %llu samples on craneassist/base\n",
                 static_cast<unsigned long long>(s.samples_written[4]));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <type_traits>
 
+#include "craneassist/control/log_fields.hpp"
 #include "craneassist/dynamics/urdf.hpp"
 
 namespace craneassist::cli {
@@ -87,6 +88,8 @@ void to_frame(const control::LogRow& row, int dof, dds::TelemetryFrame& f) noexc
   each_field(row, f, n, [](const auto& from, auto& to) {
     to = static_cast<std::remove_reference_t<decltype(to)>>(from);
   });
+  // Every numeric field of the table (telemetry_info's field_names: with the base's).
+  f.value_count = control::flat_field_values(row, n, true, f.values.data(), dds::kMaxFieldValues);
 }
 
 void from_frame(const dds::TelemetryFrame& f, control::LogRow& row) noexcept {
@@ -115,6 +118,19 @@ dds::TelemetryInfo telemetry_info(const config::CraneConfig& config, const char*
   if (m.grapple.hangs()) {
     info.hanger_joint_names.assign(dynamics::kHangerJointNames.begin(),
                                    dynamics::kHangerJointNames.end());
+  }
+  for (auto& f : control::flat_fields(std::min(m.dof(), dds::kMaxJoints), true)) {
+    // A per-joint unit "rad or m" ("rad/s or m/s"): the joint's own (name.1 is the first joint).
+    const auto either = f.unit.find(" or ");
+    const auto dot = f.name.rfind('.');
+    if (either != std::string::npos && dot != std::string::npos) {
+      const std::size_t joint = std::stoul(f.name.substr(dot + 1)) - 1;
+      const bool prismatic =
+          joint < m.joints.size() && m.joints[joint].type == dynamics::JointType::kPrismatic;
+      f.unit = prismatic ? f.unit.substr(either + 4) : f.unit.substr(0, either);
+    }
+    info.field_names.push_back(std::move(f.name));
+    info.field_units.push_back(std::move(f.unit));
   }
   info.flow_limit_m3_s = m.pump.max_flow_m3_s;
   info.power_limit_w = m.pump.prime_mover_power_w;

@@ -175,7 +175,8 @@ TEST(FieldTable, FlatValuesFollowTheirNames) {
   row.q = {1, 2, 3, 4};
   row.tip = {5, 6, 7};
   row.deadman = true;
-  const auto names = control::flat_field_names(4, false);
+  std::vector<std::string> names;
+  for (const auto& f : control::flat_fields(4, false)) names.push_back(f.name);
   std::vector<double> values(names.size() + 5, -1.0);
   const int n =
       control::flat_field_values(row, 4, false, values.data(), static_cast<int>(values.size()));
@@ -188,7 +189,12 @@ TEST(FieldTable, FlatValuesFollowTheirNames) {
   EXPECT_EQ(at("tip.y"), 6.0);
   EXPECT_EQ(at("deadman"), 1.0);
   EXPECT_EQ(std::count(names.begin(), names.end(), "base_pose.x"), 0);
-  EXPECT_EQ(control::flat_field_names(4, true).size(), names.size() + 15);
+  const auto with_base = control::flat_fields(4, true);
+  EXPECT_EQ(with_base.size(), names.size() + 15);
+  const auto phi = std::find_if(with_base.begin(), with_base.end(),
+                                [](const auto& f) { return f.name == "base_pose.phi"; });
+  ASSERT_NE(phi, with_base.end());
+  EXPECT_EQ(phi->unit, "rad");
 }
 
 TEST(Channels, Ros2SchemasAreJazzys) {

@@ -24,6 +24,17 @@ std::string_view nth(std::string_view list, std::size_t k) {
   return list.substr(0, list.find(','));
 }
 
+// The k-th of a unit list "m, m, rad" (a single unit: that one for every k).
+std::string_view nth_unit(std::string_view list, std::size_t k) {
+  if (list.find(", ") == std::string_view::npos) return list;
+  for (std::size_t i = 0; i < k; ++i) {
+    const auto sep = list.find(", ");
+    if (sep == std::string_view::npos) return list;
+    list.remove_prefix(sep + 2);
+  }
+  return list.substr(0, list.find(", "));
+}
+
 const LogRow kEmptyRow{};  // for the descriptions (the values are not read)
 
 bool present(const Field& f, bool base) {
@@ -208,22 +219,25 @@ std::string group_json_schema(FieldGroup group) {
          R"("type":"object","properties":{)" + properties + "},\"required\":[" + required + "]}";
 }
 
-std::vector<std::string> flat_field_names(int dof, bool base) {
-  std::vector<std::string> names;
+std::vector<FlatField> flat_fields(int dof, bool base) {
+  std::vector<FlatField> names;
   visit_fields(kEmptyRow, [&](const Field& f, const auto& value) {
     using T = std::decay_t<decltype(value)>;
     if (!present(f, base) || std::is_same_v<T, const char*>) return;
     if constexpr (kIsArray<T>) {
       if (f.per_joint) {
-        for (int i = 1; i <= dof; ++i)
-          names.push_back(std::string(f.name) + "." + std::to_string(i));
+        for (int i = 1; i <= dof; ++i) {
+          names.push_back({std::string(f.name) + "." + std::to_string(i), f.unit});
+        }
       } else {
         for (std::size_t k = 0; k < value.size(); ++k) {
-          names.push_back(std::string(f.name) + "." + std::string(nth(f.components, k)));
+          // A vector of mixed units ("m, m, rad") lists one per component.
+          names.push_back({std::string(f.name) + "." + std::string(nth(f.components, k)),
+                           std::string(nth_unit(f.unit, k))});
         }
       }
     } else {
-      names.emplace_back(f.name);
+      names.push_back({f.name, f.unit});
     }
   });
   return names;

@@ -61,6 +61,8 @@ bool safe_deserialize_payload(Topic topic, const std::uint8_t* data, std::size_t
         return deserialize_as<msg::OperatorCommandPubSubType>(data, size);
       case Topic::kBase:
         return deserialize_as<msg::BaseStatePubSubType>(data, size);
+      case Topic::kFields:
+        return deserialize_as<msg::FieldValuesPubSubType>(data, size);
     }
   } catch (...) {  // out of memory for the payload's copy
   }

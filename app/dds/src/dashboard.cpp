@@ -98,6 +98,7 @@ class LatestSamples {
         take_into<msg::BaseState>(reader, &Snapshot::base, topic);
         break;
       case Topic::kOperatorCommand:
+      case Topic::kFields:
         break;
     }
   }

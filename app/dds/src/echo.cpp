@@ -146,6 +146,15 @@ void describe(const msg::OperatorCommand& m, FieldVisitor& v) {
   v.flag("deadman", m.deadman());
 }
 
+// The field table's values by name (craneassist/fields), each with its unit.
+void describe(const msg::FieldValues& m, FieldVisitor& v) {
+  describe_header(m.header(), v);
+  const std::size_t n = std::min(m.names().size(), m.values().size());
+  for (std::size_t i = 0; i < n; ++i) {
+    v.number(m.names()[i].c_str(), m.values()[i], i < m.units().size() ? m.units()[i].c_str() : "");
+  }
+}
+
 void describe(const msg::BaseState& m, FieldVisitor& v) {
   describe_header(m.header(), v);
   v.number("x_m", m.pose()[0], "m");
@@ -499,6 +508,9 @@ void echo_sample(const msg::OperatorCommand& sample, EchoFormat format, std::FIL
 void echo_sample(const msg::BaseState& sample, EchoFormat format, std::FILE* out) {
   echo_one(sample, format, out);
 }
+void echo_sample(const msg::FieldValues& sample, EchoFormat format, std::FILE* out) {
+  echo_one(sample, format, out);
+}
 
 int run_echo(const EchoOptions& o) {
   const TopicInfo* topic = find_topic(o.topic);
@@ -524,6 +536,8 @@ int run_echo(const EchoOptions& o) {
       return echo_topic<msg::OperatorCommand>(*topic, o);
     case Topic::kBase:
       return echo_topic<msg::BaseState>(*topic, o);
+    case Topic::kFields:
+      return echo_topic<msg::FieldValues>(*topic, o);
   }
   return kToolUsage;
 }

@@ -116,6 +116,7 @@ ParticipantPtr make_participant(const ParticipantOptions& options) {
   register_type_support<CheckedPubSubType<craneassist::msg::CommandPathPubSubType>>(*p, types);
   register_type_support<CheckedPubSubType<craneassist::msg::OperatorCommandPubSubType>>(*p, types);
   register_type_support<CheckedPubSubType<craneassist::msg::BaseStatePubSubType>>(*p, types);
+  register_type_support<CheckedPubSubType<craneassist::msg::FieldValuesPubSubType>>(*p, types);
   return p;
 }
 

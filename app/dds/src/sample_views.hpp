@@ -20,6 +20,7 @@ void echo_sample(const msg::Hydraulics& sample, EchoFormat format, std::FILE* ou
 void echo_sample(const msg::CommandPath& sample, EchoFormat format, std::FILE* out);
 void echo_sample(const msg::OperatorCommand& sample, EchoFormat format, std::FILE* out);
 void echo_sample(const msg::BaseState& sample, EchoFormat format, std::FILE* out);
+void echo_sample(const msg::FieldValues& sample, EchoFormat format, std::FILE* out);
 
 // The dashboard's plain view (as --once prints it) of the latest sample of each telemetry topic;
 // nullptr: none received yet (base: a crane without a wheeled base).

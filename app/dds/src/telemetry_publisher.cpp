@@ -33,9 +33,10 @@ std::int64_t monotonic_ns() noexcept {
 
 namespace {
 
-// status, joints, hydraulics, command_path, base (a run with a wheeled base only)
-constexpr int kTelemetryTopics = 5;
+// status, joints, hydraulics, command_path, base (a run with a wheeled base only), fields
+constexpr int kTelemetryTopics = 6;
 constexpr int kBaseTopic = 4;
+constexpr int kFieldsTopic = 5;
 
 template <typename Header>
 void fill_header(Header& h, const TelemetryFrame& f) {
@@ -55,18 +56,20 @@ struct TelemetryPublisher::Impl {
   Impl(const config::TelemetryConfig& config, TelemetryInfo run_info, std::size_t capacity)
       : info(std::move(run_info)), base_settings(config.hydraulics), ring(capacity + 1) {
     const config::TopicSettings* settings[kTelemetryTopics] = {
-        &config.status, &config.joints, &config.hydraulics, &config.command_path,
-        &config.hydraulics};  // the base at the hydraulics topic's rate and QoS
+        &config.status,     &config.joints, &config.hydraulics, &config.command_path,
+        &config.hydraulics,  // the base at the hydraulics topic's rate and QoS
+        &config.status};     // the fields at the status topic's
     for (int i = 0; i < kTelemetryTopics; ++i) pacers[i] = TopicPacer(settings[i]->rate_hz);
     participant = make_participant(participant_options(config));
     if (config.ros2.enabled) register_ros2_types(*participant, config.type_propagation);
     publisher = participant->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
     if (publisher == nullptr) throw std::runtime_error("DDS: cannot create the publisher");
-    const Topic topics[kTelemetryTopics] = {Topic::kStatus, Topic::kJoints, Topic::kHydraulics,
-                                            Topic::kCommandPath, Topic::kBase};
+    const Topic topics[kTelemetryTopics] = {Topic::kStatus,      Topic::kJoints, Topic::kHydraulics,
+                                            Topic::kCommandPath, Topic::kBase,   Topic::kFields};
     // The base's writer comes with the first frame that has a base (publish(), on the publisher
     // thread): a run without one offers no craneassist/base.
-    for (int i = 0; i < kBaseTopic; ++i) {
+    for (int i = 0; i < kTelemetryTopics; ++i) {
+      if (i == kBaseTopic) continue;
       writers[i] = publisher->create_datawriter(get_topic(*participant, topics[i]),
                                                 writer_qos(*settings[i]));
       if (writers[i] == nullptr) {
@@ -78,6 +81,8 @@ struct TelemetryPublisher::Impl {
       ros2.emplace(*participant, *publisher, config.ros2, info);
     }
     joints.names(info.joint_names);
+    fields.names(info.field_names);
+    fields.units(info.field_units);
     joints.prismatic(info.joint_prismatic);
     sem_init(&wake, 0, 0);
     thread = std::thread([this] { run(); });
@@ -192,6 +197,9 @@ struct TelemetryPublisher::Impl {
         case 3:
           ok = write_command_path(f);
           break;
+        case kFieldsTopic:
+          ok = write_fields(f);
+          break;
         default:
           ok = write_base(f);
           break;
@@ -268,6 +276,13 @@ struct TelemetryPublisher::Impl {
     return writers[kBaseTopic]->write(&base);
   }
 
+  bool write_fields(const TelemetryFrame& f) {
+    fill_header(fields.header(), f);
+    const int n = std::clamp(f.value_count, 0, kMaxFieldValues);
+    fields.values().assign(f.values.begin(), f.values.begin() + n);
+    return writers[kFieldsTopic]->write(&fields);
+  }
+
   bool write_hydraulics(const TelemetryFrame& f) {
     fill_header(hydraulics.header(), f);
     hydraulics.pump_mode(info.pump_mode);
@@ -337,6 +352,7 @@ struct TelemetryPublisher::Impl {
   craneassist::msg::Hydraulics hydraulics;
   craneassist::msg::CommandPath command_path;
   craneassist::msg::BaseState base;
+  craneassist::msg::FieldValues fields;
   config::TopicSettings base_settings;  // the hydraulics topic's rate and QoS
   // The ring (loop thread produces, publisher thread consumes).
   std::vector<TelemetryFrame> ring;

@@ -80,6 +80,7 @@ struct TelemetryWatch::Impl {
         take_all<msg::BaseState>(reader, bad);
         break;
       case Topic::kOperatorCommand:
+      case Topic::kFields:
         break;
     }
     if (bad > 0) {

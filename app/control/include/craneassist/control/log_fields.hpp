@@ -145,10 +145,14 @@ void append_group_json(const LogRow& row, int dof, FieldGroup group, std::string
 std::string group_json_schema(FieldGroup group);
 
 // Every numeric field (numbers, bools as 0/1; per-joint fields as dof values, vectors by
-// component) flattened: the names ("q.1", "tip.x", ...) and, for one row, the values. For the
-// generic craneassist/fields DDS topic.
-std::vector<std::string> flat_field_names(int dof, bool base);
-// Writes the values in flat_field_names' order into out[0..]; returns how many (at most `size`).
+// component) flattened: the names ("q.1", "tip.x", ...) with their units and, for one row, the
+// values. For the generic craneassist/fields DDS topic.
+struct FlatField {
+  std::string name;
+  std::string unit;
+};
+std::vector<FlatField> flat_fields(int dof, bool base);
+// Writes the values in flat_fields' order into out[0..]; returns how many (at most `size`).
 int flat_field_values(const LogRow& row, int dof, bool base, double* out, int size) noexcept;
 
 // The table as Markdown (docs/log-format.md, docs/telemetry.md): `craneassist fields --markdown`.

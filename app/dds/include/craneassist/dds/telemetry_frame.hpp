@@ -13,6 +13,9 @@
 namespace craneassist::dds {
 
 inline constexpr int kMaxJoints = 8;
+// The field table's numeric values a frame carries (craneassist/fields): 8 joints and a base
+// need about 130.
+inline constexpr int kMaxFieldValues = 192;
 
 struct TelemetryFrame {
   std::uint64_t cycle = 0;
@@ -64,6 +67,10 @@ struct TelemetryFrame {
   std::array<double, 2> base_velocity{}, base_command{};
   std::array<double, 4> base_motor_flow_m3_s{};
   double base_flow_sum_m3_s = 0.0, base_flow_max_m3_s = 0.0;
+  // Every numeric value of the field table, in TelemetryInfo::field_names' order (the
+  // craneassist/fields topic): value_count of them.
+  std::array<double, kMaxFieldValues> values{};
+  int value_count = 0;
 };
 static_assert(std::is_trivially_copyable_v<TelemetryFrame>);
 
@@ -82,6 +89,8 @@ struct TelemetryInfo {
   // Maps a crane-frame vector (tip commands: x forward, y up, z lateral) to the DH base frame,
   // the URDF's base_link (the ROS 2 topics' frame). Row-major 3x3.
   std::array<double, 9> base_from_crane{1, 0, 0, 0, 1, 0, 0, 0, 1};
+  // The names and units of TelemetryFrame::values (control::flat_fields).
+  std::vector<std::string> field_names, field_units;
 };
 
 }  // namespace craneassist::dds

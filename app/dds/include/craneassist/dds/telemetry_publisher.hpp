@@ -16,8 +16,9 @@ namespace craneassist::dds {
 
 struct PublisherStats {
   std::uint64_t frames_pushed = 0;
-  std::uint64_t frames_dropped = 0;       // the ring was full (the publisher fell behind)
-  std::uint64_t samples_written[5] = {};  // status, joints, hydraulics, command_path, base
+  std::uint64_t frames_dropped = 0;  // the ring was full (the publisher fell behind)
+  // status, joints, hydraulics, command_path, base, fields
+  std::uint64_t samples_written[6] = {};
   // The ROS 2 topics (config ros2): joint_states, tip velocity command, tip velocity reference.
   std::uint64_t ros2_samples_written[3] = {};
   std::uint64_t write_errors = 0;

@@ -5,7 +5,7 @@
 
 namespace craneassist::dds {
 
-enum class Topic { kStatus, kJoints, kHydraulics, kCommandPath, kOperatorCommand, kBase };
+enum class Topic { kStatus, kJoints, kHydraulics, kCommandPath, kOperatorCommand, kBase, kFields };
 
 struct TopicInfo {
   Topic topic;
@@ -23,6 +23,7 @@ inline constexpr TopicInfo kTopics[] = {
     {Topic::kOperatorCommand, "operator_command", "craneassist/operator_command",
      "craneassist::msg::OperatorCommand"},
     {Topic::kBase, "base", "craneassist/base", "craneassist::msg::BaseState"},
+    {Topic::kFields, "fields", "craneassist/fields", "craneassist::msg::FieldValues"},
 };
 
 // The entry of a short or DDS name; nullptr when there is none.
