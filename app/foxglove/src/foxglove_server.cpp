@@ -469,79 +469,107 @@ void FoxgloveServer::Impl::on_binary(FoxgloveSession& s) {
   status(s, 2, "craneassist takes no client messages (no clientPublish): dropped");
 }
 
-void FoxgloveServer::Impl::on_text(FoxgloveSession& s, std::string_view text) {
+ClientRequest parse_client_request(std::string_view text) {
+  ClientRequest r;
   const json m = json::parse(text, nullptr, false);
   if (m.is_discarded() || !m.is_object() || !m.contains("op") || !m["op"].is_string()) {
-    client_malformed.fetch_add(1);
-    status(s, 2, "not a JSON object with an \"op\": dropped");
-    return;
+    r.why = "not a JSON object with an \"op\"";
+    return r;
   }
-  const std::string op = m["op"].get<std::string>();
+  r.op = m["op"].get<std::string>();
   const auto valid_id = [](const json& v) {
     return v.is_number_unsigned() && v.get<std::uint64_t>() <= 0xFFFFFFFFULL;
   };
-  if (op == "subscribe") {
+  if (r.op == "subscribe") {
     if (!m.contains("subscriptions") || !m["subscriptions"].is_array()) {
-      client_malformed.fetch_add(1);
-      status(s, 2, "subscribe: no \"subscriptions\" array: dropped");
-      return;
+      r.why = "subscribe: no \"subscriptions\" array";
+      return r;
     }
+    r.kind = ClientRequest::Kind::kSubscribe;
     for (const json& sub : m["subscriptions"]) {
       if (!sub.is_object() || !sub.contains("id") || !sub.contains("channelId") ||
           !valid_id(sub["id"]) || !valid_id(sub["channelId"])) {
-        client_malformed.fetch_add(1);
-        status(s, 2, "subscribe: each subscription needs an \"id\" and a \"channelId\"");
+        ++r.bad_items;
+        r.why = "subscribe: each subscription needs an \"id\" and a \"channelId\"";
         continue;
       }
-      const auto id = sub["id"].get<std::uint32_t>();
-      const auto channel = sub["channelId"].get<std::uint64_t>();
-      if (channel == 0 || channel > channels.size()) {
-        client_malformed.fetch_add(1);
-        status(s, 1, "subscribe: no channel " + std::to_string(channel));
-        continue;
-      }
-      if (s.subscriptions.count(id) != 0) {
-        client_malformed.fetch_add(1);
-        status(s, 1, "subscribe: subscription id " + std::to_string(id) + " is taken");
-        continue;
-      }
-      const std::size_t k = channel - 1;
-      s.subscriptions[id] = k;
-      ++subscribers[k];
-      subscriptions_made.fetch_add(1);
-      if (channels.channels()[k].latched) {
-        // The latched description: now, to this subscription.
-        channels.encode(k, control::LogRow{}, 0, encoded);
-        auto out = std::make_shared<Outgoing>();
-        out->bytes.push_back(kMessageData);
-        put_le(out->bytes, id);
-        put_le(out->bytes, message_time_ns(epoch_ns.load(), 0.0));
-        out->bytes.insert(out->bytes.end(), encoded.begin(), encoded.end());
-        s.send(out, true);
-      }
+      r.subscribe.emplace_back(sub["id"].get<std::uint32_t>(),
+                               sub["channelId"].get<std::uint32_t>());
     }
-    return;
+    return r;
   }
-  if (op == "unsubscribe") {
+  if (r.op == "unsubscribe") {
     if (!m.contains("subscriptionIds") || !m["subscriptionIds"].is_array()) {
-      client_malformed.fetch_add(1);
-      status(s, 2, "unsubscribe: no \"subscriptionIds\" array: dropped");
-      return;
+      r.why = "unsubscribe: no \"subscriptionIds\" array";
+      return r;
     }
+    r.kind = ClientRequest::Kind::kUnsubscribe;
     for (const json& id : m["subscriptionIds"]) {
       if (!valid_id(id)) {
-        client_malformed.fetch_add(1);
+        ++r.bad_items;
+        r.why = "unsubscribe: a subscription id is not a 32-bit unsigned integer";
         continue;
       }
-      const auto it = s.subscriptions.find(id.get<std::uint32_t>());
-      if (it == s.subscriptions.end()) continue;
-      --subscribers[it->second];
-      s.subscriptions.erase(it);
+      r.unsubscribe.push_back(id.get<std::uint32_t>());
     }
-    return;
+    return r;
   }
-  client_unsupported.fetch_add(1);
-  status(s, 2, "craneassist does not offer '" + op + "' (no command input here): dropped");
+  r.kind = ClientRequest::Kind::kUnsupported;
+  r.why = "craneassist does not offer '" + r.op + "' (no command input here)";
+  return r;
+}
+
+void FoxgloveServer::Impl::on_text(FoxgloveSession& s, std::string_view text) {
+  const ClientRequest r = parse_client_request(text);
+  switch (r.kind) {
+    case ClientRequest::Kind::kMalformed:
+      client_malformed.fetch_add(1);
+      status(s, 2, r.why + ": dropped");
+      return;
+    case ClientRequest::Kind::kUnsupported:
+      client_unsupported.fetch_add(1);
+      status(s, 2, r.why + ": dropped");
+      return;
+    case ClientRequest::Kind::kSubscribe:
+    case ClientRequest::Kind::kUnsubscribe:
+      break;
+  }
+  if (r.bad_items > 0) {
+    client_malformed.fetch_add(static_cast<std::uint64_t>(r.bad_items));
+    status(s, 2, r.why);
+  }
+  for (const std::uint32_t id : r.unsubscribe) {
+    const auto it = s.subscriptions.find(id);
+    if (it == s.subscriptions.end()) continue;
+    --subscribers[it->second];
+    s.subscriptions.erase(it);
+  }
+  for (const auto& [id, channel] : r.subscribe) {
+    if (channel == 0 || channel > channels.size()) {
+      client_malformed.fetch_add(1);
+      status(s, 1, "subscribe: no channel " + std::to_string(channel));
+      continue;
+    }
+    if (s.subscriptions.count(id) != 0) {
+      client_malformed.fetch_add(1);
+      status(s, 1, "subscribe: subscription id " + std::to_string(id) + " is taken");
+      continue;
+    }
+    const std::size_t k = channel - 1;
+    s.subscriptions[id] = k;
+    ++subscribers[k];
+    subscriptions_made.fetch_add(1);
+    if (channels.channels()[k].latched) {
+      // The latched description: now, to this subscription.
+      channels.encode(k, control::LogRow{}, 0, encoded);
+      auto out = std::make_shared<Outgoing>();
+      out->bytes.push_back(kMessageData);
+      put_le(out->bytes, id);
+      put_le(out->bytes, message_time_ns(epoch_ns.load(), 0.0));
+      out->bytes.insert(out->bytes.end(), encoded.begin(), encoded.end());
+      s.send(out, true);
+    }
+  }
 }
 
 void FoxgloveServer::Impl::shutdown() {

@@ -17,6 +17,9 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
 
 #include "craneassist/control/control_loop.hpp"
 #include "craneassist/dynamics/model.hpp"
@@ -34,6 +37,21 @@ struct ServerOptions {
 
 // "8765", "0.0.0.0:8765", "[::1]:8765" into options; false (and why) when not valid.
 bool parse_listen_address(const std::string& text, ServerOptions& options, std::string& why);
+
+// A client's text message (Foxglove WebSocket protocol): what the server does with it. Only
+// subscribe and unsubscribe are offered; any other op is unsupported, anything that is not a JSON
+// object with a string "op" (or a subscribe/unsubscribe without its array) is malformed.
+// Entries of the array that are not valid are counted in bad_items and left out.
+struct ClientRequest {
+  enum class Kind { kMalformed, kUnsupported, kSubscribe, kUnsubscribe };
+  Kind kind = Kind::kMalformed;
+  std::string op;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> subscribe;  // subscription id, channel id
+  std::vector<std::uint32_t> unsubscribe;                          // subscription ids
+  int bad_items = 0;
+  std::string why;  // for the status reply ("" when all is well)
+};
+ClientRequest parse_client_request(std::string_view text);
 
 struct ServerCounters {
   std::uint64_t clients_connected = 0;
