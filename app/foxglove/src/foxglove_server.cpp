@@ -22,6 +22,7 @@
 #include "craneassist/control/spsc_ring.hpp"
 #include "craneassist/foxglove/channels.hpp"
 #include "craneassist/foxglove/mcap_recorder.hpp"
+#include "craneassist/net/listener.hpp"
 
 namespace craneassist::foxglove {
 
@@ -365,45 +366,15 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   FoxgloveServer::Impl& impl_;
 };
 
-void accept(FoxgloveServer::Impl& impl) {
-  impl.acceptor.async_accept([&impl](beast::error_code ec, tcp::socket socket) {
-    if (ec == net::error::operation_aborted) return;
-    if (!ec) std::make_shared<HttpSession>(std::move(socket), impl)->read();
-    accept(impl);
-  });
-}
-
 }  // namespace
 
 void FoxgloveServer::Impl::start() {
-  beast::error_code ec;
-  const auto address = net::ip::make_address(options.address, ec);
-  if (ec) throw std::runtime_error("foxglove: bad listen address '" + options.address + "'");
-  const tcp::endpoint endpoint(address, options.port);
-  auto fail = [&](const char* what) {
-    throw std::runtime_error("foxglove: cannot listen on " + options.address + ":" +
-                             std::to_string(options.port) + ": " + what + ": " + ec.message());
-  };
-  acceptor.open(endpoint.protocol(), ec);
-  if (ec) fail("open");
-  acceptor.set_option(net::socket_base::reuse_address(true), ec);
-  acceptor.bind(endpoint, ec);
-  if (ec) fail("bind");
-  acceptor.listen(net::socket_base::max_listen_connections, ec);
-  if (ec) fail("listen");
-  accept(*this);
-  tick();
-  thread = std::thread([this] {
-    for (;;) {
-      try {
-        ioc.run();
-        break;
-      } catch (const std::exception& e) {
-        std::fprintf(stderr, "craneassist: foxglove: %s\n", e.what());
-      }
-    }
-    stopped.set_value();
+  craneassist::net::listen(acceptor, options.address, options.port, "foxglove");
+  craneassist::net::accept_into(acceptor, [this](tcp::socket socket) {
+    std::make_shared<HttpSession>(std::move(socket), *this)->read();
   });
+  tick();
+  thread = craneassist::net::run_io_thread(ioc, stopped, "foxglove");
 }
 
 void FoxgloveServer::Impl::tick() {
@@ -593,13 +564,9 @@ FoxgloveServer::~FoxgloveServer() {
 }
 
 void FoxgloveServer::stop(double drain_s) {
-  if (!impl_->thread.joinable()) return;
-  net::post(impl_->ioc, [impl = impl_.get()] { impl->shutdown(); });
-  if (impl_->stopped.get_future().wait_for(std::chrono::duration<double>(drain_s)) !=
-      std::future_status::ready) {
-    impl_->ioc.stop();
-  }
-  impl_->thread.join();
+  craneassist::net::stop_io_thread(
+      impl_->ioc, impl_->thread, impl_->stopped, [impl = impl_.get()] { impl->shutdown(); },
+      drain_s);
 }
 
 bool FoxgloveServer::wait_for_subscriber(double timeout_s) const {
@@ -617,10 +584,7 @@ unsigned short FoxgloveServer::port() const {
 }
 
 std::string FoxgloveServer::url() const {
-  std::string host = impl_->options.address;
-  if (host == "0.0.0.0" || host == "::") host = "127.0.0.1";
-  if (host.find(':') != std::string::npos) host = "[" + host + "]";
-  return "ws://" + host + ":" + std::to_string(port());
+  return "ws://" + craneassist::net::client_host_port(impl_->options.address, port());
 }
 
 control::CycleObserver& FoxgloveServer::observer() {

@@ -22,6 +22,7 @@
 #include "craneassist/input/joystick_mapping.hpp"
 #include "craneassist/input/latest_pad.hpp"
 #include "craneassist/input/triple_buffer.hpp"
+#include "craneassist/net/listener.hpp"
 #include "pad_message.hpp"
 #include "scene.hpp"
 
@@ -330,46 +331,15 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   WebServer::Impl& impl_;
 };
 
-void accept(WebServer::Impl& impl) {
-  impl.acceptor.async_accept([&impl](beast::error_code ec, tcp::socket socket) {
-    if (ec == net::error::operation_aborted) return;
-    if (!ec) std::make_shared<HttpSession>(std::move(socket), impl)->read();
-    accept(impl);
-  });
-}
-
 }  // namespace
 
 void WebServer::Impl::start() {
-  beast::error_code ec;
-  const auto address = net::ip::make_address(options.address, ec);
-  if (ec) throw std::runtime_error("web: bad listen address '" + options.address + "'");
-  const tcp::endpoint endpoint(address, options.port);
-  auto fail = [&](const char* what) {
-    throw std::runtime_error("web: cannot listen on " + options.address + ":" +
-                             std::to_string(options.port) + ": " + what + ": " + ec.message());
-  };
-  acceptor.open(endpoint.protocol(), ec);
-  if (ec) fail("open");
-  acceptor.set_option(net::socket_base::reuse_address(true), ec);
-  acceptor.bind(endpoint, ec);
-  if (ec) fail("bind");
-  acceptor.listen(net::socket_base::max_listen_connections, ec);
-  if (ec) fail("listen");
-  accept(*this);
-  tick();
-  thread = std::thread([this] {
-    // A handler that throws (out of memory) must not end the process: log and go on.
-    for (;;) {
-      try {
-        ioc.run();
-        break;
-      } catch (const std::exception& e) {
-        std::fprintf(stderr, "craneassist: web: %s\n", e.what());
-      }
-    }
-    stopped.set_value();
+  craneassist::net::listen(acceptor, options.address, options.port, "web");
+  craneassist::net::accept_into(acceptor, [this](tcp::socket socket) {
+    std::make_shared<HttpSession>(std::move(socket), *this)->read();
   });
+  tick();
+  thread = craneassist::net::run_io_thread(ioc, stopped, "web");
 }
 
 void WebServer::Impl::tick() {
@@ -496,12 +466,8 @@ WebServer::WebServer(const WebOptions& options, const config::CraneConfig& crane
 }
 
 WebServer::~WebServer() {
-  net::post(impl_->ioc, [impl = impl_.get()] { impl->shutdown(); });
-  if (impl_->stopped.get_future().wait_for(std::chrono::milliseconds(500)) !=
-      std::future_status::ready) {
-    impl_->ioc.stop();
-  }
-  impl_->thread.join();
+  craneassist::net::stop_io_thread(
+      impl_->ioc, impl_->thread, impl_->stopped, [impl = impl_.get()] { impl->shutdown(); }, 0.5);
 }
 
 unsigned short WebServer::port() const {
@@ -510,10 +476,8 @@ unsigned short WebServer::port() const {
 }
 
 std::string WebServer::url() const {
-  std::string host = impl_->options.address;
-  if (host == "0.0.0.0" || host == "::") host = "127.0.0.1";
-  if (host.find(':') != std::string::npos) host = "[" + host + "]";
-  return "http://" + host + ":" + std::to_string(port()) + "/?token=" + impl_->token;
+  return "http://" + craneassist::net::client_host_port(impl_->options.address, port()) +
+         "/?token=" + impl_->token;
 }
 
 control::CycleObserver& WebServer::observer() {

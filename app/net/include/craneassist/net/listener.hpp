@@ -1,0 +1,91 @@
+// What the two Boost.Beast servers of craneassist share (the web view, app/web; the Foxglove
+// WebSocket server, app/foxglove): listening on an address, accepting connections into
+// sessions, running the I/O thread, and the address a client should use.
+#pragma once
+
+#include <boost/asio.hpp>
+#include <cstdio>
+#include <exception>
+#include <future>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+namespace craneassist::net {
+
+namespace asio = boost::asio;
+using tcp = asio::ip::tcp;
+
+// Opens, binds and listens; throws std::runtime_error "WHO: cannot listen on ADDRESS:PORT: step:
+// why" (a port in use, an address not of this host) or "WHO: bad listen address".
+inline void listen(tcp::acceptor& acceptor, const std::string& address, unsigned short port,
+                   const char* who) {
+  boost::system::error_code ec;
+  const auto ip = asio::ip::make_address(address, ec);
+  if (ec) throw std::runtime_error(std::string(who) + ": bad listen address '" + address + "'");
+  const tcp::endpoint endpoint(ip, port);
+  auto fail = [&](const char* what) {
+    throw std::runtime_error(std::string(who) + ": cannot listen on " + address + ":" +
+                             std::to_string(port) + ": " + what + ": " + ec.message());
+  };
+  acceptor.open(endpoint.protocol(), ec);
+  if (ec) fail("open");
+  acceptor.set_option(asio::socket_base::reuse_address(true), ec);
+  acceptor.bind(endpoint, ec);
+  if (ec) fail("bind");
+  acceptor.listen(asio::socket_base::max_listen_connections, ec);
+  if (ec) fail("listen");
+}
+
+// Accepts connections for ever (until the acceptor closes): each socket to make_session(socket).
+template <class MakeSession>
+void accept_into(tcp::acceptor& acceptor, MakeSession make_session) {
+  acceptor.async_accept([&acceptor, make_session](boost::system::error_code ec, tcp::socket s) {
+    if (ec == asio::error::operation_aborted) return;
+    if (!ec) make_session(std::move(s));
+    accept_into(acceptor, make_session);
+  });
+}
+
+// The I/O thread: runs ioc until it has no work; a handler that throws (out of memory) is
+// logged and the loop goes on. `stopped` is set when it ends.
+inline std::thread run_io_thread(asio::io_context& ioc, std::promise<void>& stopped,
+                                 const char* who) {
+  return std::thread([&ioc, &stopped, who] {
+    for (;;) {
+      try {
+        ioc.run();
+        break;
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "craneassist: %s: %s\n", who, e.what());
+      }
+    }
+    stopped.set_value();
+  });
+}
+
+// Ends the I/O thread: `shutdown` posted to it (close the acceptor and the sessions), then at
+// most wait_s for the thread to run out of work before the context is stopped.
+template <class Shutdown>
+void stop_io_thread(asio::io_context& ioc, std::thread& thread, std::promise<void>& stopped,
+                    Shutdown shutdown, double wait_s) {
+  if (!thread.joinable()) return;
+  asio::post(ioc, shutdown);
+  if (stopped.get_future().wait_for(std::chrono::duration<double>(wait_s)) !=
+      std::future_status::ready) {
+    ioc.stop();
+  }
+  thread.join();
+}
+
+// "HOST:PORT" for a client on this host: a listener on every interface (0.0.0.0, ::) is reached
+// at 127.0.0.1; an IPv6 address in brackets.
+inline std::string client_host_port(const std::string& address, unsigned short port) {
+  std::string host = address;
+  if (host == "0.0.0.0" || host == "::") host = "127.0.0.1";
+  if (host.find(':') != std::string::npos) host = "[" + host + "]";
+  return host + ":" + std::to_string(port);
+}
+
+}  // namespace craneassist::net
