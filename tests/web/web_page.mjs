@@ -37,6 +37,17 @@ try {
   await sleep(1200);
   const rate = await page.evaluate(() => window.craneassist.rate_hz);
   check(rate >= 20 && rate <= 40, `frames received: ${rate} per second (30 streamed)`);
+  // The "All values" list: every field of the table (crane.json), each filled from the frames.
+  await page.evaluate(() => { document.getElementById('all-values').open = true; });
+  await sleep(300);
+  const values = await page.evaluate(() => ({
+    fields: window.craneassist.crane.fields.length,
+    rows: document.querySelectorAll('#fields-table tr').length,
+    power: [...document.querySelectorAll('#fields-table tr')]
+      .find((r) => r.cells[0].textContent === 'hydraulics.pump_pressure_pa')?.cells[1].textContent,
+  }));
+  check(values.fields > 60 && values.rows === values.fields && /^[0-9.e+-]+$/.test(values.power ?? ''),
+    `all values: ${values.rows} rows of ${values.fields} fields, pump pressure ${values.power} Pa`);
   // Before any stick motion: the polytope's volume at the start pose, no stick direction yet.
   const idle = await polytopeShown(page);
   checkPolytopeShown(idle, 'at rest');

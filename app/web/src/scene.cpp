@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <string_view>
 
+#include "craneassist/control/log_fields.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
 #include "craneassist/dynamics/pendulum.hpp"
 
@@ -137,6 +138,19 @@ std::string crane_json(const config::CraneConfig& crane, double frame_rate_hz) {
       .number("max_pressure_pa", dynamics::supply_pressure_ceiling_pa(m.pump))
       .number("max_power_w", m.pump.prime_mover_power_w)
       .close();
+  // The field table (control/log_fields.hpp): the page lists every value of frame.fields by it.
+  std::string& fields = root.nested("fields");
+  fields += '[';
+  for (const control::Field& field : control::field_table()) {
+    if (fields.back() != '[') fields += ',';
+    Object(fields)
+        .text("name", field.name)
+        .text("unit", field.unit)
+        .text("group", control::to_string(field.group))
+        .text("meaning", field.meaning)
+        .close();
+  }
+  fields += ']';
   root.number("rate_hz", crane.control.rate_hz).number("frame_rate_hz", frame_rate_hz).close();
   return out;
 }
@@ -275,6 +289,18 @@ void SceneBuilder::frame_json(const control::LogRow& row, std::uint64_t seq, std
         .close();
   }
   if (row.base_present) base_json(row, f.nested("base"));
+  // Every value of the field table, by group (the page's "All values" list).
+  std::string& fields = f.nested("fields");
+  fields += '{';
+  for (const control::FieldGroup g : control::kFieldGroups) {
+    if (g == control::FieldGroup::kBase && !row.base_present) continue;
+    if (fields.back() != '{') fields += ',';
+    fields += '"';
+    fields += control::to_string(g);
+    fields += "\":";
+    control::append_group_json(row, n, g, fields);
+  }
+  fields += '}';
 
   // The drawing: joint frame origins, and each cylinder's ends.
   dynamics::JointVector q(n);

@@ -277,7 +277,40 @@ function polytopeText(p) {
   return `dimension ${p.dim}: no motion across it`;
 }
 
+// "All values": every field of the frame's field table (crane.json's "fields": name, unit, group,
+// meaning), a row per field, filled while the list is open.
+let fieldCells = null;
+function showFields(f) {
+  if (!crane || !crane.fields || !f.fields || !$('all-values').open) return;
+  const table = $('fields-table');
+  if (fieldCells === null) {
+    fieldCells = new Map();
+    for (const d of crane.fields) {
+      const tr = document.createElement('tr');
+      tr.title = d.meaning;
+      const name = document.createElement('td');
+      name.textContent = `${d.group}.${d.name}`;
+      const value = document.createElement('td');
+      const unit = document.createElement('td');
+      unit.textContent = d.unit;
+      tr.append(name, value, unit);
+      table.append(tr);
+      fieldCells.set(`${d.group}.${d.name}`, value);
+    }
+  }
+  const show = (v) => (v === null ? '-' : typeof v === 'number' ? (Number.isInteger(v) ? String(v) : v.toPrecision(4))
+    : Array.isArray(v) ? v.map(show).join(' ') : typeof v === 'object' ? Object.values(v).map(show).join(' ')
+    : String(v));
+  for (const [group, values] of Object.entries(f.fields)) {
+    for (const [name, v] of Object.entries(values)) {
+      const cell = fieldCells.get(`${group}.${name}`);
+      if (cell) cell.textContent = show(v);
+    }
+  }
+}
+
 function showFrame(f) {
+  showFields(f);
   $('t').textContent = fmt(f.t, 1);
   $('tip').textContent = f.tip.map((v) => fmt(v)).join(' ');
   $('speed').textContent = fmt(norm(f.tip_v));
