@@ -138,6 +138,9 @@ CLI::App* add_dashboard_command(CLI::App& cli, DashboardArgs& args) {
   dashboard->add_flag("--once", args.once,
                       "Print one plain snapshot once every telemetry topic has a sample, then "
                       "exit (also when stdout is not a terminal)");
+  dashboard->add_flag("--fields", args.fields,
+                      "Also every value of the field table (craneassist/fields, with its unit; "
+                      "craneassist fields)");
   add_common_options(*dashboard, args,
                      "Fail (exit 3) when a telemetry topic has no sample within this many seconds");
   return dashboard;
@@ -146,6 +149,7 @@ CLI::App* add_dashboard_command(CLI::App& cli, DashboardArgs& args) {
 int run_dashboard_command(const DashboardArgs& args) {
   dds::DashboardOptions o;
   o.once = args.once;
+  o.fields = args.fields;
   return run_tool(args, o, dds::run_dashboard);
 }
 

@@ -29,6 +29,7 @@ struct EchoArgs : DdsToolArgs {
 
 struct DashboardArgs : DdsToolArgs {
   bool once = false;
+  bool fields = false;  // --fields
 };
 
 struct WebWatchArgs : DdsToolArgs {

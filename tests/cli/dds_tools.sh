@@ -2,7 +2,7 @@
 # craneassist echo and craneassist dashboard from the command line, against dds_test_publisher
 # (synthetic telemetry, tests/dds_test_frames.hpp): exit codes, messages, output.
 # Usage: dds_tools.sh CASE CRANEASSIST DDS_TEST_PUBLISHER DOMAIN
-#   CASE: echo | usage | timeout | dashboard | signal
+#   CASE: echo | usage | timeout | dashboard | signal | fields (against craneassist replay itself)
 set -eu
 . "$(dirname "$0")/test_lib.sh"
 case_name=$1
@@ -106,6 +106,21 @@ dashboard)
   [ "$(grep -c "^craneassist dashboard" "$work/out")" = 1 ] || fail "not one snapshot"
   has out "pump limiter  none"
   echo "dashboard OK"
+  ;;
+fields)
+  # The field table on DDS (craneassist/fields) from a real run: echo prints every value by name
+  # with its unit, dashboard --fields shows them.
+  "$bin" replay --telemetry --domain "$domain" --realtime --no-log > "$work/replay.log" 2>&1 &
+  bg_pid=$!
+  expect 0 "$bin" echo fields --domain "$domain" --count 1 --timeout 15
+  for text in "cycle:" "q.2: " " rad" "pump_power_w: " " W" "load_moment_ratio: " "deadman: "; do
+    has out "$text"
+  done
+  expect 0 "$bin" dashboard --once --fields --domain "$domain" --timeout 15
+  for text in "craneassist dashboard" "pump_pressure_pa" "Pa" "payload_estimate_kg" "q_ref.4"; do
+    has out "$text"
+  done
+  echo "fields OK"
   ;;
 signal)
   # Waiting for samples forever: SIGTERM and SIGINT end it with exit 0.

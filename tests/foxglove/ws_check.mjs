@@ -32,7 +32,8 @@ const url = `ws://127.0.0.1:${port}`;
 const csvPath = `${outdir}/foxglove_${mode}.csv`;
 const realtime = mode === "live";
 
-const args = ["replay", replay, "--log", csvPath, "--foxglove", `127.0.0.1:${port}`,
+// simtime: the bundled demo (17 s of machine time, 1721 cycles, in well under a second).
+const args = ["replay", ...(realtime ? [replay] : []), "--log", csvPath, "--foxglove", `127.0.0.1:${port}`,
   "--foxglove-wait", "15", "--settle", "1"];
 if (realtime) args.push("--realtime");
 const run = spawn(craneassist, args, { stdio: ["ignore", "pipe", "pipe"] });
@@ -42,7 +43,8 @@ run.stderr.on("data", (d) => { output += d; });
 const exited = new Promise((done) => run.on("exit", (code) => done(code)));
 
 // A client: connects with `subprotocol`, subscribes to every channel, keeps what arrives.
-// readHz: its socket is read only that often (0: as fast as it comes).
+// readHz: its socket is read only that often (0: as fast as it comes; -1: never, a client that
+// has stalled).
 function client(name, subprotocol, readHz = 0) {
   const ws = new WebSocket(url, [subprotocol]);
   const c = { name, subprotocol, ws, info: null, channels: [], bySub: new Map(), messages: [],
@@ -54,6 +56,7 @@ function client(name, subprotocol, readHz = 0) {
   fc.on("advertise", (channels) => {
     c.channels.push(...channels);
     for (const ch of channels) c.bySub.set(fc.subscribe(ch.id), ch);
+    if (readHz < 0) ws._socket.pause();
     if (readHz > 0) {
       const socket = ws._socket;
       socket.pause();
@@ -85,6 +88,10 @@ const clients = realtime
   ? [client("websocket.v1", "foxglove.websocket.v1"), client("sdk.v1", "foxglove.sdk.v1"),
      client("100 Hz", "foxglove.sdk.v1", 100), client("10 Hz", "foxglove.websocket.v1", 10)]
   : [client("sim time", "foxglove.sdk.v1")];
+
+// A client that subscribes to everything and then never reads: it loses messages, the others
+// and the run do not notice.
+const stalled = realtime ? null : client("stalled", "foxglove.sdk.v1", -1);
 
 // A client that sends what a server must survive: not JSON, an unknown op, a bad subscription,
 // a binary frame (client publish, not offered), and a request without a Foxglove subprotocol.
@@ -189,6 +196,23 @@ for (const c of clients) {
 check(garbageStatuses.length >= 4, `garbage client: ${garbageStatuses.length} status replies (${garbageStatuses.map((s) => s.message.slice(0, 30)).join(" | ")})`);
 const report = output.split("\n").find((l) => l.includes("foxglove:") && l.includes("clients")) ?? "";
 console.log(report);
+if (realtime) {
+  for (const c of clients) {
+    const n = c.messages.filter((m) => m.channel.topic === "/joint_states").length;
+    check(n >= 0.95 * rowsByT.size - 5, `${c.name}: ${n} of ${rowsByT.size} cycles on /joint_states`);
+  }
+  const last = clients[0].messages.filter((m) => m.channel.topic === "/craneassist/status").pop();
+  const st = last ? JSON.parse(new TextDecoder().decode(last.data)) : {};
+  console.log(`loop: worst start latency ${(1e3 * st.loop_latency_max_s).toFixed(2)} ms, ${st.loop_overruns} overruns`);
+} else {
+  // The stalled client's queue filled: it lost messages; the run went on at its own pace.
+  const dropped = Number((/\((\d+) dropped: a client behind/.exec(report) ?? [0, 0])[1]);
+  check(dropped > 0, `the stalled client lost ${dropped} messages`);
+  const ran = /ran ([0-9.]+) s of machine time in ([0-9.]+) s/.exec(output);
+  check(ran !== null && Number(ran[2]) < Number(ran[1]),
+        `the run was not held up: ${ran ? ran[1] : "?"} s of machine time in ${ran ? ran[2] : "?"} s`);
+  stalled.ws.terminate();
+}
 check(/client messages [1-9]\d* malformed, [1-9]\d* unsupported/.test(report), "the server counted the malformed and unsupported messages");
 garbage.close();
 if (failures > 0) {

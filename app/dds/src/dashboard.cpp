@@ -57,6 +57,9 @@ struct Snapshot {
   // of the topics the view waits for.
   msg::BaseState base;
   std::int64_t base_received_ns = 0;
+  // Every value of the field table (craneassist/fields): the --fields view. Not waited for.
+  msg::FieldValues fields;
+  std::int64_t fields_received_ns = 0;
   int matched[kTelemetryTopics] = {};
   std::uint64_t malformed[kTelemetryTopics] = {};  // dropped: could not be deserialized
 
@@ -97,8 +100,10 @@ class LatestSamples {
       case Topic::kBase:
         take_into<msg::BaseState>(reader, &Snapshot::base, topic);
         break;
-      case Topic::kOperatorCommand:
       case Topic::kFields:
+        take_into<msg::FieldValues>(reader, &Snapshot::fields, topic);
+        break;
+      case Topic::kOperatorCommand:
         break;
     }
   }
@@ -120,7 +125,9 @@ class LatestSamples {
     while (take_next_valid(reader, &sample, info, malformed)) {
       std::lock_guard<std::mutex> lock(mutex_);
       latest_.*field = sample;
-      (i >= 0 ? latest_.received_ns[i] : latest_.base_received_ns) = monotonic_ns();
+      (i >= 0                    ? latest_.received_ns[i]
+       : topic == Topic::kFields ? latest_.fields_received_ns
+                                 : latest_.base_received_ns) = monotonic_ns();
     }
     if (malformed > 0 && i >= 0) {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -378,6 +385,26 @@ std::vector<std::string> render(const Snapshot& s, const DashboardOptions& o, st
     lines.push_back(fmt("%-10s%llu malformed samples dropped (%s)", "dropped",
                         static_cast<unsigned long long>(malformed), per_topic.c_str()));
   }
+  if (o.fields) {
+    // Every value of the field table as craneassist/fields carries it, three to a line.
+    lines.emplace_back();
+    const auto& f = s.fields;
+    if (s.fields_received_ns == 0) {
+      lines.push_back(fmt("%-10swaiting for craneassist/fields", "fields"));
+    } else {
+      const std::size_t n = std::min(f.names().size(), f.values().size());
+      std::string line;
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::string unit = i < f.units().size() ? f.units()[i] : "";
+        line += fmt("%-26.26s%11.4g %-9.9s", f.names()[i].c_str(), f.values()[i],
+                    unit == "1" ? "" : unit.c_str());
+        if (i % 3 == 2 || i + 1 == n) {
+          lines.push_back(line);
+          line.clear();
+        }
+      }
+    }
+  }
   if (live) lines.push_back("q or Ctrl-C quits");
   for (auto& line : lines) line.erase(line.find_last_not_of(' ') + 1);
   return lines;
@@ -522,7 +549,7 @@ int run_dashboard(const DashboardOptions& o) {
   const auto session = open_tool_session(
       "craneassist-dashboard", o.domain_id, o.transport, o.type_propagation,
       std::vector<Topic>{Topic::kStatus, Topic::kJoints, Topic::kHydraulics, Topic::kCommandPath,
-                         Topic::kBase},
+                         Topic::kBase, Topic::kFields},
       o.err, [&latest](Topic topic, fdds::DataReader& reader) { latest.take(topic, reader); });
   if (!session) return kToolRuntime;
   auto snapshot = [&] {
@@ -538,7 +565,7 @@ int run_dashboard(const DashboardOptions& o) {
   if (!live) {
     while (!stop_requested()) {
       const Snapshot s = snapshot();
-      if (s.all()) {
+      if (s.all() && (!o.fields || s.fields_received_ns != 0)) {
         for (const auto& line : render(s, o, monotonic_ns(), false)) {
           std::fprintf(o.out, "%s\n", line.c_str());
         }

@@ -40,6 +40,8 @@ struct DashboardOptions {
   config::DdsTransport transport = config::DdsTransport::kDefault;
   config::TypePropagation type_propagation;  // the settings' type_propagation
   double refresh_s = 0.1;                    // live view: redraw period
+  // Also every value of the field table, from craneassist/fields (the snapshot waits for it).
+  bool fields = false;
   std::FILE* out = stdout;
   std::FILE* err = stderr;
 };
