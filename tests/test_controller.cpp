@@ -125,6 +125,25 @@ TEST(Controller, ReferenceKeepsTheCommandedDirection) {
   EXPECT_NEAR(out.ref_tip_velocity_m_s.norm(), out.scale * v.norm(), 1e-9);
 }
 
+TEST(Controller, ScaleStaysWithinZeroAndOneWhenTheCommandFalls) {
+  // Full scaling: the reference decelerates with bounded jerk after the stick eases from 0.8 to
+  // 0.1 m/s, so for a while it is faster than the command; the scale (the limits' factor on the
+  // command, 0..1 in the IDL) is then 1, not the ratio (which reached about 1.7 before).
+  Rig rig(control::ScalingMode::kFull);
+  auto& [cfg, controller, state, out] = rig;
+  const Eigen::Vector3d fast(0.8, 0.0, 0.0), slow(0.1, 0.0, 0.0);
+  rig.follow_one_valve_delay_late(fast, 200);
+  double faster = 0.0;
+  for (int k = 0; k < 100; ++k) {
+    ASSERT_EQ(controller.update(state, slow, out), control::ControllerStatus::kRunning);
+    faster = std::max(faster, out.ref_tip_velocity_m_s.norm() / slow.norm());
+    EXPECT_GE(out.scale, 0.0);
+    EXPECT_LE(out.scale, 1.0);
+    state.q = out.q_ref;
+  }
+  EXPECT_GT(faster, 1.5) << "the reference outruns the eased command for a while";
+}
+
 TEST(Controller, InvalidInputStopsWithNeutralValves) {
   Rig rig(control::ScalingMode::kFlowOnly);
   auto& [cfg, controller, state, out] = rig;

@@ -388,7 +388,9 @@ void Controller::update_full(const valves::MachineState& state, const Eigen::Vec
   out.qdot_ref = g.f1 * along;
   out.ref_tip_velocity_m_s = u * along;  // = J(q_ref) qdot_ref
   const double v_cmd_norm = v_cmd.norm();
-  out.scale = v_cmd_norm > 0.0 ? scaler_out_.sdot / v_cmd_norm : 1.0;
+  // The factor the limits put on the command, 0..1: while the reference decelerates to a
+  // command that fell (a released or eased stick) it is faster than the command, unscaled.
+  out.scale = v_cmd_norm > 0.0 ? std::clamp(scaler_out_.sdot / v_cmd_norm, 0.0, 1.0) : 1.0;
   out.flow_demand_m3_s = scaler_out_.speed.flow_per_speed_m3 * v_cmd_norm;
   out.limit = scaler_out_.limit;
   out.s = scaler_out_.s;

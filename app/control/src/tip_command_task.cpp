@@ -111,6 +111,10 @@ CycleStatus TipCommandTask::step(const CycleTime& time, const valves::MachineSta
   // A stop request overrides the operator: the controller gets no command.
   const Eigen::Vector3d& v = stop_cause != nullptr ? kNoValue : command_.v_m_s;
   const CycleStatus status = controller_.update(state, v, out_);
+  // The controller stops as for a stale input; the log says it was asked to.
+  if (stop_cause != nullptr && out_.limit == scaling::ActiveLimit::kStaleInput) {
+    out_.limit = scaling::ActiveLimit::kStopRequest;
+  }
   command.spool = out_.valves.spool;
   if (base_ != nullptr && stop_cause == nullptr && v.allFinite()) {
     scaling::flow_bounded_drive(*base_, command_.drive[0], command_.drive[1],

@@ -17,8 +17,9 @@ enum class ActiveLimit {
   kPressure,              // a load pressure at the pump's ceiling (relief; p_s with a CP pump)
   kDynamicsFailed,        // the ODE dynamics step failed (out of memory): stopping without it
   kOverload,              // the rated capacity limiter: the motion would raise the load moment
+  kStopRequest,           // the run asks for a stop: its end, the operator's quit, a fault
 };
-inline constexpr int kActiveLimitCount = static_cast<int>(ActiveLimit::kOverload) + 1;
+inline constexpr int kActiveLimitCount = static_cast<int>(ActiveLimit::kStopRequest) + 1;
 
 const char* to_string(ActiveLimit limit);
 

@@ -1,4 +1,4 @@
-// Uniform flow prescaling of a joint-rate reference (algorithms.md section 2; "Real-time
+// Uniform flow prescaling of a joint-rate reference (docs/algorithms.md section 2; "Real-time
 // trajectory scaling algorithm for hydraulic manipulators subject to limited on-board power"
 // section 3.2, "Flow-limited path-following control of a double Ackermann steered hydraulic
 // mobile manipulator" eq. 15).

@@ -1,7 +1,7 @@
 // Constraints on the path speed and acceleration of a joint path q = f(s), at the current
 // (q, sdot): the velocity-level limits (pump flow, cylinder speeds, quasi-static power) and the
 // acceleration-level bounds (load-sensing power, cylinder accelerations, path acceleration)
-// that the jerk-bounded scaling filter then respects. algorithms.md sections 2 and 4.
+// that the jerk-bounded scaling filter then respects. docs/algorithms.md sections 2 and 4.
 //
 // With qdot = f' sdot and qddot = f'' sdot^2 + f' sddot, the joint efforts are
 // tau = m sddot + b (dynamics::PathTerms), the cylinder velocities v_i = r_i f'_i sdot (r_i =
@@ -43,7 +43,7 @@ struct SpeedLimits {
   double flow_per_speed_m3 = 0.0;  // Q(sdot) / sdot
 };
 
-// Velocity-level limits of algorithms.md section 2 for the path tangent f'.
+// Velocity-level limits of docs/algorithms.md section 2 for the path tangent f'.
 void path_speed_limits(const dynamics::CraneModel& model, const PathGeometry& path,
                        double flow_reserve, SpeedLimits& out);
 

@@ -88,7 +88,7 @@ class PathScaler {
                                          dynamics::PathTerms& path_terms,
                                          AccelerationBounds& bounds) noexcept;
 
-// delta(|e|) of algorithms.md section 6: 1 below e_ok, e_ok / |e| above.
+// delta(|e|) of docs/algorithms.md section 6: 1 below e_ok, e_ok / |e| above.
 double tracking_factor(double error_m, double error_ok_m);
 
 // The lower bound on sddot the scalers use: the constraints' own where it allows slowing down;

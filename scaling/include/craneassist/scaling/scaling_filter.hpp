@@ -1,5 +1,5 @@
-// Jerk-bounded trajectory scaling filter (algorithms.md section 5; "Real-time trajectory scaling
-// algorithm for hydraulic manipulators subject to limited on-board power", appendix).
+// Jerk-bounded trajectory scaling filter (docs/algorithms.md section 5; "Real-time trajectory
+// scaling algorithm for hydraulic manipulators subject to limited on-board power", appendix).
 //
 // The filter turns the prescaled path-speed request sdot_d and this cycle's path-acceleration
 // bounds [sddot_min, sddot_max] into a path jerk j, |j| <= J, and integrates it exactly over the

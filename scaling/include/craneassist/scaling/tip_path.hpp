@@ -1,4 +1,4 @@
-// The tip path of one control cycle (algorithms.md section 1): the straight tip line
+// The tip path of one control cycle (docs/algorithms.md section 1): the straight tip line
 // x(s) = x0 + u s along the reference direction u, resolved into joint space.
 //
 // f'(s) resolves u through the redundancy resolution: for a four-joint loader exactly on the

@@ -1,5 +1,8 @@
-// The one fixed-rate control loop of craneassist. Every run goes through it: replay, live `sim`,
-// trajectory execution, the 2R experiment and the valve calibration. Each cycle:
+// The one fixed-rate control loop of craneassist. Every run of the product goes through it:
+// replay, live `sim`, trajectory execution, the 2R experiment and the valve calibration. Two
+// studies of the papers run their own loops on their own simulators and do not: `follow` (paper
+// 003's base and crane, app/offline/mobile_follow) and `ptp --simulate` (paper 001's MHSB arm,
+// app/offline/ptp_simulation on sim_backend's MHSB simulator). Each cycle:
 //
 //   read the machine -> the cycle task (command source + controller) -> write the valves
 //   -> the CSV log and the observers -> let one period pass -> pace (real time, or machine time)

@@ -76,7 +76,7 @@ void visit_fields(Row& r, Visitor&& v) {
   v(Field{"pump_pressure_pa", "Pa", "measured", "pump supply pressure", G::kHydraulics, "pump_pressure_pa", "%.6g", 1.0, false, "Hydraulics.pressure_pa"}, r.pump_pressure_pa);
   v(Field{"pump_power_w", "W", "measured", "hydraulic power at the pump, pressure times flow", G::kHydraulics, "pump_power_w", "%.6g", 1.0, false, "Hydraulics.power_w"}, r.pump_power_w);
   v(Field{"energy_j", "J", "measured", "pump energy integrated since the start", G::kHydraulics, "energy_j", "%.6g", 1.0, false, "Hydraulics.energy_j"}, r.energy_j);
-  v(Field{"active_limit", "text", "controller", "which limit holds the motion back (none, flow, cylinder_speed, power, pressure, singularity, joint_limit, overload, stale_input, ...)", G::kLimits, "active_limit", "%.6g", 1.0, false, "Status.active_limit"}, r.active_limit);
+  v(Field{"active_limit", "text", "controller", "which limit holds the motion back (none, flow, cylinder_speed, power, pressure, singularity, joint_limit, overload, stale_input, stop_request, ...)", G::kLimits, "active_limit", "%.6g", 1.0, false, "Status.active_limit"}, r.active_limit);
   v(Field{"scale", "1", "controller", "reference tip speed over commanded tip speed (1: unscaled)", G::kLimits, "scale", "%.6g", 1.0, false, "Status.scale"}, r.scale);
   v(Field{"flow_demand_m3s", "m^3/s", "controller", "pump flow the unscaled command would need", G::kHydraulics, "flow_demand_m3s", "%.6g", 1.0, false, "Hydraulics.flow_demand_m3_s"}, r.flow_demand_m3s);
   v(Field{"pump_limit", "text", "measured", "which pump limit holds the delivered flow below demand: none, max_flow, power, relief", G::kHydraulics, "pump_limit", "%.6g", 1.0, false, "Hydraulics.pump_limit"}, r.pump_limit);
