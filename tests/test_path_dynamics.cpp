@@ -1,5 +1,5 @@
 // RigidBodyTerms::path_terms (m = H f', b = H f'' sdot^2 + C(q, f' sdot) f' sdot + g, the path
-// dynamics of algorithms.md section 3) against an independent recursive Newton-Euler
+// dynamics of docs/algorithms.md section 3) against an independent recursive Newton-Euler
 // implementation and against the compute()-based formula; no allocation in the control cycle.
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
-// Jerk-bounded scaling filter (algorithms.md section 5): one test group per required behaviour,
-// in the brief's priority order, plus the two pure helpers. Every check is on an exact property
-// (a bound, an equality, a count), never on the look of a curve.
+// Jerk-bounded scaling filter (docs/algorithms.md section 5): one test group per required
+// behaviour, in the brief's priority order, plus the two pure helpers. Every check is on an exact
+// property (a bound, an equality, a count), never on the look of a curve.
 #include <gtest/gtest.h>
 
 #include <algorithm>

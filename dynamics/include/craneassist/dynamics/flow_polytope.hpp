@@ -1,4 +1,4 @@
-// The flow manipulability polytope (algorithms.md section 9; Oda, Suzumura and Hyon, "Motion
+// The flow manipulability polytope (docs/algorithms.md section 9; Oda, Suzumura and Hyon, "Motion
 // Planning of MHSB for Redundant Hydraulic Manipulators", section 2.1): the tip velocities the
 // machine can deliver at a pose, from its cylinder speed limits and its pump's flow.
 //
@@ -7,7 +7,7 @@
 //     Q(qdot) = sum_i Aflow_i(sign v_i) |v_i| <= Q_max,
 // with Aflow the piston area extending and the rod-side area retracting (A_A - A_B extending for
 // a cylinder with a differential spool; model.hpp flow_area_m2): exactly the sum the scaling
-// stage's flow bound uses (algorithms.md section 2). In joint rates this is a box cut by one
+// stage's flow bound uses (docs/algorithms.md section 2). In joint rates this is a box cut by one
 // constraint that is linear in each orthant:
 //     qdot_min_i <= qdot_i <= qdot_max_i,   sum_i w_i(sign qdot_i) |qdot_i| <= Q_max,
 //     qdot_max_i = -qdot_min_i = v_max_i / |r_i|,   w_i(+-) = |r_i| Aflow_i(sign(+-r_i)).

@@ -274,7 +274,7 @@ inline void set_payload_mass_kg(CraneModel& m, double mass_kg) {
   }
 }
 
-// Effective area the pump must fill for cylinder velocity v (algorithms.md section 2).
+// Effective area the pump must fill for cylinder velocity v (docs/algorithms.md section 2).
 inline double flow_area_m2(const Cylinder& c, double v_m_s) {
   if (v_m_s >= 0.0) return c.differential_spool ? c.area_a_m2 - c.area_b_m2 : c.area_a_m2;
   return c.area_b_m2;

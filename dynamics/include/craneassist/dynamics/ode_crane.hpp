@@ -1,7 +1,7 @@
 // The crane as Open Dynamics Engine (ODE) rigid bodies and joints.
 //
 // Shared by the simulator, which steps it in its own world with its own ERP/CFM, and by
-// RigidBodyTerms, which probes it for H(q), C(q,qdot)qdot and g(q) (algorithms.md section 3).
+// RigidBodyTerms, which probes it for H(q), C(q,qdot)qdot and g(q) (docs/algorithms.md section 3).
 //
 // Conventions:
 // - The ODE world frame is the DH base frame (frame 0). The caller sets the world's gravity

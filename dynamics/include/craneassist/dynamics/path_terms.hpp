@@ -2,7 +2,7 @@
 // and what the scaling reads. Kept apart from RigidBodyTerms so that code that only passes the
 // terms around (scaling's headers) needs neither the probe nor ODE.
 //
-// Convention: tau = H(q) qddot + C(q,qdot) qdot + g(q) (+ tau_ext), algorithms.md section 3.
+// Convention: tau = H(q) qddot + C(q,qdot) qdot + g(q) (+ tau_ext), docs/algorithms.md section 3.
 #pragma once
 
 #include "craneassist/dynamics/model.hpp"
@@ -15,7 +15,7 @@ struct DynamicsTerms {
   JointVector gravity;   // g(q)
 };
 
-// The dynamics along a path q = f(s) (algorithms.md section 3, corrected):
+// The dynamics along a path q = f(s) (docs/algorithms.md section 3, corrected):
 // tau = m sddot + b with m = H(q) f' and b = H(q) f'' sdot^2 + C(q, f' sdot) f' sdot + g(q).
 struct PathTerms {
   JointVector m;

@@ -1,5 +1,5 @@
 // Online redundancy resolutions of a loader crane parameterised by the extension rate
-// (algorithms.md section 7; "Global energy-optimal redundancy resolution of hydraulic
+// (docs/algorithms.md section 7; "Global energy-optimal redundancy resolution of hydraulic
 // manipulators: experimental results for a forestry manipulator", section 4).
 //
 // With the extension rate t = q4dot free, slew, lift and tilt follow from the tip velocity v:

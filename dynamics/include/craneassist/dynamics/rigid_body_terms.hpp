@@ -2,7 +2,8 @@
 //
 // Convention: tau = H(q) qddot + C(q,qdot) qdot + g(q) (+ tau_ext), as in Hulttinen & Mattila,
 // "Real-time trajectory scaling algorithm for hydraulic manipulators subject to limited on-board
-// power" (algorithms.md section 3). g is the effort that holds the crane still against gravity.
+// power" (docs/algorithms.md section 3). g is the effort that holds the crane still against
+// gravity.
 //
 // Method. The probe owns a private ODE world (ERP = 0, CFM = 0, no end stops) holding the same
 // OdeCrane the simulator steps. dWorldStep solves the joint constraints at velocity level,

@@ -1,5 +1,5 @@
 // Offline energy-optimal redundancy resolution along a prescribed tip path by discrete-time
-// dynamic programming (paper 000 section 5, Algorithm 1; algorithms.md section 7).
+// dynamic programming (paper 000 section 5, Algorithm 1; docs/algorithms.md section 7).
 //
 // States: extension cylinder position c and velocity v on a uniform grid; control: its
 // acceleration a on a uniform grid; dynamics c' = c + v dt + a dt^2 / 2, v' = v + a dt (paper 000

@@ -1,4 +1,4 @@
-// The stage model of the offline redundancy planner (paper 000 sections 4-5, algorithms.md
+// The stage model of the offline redundancy planner (paper 000 sections 4-5, docs/algorithms.md
 // section 7): a prescribed tip path sampled every dt, the extension cylinder's position c and
 // velocity v as the state, its acceleration a as the control, and a running cost per stage.
 //
