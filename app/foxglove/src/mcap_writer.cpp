@@ -91,7 +91,7 @@ McapWriter::McapWriter(const std::filesystem::path& path, const McapOptions& opt
   if (options_.compression == McapCompression::kZstd) zstd_ = ZSTD_createCCtx();
   std::vector<std::uint8_t> bytes(std::begin(kMagic), std::end(kMagic)), header;
   Bytes h{header};
-  h.str("ros2");
+  h.str("");  // no profile (see the header)
   h.str("craneassist");
   Bytes{bytes}.record(kHeader, header);
   put(bytes);

@@ -42,8 +42,10 @@ std::uint32_t crc32(std::uint32_t crc, const void* data, std::size_t size) noexc
 
 class McapWriter {
  public:
-  // Creates the file and writes the magic and the header (profile "ros2": the cdr channels are
-  // ROS 2 messages). Throws std::runtime_error naming the file when it cannot.
+  // Creates the file and writes the magic and the header. No profile: the "ros2" profile asks for
+  // cdr channels only, and the field table's channels are JSON (the cdr ones are ROS 2 messages
+  // all the same, with ros2msg schemas). Throws std::runtime_error naming the file when it
+  // cannot.
   McapWriter(const std::filesystem::path& path, const McapOptions& options);
   ~McapWriter();
   McapWriter(const McapWriter&) = delete;
