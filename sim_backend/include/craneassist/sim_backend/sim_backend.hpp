@@ -51,7 +51,7 @@ struct SimSettings {
   double swing_resolution_rad = 0.0;
   // The machine's grapple when it differs from the controller's model (the model's grapple
   // otherwise): a longer rotator link, another brake.
-  std::optional<dynamics::HangingGrapple> grapple;
+  std::optional<dynamics::HangingGrapple> grapple{};
 };
 
 class SimBackend final : public valves::MachineInterface {
