@@ -312,24 +312,11 @@ class FoxgloveSession : public std::enable_shared_from_this<FoxgloveSession> {
 namespace {
 
 // One HTTP connection: the WebSocket upgrade with a Foxglove subprotocol, or a plain answer.
-class HttpSession : public std::enable_shared_from_this<HttpSession> {
+class HttpSession : public craneassist::net::HttpConnection<HttpSession> {
  public:
   HttpSession(tcp::socket&& socket, FoxgloveServer::Impl& impl)
-      : stream_(std::move(socket)), impl_(impl) {}
+      : HttpConnection(std::move(socket)), impl_(impl) {}
 
-  void read() {
-    parser_.emplace();
-    parser_->header_limit(8192);
-    parser_->body_limit(8192);
-    stream_.expires_after(std::chrono::seconds(30));
-    http::async_read(stream_, buffer_, *parser_,
-                     [self = shared_from_this()](beast::error_code ec, std::size_t) {
-                       if (ec) return;
-                       self->handle(self->parser_->release());
-                     });
-  }
-
- private:
   void handle(http::request<http::string_body> req) {
     std::string subprotocol;
     if (websocket::is_upgrade(req)) {
@@ -353,16 +340,12 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
         "(docs/foxglove.md)\n";
     res->keep_alive(false);
     res->prepare_payload();
-    http::async_write(stream_, *res,
-                      [self = shared_from_this(), res](beast::error_code, std::size_t) {
-                        beast::error_code ignored;
-                        self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
-                      });
+    http::async_write(
+        stream_, *res,
+        [self = shared_from_this(), res](beast::error_code, std::size_t) { self->shutdown(); });
   }
 
-  beast::tcp_stream stream_;
-  beast::flat_buffer buffer_;
-  std::optional<http::request_parser<http::string_body>> parser_;
+ private:
   FoxgloveServer::Impl& impl_;
 };
 

@@ -250,28 +250,11 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
 namespace {
 
 // One HTTP connection: the page's files, /crane.json, and the upgrade to /ws.
-class HttpSession : public std::enable_shared_from_this<HttpSession> {
+class HttpSession : public craneassist::net::HttpConnection<HttpSession> {
  public:
   HttpSession(tcp::socket&& socket, WebServer::Impl& impl)
-      : stream_(std::move(socket)), impl_(impl) {}
+      : HttpConnection(std::move(socket)), impl_(impl) {}
 
-  void read() {
-    parser_.emplace();
-    parser_->header_limit(8192);
-    parser_->body_limit(8192);
-    stream_.expires_after(std::chrono::seconds(30));
-    http::async_read(stream_, buffer_, *parser_,
-                     [self = shared_from_this()](beast::error_code ec, std::size_t) {
-                       if (ec) {
-                         beast::error_code ignored;
-                         self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
-                         return;
-                       }
-                       self->handle(self->parser_->release());
-                     });
-  }
-
- private:
   void handle(http::request<http::string_body> req) {
     impl_.count(&WebCounters::http_requests);
     const std::string_view target(req.target().data(), req.target().size());
@@ -317,17 +300,14 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     http::async_write(stream_, *res,
                       [self = shared_from_this(), res](beast::error_code ec, std::size_t) {
                         if (ec || !res->keep_alive()) {
-                          beast::error_code ignored;
-                          self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+                          self->shutdown();
                           return;
                         }
                         self->read();
                       });
   }
 
-  beast::tcp_stream stream_;
-  beast::flat_buffer buffer_;
-  std::optional<http::request_parser<http::string_body>> parser_;
+ private:
   WebServer::Impl& impl_;
 };
 

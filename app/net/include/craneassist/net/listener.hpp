@@ -4,10 +4,14 @@
 #pragma once
 
 #include <boost/asio.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <chrono>
 #include <cstdio>
 #include <exception>
 #include <future>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -78,6 +82,41 @@ void stop_io_thread(asio::io_context& ioc, std::thread& thread, std::promise<voi
   }
   thread.join();
 }
+
+// One HTTP connection of a server (CRTP: Derived is the server's session, which answers in
+// handle(request)): reads a request of at most 8 kB header and 8 kB body within 30 s; a read
+// that fails (the client left, too large, too slow) shuts the connection.
+template <class Derived>
+class HttpConnection : public std::enable_shared_from_this<Derived> {
+ public:
+  explicit HttpConnection(tcp::socket&& socket) : stream_(std::move(socket)) {}
+
+  void read() {
+    parser_.emplace();
+    parser_->header_limit(8192);
+    parser_->body_limit(8192);
+    stream_.expires_after(std::chrono::seconds(30));
+    boost::beast::http::async_read(
+        stream_, buffer_, *parser_,
+        [self = this->shared_from_this()](boost::system::error_code ec, std::size_t) {
+          if (ec) {
+            self->shutdown();
+            return;
+          }
+          self->handle(self->parser_->release());
+        });
+  }
+
+ protected:
+  void shutdown() {
+    boost::system::error_code ignored;
+    stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+  }
+
+  boost::beast::tcp_stream stream_;
+  boost::beast::flat_buffer buffer_;
+  std::optional<boost::beast::http::request_parser<boost::beast::http::string_body>> parser_;
+};
 
 // "HOST:PORT" for a client on this host: a listener on every interface (0.0.0.0, ::) is reached
 // at 127.0.0.1; an IPv6 address in brackets.
