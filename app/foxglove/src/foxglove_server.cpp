@@ -6,22 +6,17 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 #include <chrono>
-#include <cmath>
-#include <cstdio>
 #include <deque>
-#include <fstream>
 #include <future>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <optional>
 #include <stdexcept>
 #include <string_view>
 #include <thread>
 #include <vector>
 
-#include "craneassist/control/spsc_ring.hpp"
 #include "craneassist/foxglove/channels.hpp"
-#include "craneassist/foxglove/mcap_recorder.hpp"
+#include "craneassist/foxglove/cycle_hand_over.hpp"
 #include "craneassist/net/listener.hpp"
 
 namespace craneassist::foxglove {
@@ -56,19 +51,6 @@ std::string pick_subprotocol(std::string_view offered) {
   return {};
 }
 
-std::string random_session_id() {
-  unsigned char bytes[8] = {};
-  std::ifstream urandom("/dev/urandom", std::ios::binary);
-  urandom.read(reinterpret_cast<char*>(bytes), sizeof bytes);
-  std::string id;
-  char hex[3];
-  for (const unsigned char b : bytes) {
-    std::snprintf(hex, sizeof hex, "%02x", b);
-    id += hex;
-  }
-  return id;
-}
-
 template <class T>
 void put_le(std::vector<std::uint8_t>& out, T v) {
   for (std::size_t i = 0; i < sizeof(T); ++i)
@@ -80,6 +62,18 @@ struct Outgoing {
   bool text = false;
 };
 using OutgoingPtr = std::shared_ptr<const Outgoing>;
+
+// A Message Data frame: opcode, subscription id, time (ns), the message.
+OutgoingPtr message_data(std::uint32_t subscription, std::uint64_t t_ns,
+                         const std::vector<std::uint8_t>& message) {
+  auto m = std::make_shared<Outgoing>();
+  m->bytes.reserve(13 + message.size());
+  m->bytes.push_back(kMessageData);
+  put_le(m->bytes, subscription);
+  put_le(m->bytes, t_ns);
+  m->bytes.insert(m->bytes.end(), message.begin(), message.end());
+  return m;
+}
 
 OutgoingPtr text_message(const std::string& s) {
   auto m = std::make_shared<Outgoing>();
@@ -125,8 +119,9 @@ struct FoxgloveServer::Impl {
   Impl(const ServerOptions& o, const dynamics::CraneModel& model)
       : options(o),
         channels(model, o.base),
-        ring(o.ring_rows),
-        session_id(random_session_id()),
+        cycles(o.ring_rows, !o.sim_time),
+        // Not a secret (the web view's token is): all zeros if /dev/urandom cannot be read.
+        session_id(craneassist::net::random_hex(8).value_or(std::string(16, '0'))),
         acceptor(ioc),
         timer(ioc) {
     // serverInfo and advertise: the same for every client.
@@ -151,31 +146,13 @@ struct FoxgloveServer::Impl {
     subscribers.assign(channels.size(), 0);
   }
 
-  struct Slot {
-    control::LogRow row;
-    double t_s = 0.0;
-  };
-
   class Observer : public control::CycleObserver {
    public:
-    explicit Observer(Impl& impl) : impl_(impl) {}
-    void on_cycle(const control::CycleRecord& cycle) noexcept override {
-      if (!epoch_set_) {
-        epoch_set_ = true;
-        if (!impl_.options.sim_time) {
-          impl_.epoch_ns.store(wall_clock_ns() -
-                               static_cast<std::int64_t>(std::llround(cycle.time.t_s * 1e9)));
-        }
-      }
-      slot_.row = cycle.row;
-      slot_.t_s = cycle.time.t_s;
-      if (!impl_.ring.push(slot_)) impl_.cycles_dropped.fetch_add(1, std::memory_order_relaxed);
-    }
+    explicit Observer(CycleHandOver& cycles) : cycles_(cycles) {}
+    void on_cycle(const control::CycleRecord& cycle) noexcept override { cycles_.push(cycle); }
 
    private:
-    Impl& impl_;
-    bool epoch_set_ = false;
-    Slot slot_;
+    CycleHandOver& cycles_;
   };
 
   void start();
@@ -188,7 +165,7 @@ struct FoxgloveServer::Impl {
 
   ServerOptions options;
   ChannelSet channels;
-  control::SpscRing<Slot> ring;
+  CycleHandOver cycles;  // from the loop
   std::string session_id;
   OutgoingPtr server_info, advertise;
   net::io_context ioc{1};
@@ -196,17 +173,14 @@ struct FoxgloveServer::Impl {
   net::steady_timer timer;
   std::thread thread;
   std::promise<void> stopped;
-  std::atomic<std::int64_t> epoch_ns{0};
   // I/O thread only.
   std::vector<std::weak_ptr<FoxgloveSession>> sessions;
   std::vector<int> subscribers;  // per channel, over all sessions
   std::vector<std::uint8_t> encoded;
-  std::optional<OutgoingPtr> description;  // the latched /robot_description, once encoded
-  Observer observer{*this};
+  Observer observer{cycles};
   // Counters (any thread reads them).
   std::atomic<std::uint64_t> clients_connected{0}, subscriptions_made{0}, messages_sent{0},
-      messages_dropped{0}, cycles_dropped{0}, client_malformed{0}, client_unsupported{0},
-      refused{0};
+      messages_dropped{0}, client_malformed{0}, client_unsupported{0}, refused{0};
 };
 
 // One client: message frames out (a queue bounded in bytes; a client behind loses frames),
@@ -376,9 +350,9 @@ void FoxgloveServer::Impl::drain() {
     if (s && !s->closed()) sessions[live++] = weak;
   }
   sessions.resize(live);
-  while (const Slot* slot = ring.front()) {
+  while (const CycleHandOver::Slot* slot = cycles.front()) {
     if (!sessions.empty()) {
-      const std::uint64_t t_ns = message_time_ns(epoch_ns.load(), slot->t_s);
+      const std::uint64_t t_ns = cycles.time_ns(slot->t_s);
       if (options.sim_time) {
         auto m = std::make_shared<Outgoing>();
         m->bytes.push_back(kTime);
@@ -395,13 +369,7 @@ void FoxgloveServer::Impl::drain() {
           if (!s) continue;
           for (const auto& [id, channel] : s->subscriptions) {
             if (channel != k) continue;
-            auto m = std::make_shared<Outgoing>();
-            m->bytes.reserve(13 + encoded.size());
-            m->bytes.push_back(kMessageData);
-            put_le(m->bytes, id);
-            put_le(m->bytes, t_ns);
-            m->bytes.insert(m->bytes.end(), encoded.begin(), encoded.end());
-            if (s->send(m)) {
+            if (s->send(message_data(id, t_ns, encoded))) {
               messages_sent.fetch_add(1, std::memory_order_relaxed);
             } else {
               messages_dropped.fetch_add(1, std::memory_order_relaxed);
@@ -410,7 +378,7 @@ void FoxgloveServer::Impl::drain() {
         }
       }
     }
-    ring.pop();
+    cycles.pop();
   }
 }
 
@@ -516,12 +484,7 @@ void FoxgloveServer::Impl::on_text(FoxgloveSession& s, std::string_view text) {
     if (channels.channels()[k].latched) {
       // The latched description: now, to this subscription.
       channels.encode(k, control::LogRow{}, 0, encoded);
-      auto out = std::make_shared<Outgoing>();
-      out->bytes.push_back(kMessageData);
-      put_le(out->bytes, id);
-      put_le(out->bytes, message_time_ns(epoch_ns.load(), 0.0));
-      out->bytes.insert(out->bytes.end(), encoded.begin(), encoded.end());
-      s.send(out, true);
+      s.send(message_data(id, cycles.time_ns(0.0), encoded), true);
     }
   }
 }
@@ -578,7 +541,7 @@ ServerCounters FoxgloveServer::counters() const {
   const Impl& i = *impl_;
   return {i.clients_connected.load(),  i.subscriptions_made.load(),
           i.messages_sent.load(),      i.messages_dropped.load(),
-          i.cycles_dropped.load(),     i.client_malformed.load(),
+          i.cycles.dropped(),          i.client_malformed.load(),
           i.client_unsupported.load(), i.refused.load()};
 }
 

@@ -1,32 +1,17 @@
 #include "craneassist/foxglove/mcap_recorder.hpp"
 
-#include <time.h>
-
 #include <chrono>
 #include <cmath>
 #include <exception>
 
 namespace craneassist::foxglove {
 
-std::uint64_t message_time_ns(std::int64_t epoch_ns, double t_s) noexcept {
-  const double ns = static_cast<double>(epoch_ns) + std::round(t_s * 1e9);
-  if (!(ns > 0.0)) return 0;
-  if (ns >= 1.8e19) return 18'000'000'000'000'000'000ULL;
-  return static_cast<std::uint64_t>(ns);
-}
-
-std::int64_t wall_clock_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
-}
-
 McapRecorder::McapRecorder(const std::filesystem::path& path, const dynamics::CraneModel& model,
                            bool base, const McapRecorderOptions& options)
     : options_(options),
       channels_(model, base),
       writer_(path, options.file),
-      ring_(options.ring_rows) {
+      cycles_(options.ring_rows, options.wall_clock) {
   for (const Channel& c : channels_.channels()) ids_.push_back(writer_.add_channel(c));
   message_.reserve(1 << 16);
   thread_ = std::thread([this] { run(); });
@@ -40,20 +25,11 @@ McapRecorder::~McapRecorder() {
 }
 
 void McapRecorder::on_cycle(const control::CycleRecord& cycle) noexcept {
-  if (!epoch_set_) {
-    epoch_set_ = true;
-    if (options_.wall_clock) {
-      epoch_ns_ = wall_clock_ns() - static_cast<std::int64_t>(std::llround(cycle.time.t_s * 1e9));
-    }
-  }
-  Slot slot;
-  slot.row = cycle.row;
-  slot.t_s = cycle.time.t_s;
-  if (!ring_.push(slot)) dropped_.fetch_add(1, std::memory_order_relaxed);
+  cycles_.push(cycle);
 }
 
-void McapRecorder::write_slot(const Slot& slot) {
-  const std::uint64_t t_ns = message_time_ns(epoch_ns_, slot.t_s);
+void McapRecorder::write_slot(const CycleHandOver::Slot& slot) {
+  const std::uint64_t t_ns = cycles_.time_ns(slot.t_s);
   const auto stamp = static_cast<std::int64_t>(t_ns);
   for (std::size_t k = 0; k < channels_.size(); ++k) {
     if (channels_.channels()[k].latched) {
@@ -69,9 +45,9 @@ void McapRecorder::run() {
   try {
     for (;;) {
       const bool stopping = stop_.load(std::memory_order_acquire);
-      while (const Slot* slot = ring_.front()) {
+      while (const CycleHandOver::Slot* slot = cycles_.front()) {
         write_slot(*slot);
-        ring_.pop();
+        cycles_.pop();
       }
       if (stopping) break;
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -102,7 +78,7 @@ std::string McapRecorder::report() const {
   return "  mcap: " + writer_.path().string() + ", " + std::to_string(s.messages) +
          " messages on " + std::to_string(channels_.size()) + " channels in " +
          std::to_string(s.chunks) + " chunks, " + std::to_string(s.bytes) + " bytes (" +
-         std::to_string(dropped_.load()) + " cycles dropped)";
+         std::to_string(cycles_.dropped()) + " cycles dropped)";
 }
 
 }  // namespace craneassist::foxglove

@@ -7,9 +7,7 @@
 #include <boost/beast/websocket.hpp>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <deque>
-#include <fstream>
 #include <future>
 #include <mutex>
 #include <stdexcept>
@@ -48,17 +46,9 @@ std::string_view asset(const char* begin, const char* end) {
 }
 
 std::string random_token() {
-  unsigned char bytes[16] = {};
-  std::ifstream urandom("/dev/urandom", std::ios::binary);
-  urandom.read(reinterpret_cast<char*>(bytes), sizeof bytes);
-  if (!urandom) throw std::runtime_error("web: cannot read /dev/urandom for the session token");
-  std::string token;
-  char hex[3];
-  for (const unsigned char b : bytes) {
-    std::snprintf(hex, sizeof hex, "%02x", b);
-    token += hex;
-  }
-  return token;
+  auto token = craneassist::net::random_hex(16);
+  if (!token) throw std::runtime_error("web: cannot read /dev/urandom for the session token");
+  return *token;
 }
 
 // The value of `name` in the query of a request target ("/ws?token=abc&x=1"), or "".

@@ -1,7 +1,7 @@
 // `--mcap FILE` (replay, sim): the loop's cycles recorded as an MCAP file with the channels of
-// channels.hpp, every cycle. A CycleObserver: on the loop thread it copies the row into a
-// preallocated ring and returns (no lock, no allocation, no I/O; a full ring drops the cycle
-// and counts it); a writer thread encodes the messages and writes the chunks (McapWriter).
+// channels.hpp, every cycle. A CycleObserver: on the loop thread it hands the cycle over
+// (cycle_hand_over.hpp: no lock, no allocation, no I/O; a full ring drops the cycle and counts
+// it); a writer thread encodes the messages and writes the chunks (McapWriter).
 #pragma once
 
 #include <atomic>
@@ -11,8 +11,8 @@
 #include <thread>
 
 #include "craneassist/control/control_loop.hpp"
-#include "craneassist/control/spsc_ring.hpp"
 #include "craneassist/foxglove/channels.hpp"
+#include "craneassist/foxglove/cycle_hand_over.hpp"
 #include "craneassist/foxglove/mcap_writer.hpp"
 
 namespace craneassist::foxglove {
@@ -24,11 +24,6 @@ struct McapRecorderOptions {
   bool wall_clock = false;
   std::size_t ring_rows = 1 << 12;
 };
-
-// Message time of a cycle at machine time t_s (ns; the epoch offset added, never negative).
-std::uint64_t message_time_ns(std::int64_t epoch_ns, double t_s) noexcept;
-// The wall clock now, ns since the Unix epoch.
-std::int64_t wall_clock_ns() noexcept;
 
 class McapRecorder : public control::CycleObserver {
  public:
@@ -43,16 +38,12 @@ class McapRecorder : public control::CycleObserver {
 
   // "  mcap: FILE, N messages on C channels in K chunks, B bytes (D cycles dropped)"
   std::string report() const;
-  std::uint64_t dropped() const noexcept { return dropped_.load(); }
+  std::uint64_t dropped() const noexcept { return cycles_.dropped(); }
   McapStats stats() const;
 
  private:
-  struct Slot {
-    control::LogRow row;
-    double t_s = 0.0;
-  };
   void run();
-  void write_slot(const Slot& slot);
+  void write_slot(const CycleHandOver::Slot& slot);
   void finish();
 
   McapRecorderOptions options_;
@@ -60,12 +51,9 @@ class McapRecorder : public control::CycleObserver {
   McapWriter writer_;
   std::vector<std::uint16_t> ids_;
   std::vector<std::uint8_t> message_;
-  control::SpscRing<Slot> ring_;
-  std::int64_t epoch_ns_ = 0;
-  bool epoch_set_ = false;  // loop thread only
+  CycleHandOver cycles_;
   bool description_written_ = false;
   std::atomic<bool> stop_{false};
-  std::atomic<std::uint64_t> dropped_{0};
   std::string error_;  // the writer thread's, after it stopped
   std::thread thread_;
 };

@@ -9,12 +9,14 @@
 #include <chrono>
 #include <cstdio>
 #include <exception>
+#include <fstream>
 #include <future>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <vector>
 
 namespace craneassist::net {
 
@@ -81,6 +83,22 @@ void stop_io_thread(asio::io_context& ioc, std::thread& thread, std::promise<voi
     ioc.stop();
   }
   thread.join();
+}
+
+// `bytes` random bytes from /dev/urandom as lowercase hex (a session's token or id); nullopt when
+// they cannot be read.
+inline std::optional<std::string> random_hex(std::size_t bytes) {
+  std::vector<unsigned char> raw(bytes);
+  std::ifstream urandom("/dev/urandom", std::ios::binary);
+  urandom.read(reinterpret_cast<char*>(raw.data()), static_cast<std::streamsize>(raw.size()));
+  if (!urandom) return std::nullopt;
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  for (const unsigned char b : raw) {
+    out += kHex[b >> 4];
+    out += kHex[b & 15];
+  }
+  return out;
 }
 
 // One HTTP connection of a server (CRTP: Derived is the server's session, which answers in
