@@ -41,15 +41,11 @@ void CsvLog::write_row(const LogRow& r) {
     first = false;
     if (f.csv_empty_if_nan && !std::isfinite(x)) return;
     // The component's format where the field lists one per component.
-    const char* format = f.csv_format;
-    for (std::size_t k = 0; k < component && std::strchr(format, ',') != nullptr; ++k) {
-      format = std::strchr(format, ',') + 1;
-    }
+    const std::string_view format = list_item(f.csv_format, component);
     char one[16];
-    const std::size_t length = std::strcspn(format, ",");
-    if (length >= sizeof one) return;
-    std::memcpy(one, format, length);
-    one[length] = '\0';
+    if (format.size() >= sizeof one) return;
+    std::memcpy(one, format.data(), format.size());
+    one[format.size()] = '\0';
     std::fprintf(file_, one, x * f.csv_scale);
   };
   visit_fields(r, [&](const Field& f, const auto& value) {

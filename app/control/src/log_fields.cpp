@@ -14,27 +14,6 @@ inline constexpr bool kIsArray = false;
 template <std::size_t N>
 inline constexpr bool kIsArray<std::array<double, N>> = true;
 
-// The names in a comma-separated list ("x,y,z"), by index.
-std::string_view nth(std::string_view list, std::size_t k) {
-  for (std::size_t i = 0; i < k; ++i) {
-    const auto comma = list.find(',');
-    if (comma == std::string_view::npos) return {};
-    list.remove_prefix(comma + 1);
-  }
-  return list.substr(0, list.find(','));
-}
-
-// The k-th of a unit list "m, m, rad" (a single unit: that one for every k).
-std::string_view nth_unit(std::string_view list, std::size_t k) {
-  if (list.find(", ") == std::string_view::npos) return list;
-  for (std::size_t i = 0; i < k; ++i) {
-    const auto sep = list.find(", ");
-    if (sep == std::string_view::npos) return list;
-    list.remove_prefix(sep + 2);
-  }
-  return list.substr(0, list.find(", "));
-}
-
 const LogRow kEmptyRow{};  // for the descriptions (the values are not read)
 
 bool present(const Field& f, bool base) {
@@ -49,25 +28,6 @@ void append_number(double x, std::string& out) {
   char buf[32];
   const auto end = std::to_chars(buf, buf + sizeof buf, x).ptr;  // shortest round trip
   out.append(buf, end);
-}
-
-void append_string(const char* s, std::string& out) {
-  out += '"';
-  for (const char* c = s; c != nullptr && *c != '\0'; ++c) {
-    const auto u = static_cast<unsigned char>(*c);
-    if (*c == '"' || *c == '\\') {
-      out += '\\';
-      out += *c;
-    } else if (u < 0x20) {
-      static constexpr char kHex[] = "0123456789abcdef";
-      out += "\\u00";
-      out += kHex[u >> 4];
-      out += kHex[u & 15];
-    } else {
-      out += *c;
-    }
-  }
-  out += '"';
 }
 
 template <class T>
@@ -85,7 +45,7 @@ void append_value(const Field& f, const T& value, int dof, std::string& out) {
       for (std::size_t k = 0; k < value.size(); ++k) {
         if (k > 0) out += ',';
         out += '"';
-        out += nth(f.components, k);
+        out += list_item(f.components, k);
         out += "\":";
         append_number(value[k], out);
       }
@@ -94,7 +54,7 @@ void append_value(const Field& f, const T& value, int dof, std::string& out) {
   } else if constexpr (std::is_same_v<T, bool>) {
     out += value ? "true" : "false";
   } else if constexpr (std::is_same_v<T, const char*>) {
-    append_string(value, out);
+    append_json_string(value != nullptr ? value : "", out);
   } else if constexpr (std::is_integral_v<T>) {
     out += std::to_string(value);
   } else {
@@ -113,7 +73,7 @@ std::string schema_of(const Field& f, const T& value) {
       s = R"({"type":"object","properties":{)";
       std::string required;
       for (std::size_t k = 0; k < value.size(); ++k) {
-        const std::string c(nth(f.components, k));
+        const std::string c(list_item(f.components, k));
         if (k > 0) {
           s += ',';
           required += ',';
@@ -133,11 +93,39 @@ std::string schema_of(const Field& f, const T& value) {
     s = R"({"type":["number","null"])";
   }
   std::string description;
-  append_string((std::string(f.unit) + ": " + f.meaning).c_str(), description);
+  append_json_string(std::string(f.unit) + ": " + f.meaning, description);
   return s + ",\"description\":" + description + "}";
 }
 
 }  // namespace
+
+std::string_view list_item(std::string_view list, std::size_t k, std::string_view separator) {
+  for (std::size_t i = 0; i < k; ++i) {
+    const auto at = list.find(separator);
+    if (at == std::string_view::npos) break;  // fewer items: the last one
+    list.remove_prefix(at + separator.size());
+  }
+  return list.substr(0, list.find(separator));
+}
+
+void append_json_string(std::string_view text, std::string& out) {
+  out += '"';
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (u < 0x20) {
+      static constexpr char kHex[] = "0123456789abcdef";
+      out += "\\u00";
+      out += kHex[u >> 4];
+      out += kHex[u & 15];
+    } else {
+      out += c;
+    }
+  }
+  out += '"';
+}
 
 const char* to_string(FieldGroup group) noexcept {
   switch (group) {
@@ -232,8 +220,8 @@ std::vector<FlatField> flat_fields(int dof, bool base) {
       } else {
         for (std::size_t k = 0; k < value.size(); ++k) {
           // A vector of mixed units ("m, m, rad") lists one per component.
-          names.push_back({std::string(f.name) + "." + std::string(nth(f.components, k)),
-                           std::string(nth_unit(f.unit, k))});
+          names.push_back({std::string(f.name) + "." + std::string(list_item(f.components, k)),
+                           std::string(list_item(f.unit, k, ", "))});
         }
       }
     } else {

@@ -38,21 +38,9 @@ void numbers(std::string& out, const double* v, int n) {
   out += ']';
 }
 
-// A JSON string from text the project controls (names from the config): quotes and control
-// characters escaped.
+// A JSON string from text the project controls (names from the config).
 void quoted(std::string& out, std::string_view s) {
-  out += '"';
-  for (const char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      put(out, "\\u%04x", static_cast<unsigned>(c));
-    } else {
-      out += c;
-    }
-  }
-  out += '"';
+  control::append_json_string(s, out);
 }
 
 // One JSON object, field by field, appended to a string.

@@ -132,6 +132,13 @@ void visit_fields(Row& r, Visitor&& v) {
   // clang-format on
 }
 
+// The k-th item of a list ("x,y,z"; "m, m, rad" with separator ", "); the last one when the
+// list has fewer (a single item serves every k).
+std::string_view list_item(std::string_view list, std::size_t k, std::string_view separator = ",");
+
+// Appends text as a JSON string: quotes, backslashes and control characters escaped.
+void append_json_string(std::string_view text, std::string& out);
+
 // The table, in order (for descriptions: docs, schemas, tests).
 std::vector<Field> field_table();
 
