@@ -6,7 +6,7 @@
 #include <numbers>
 
 #include "craneassist/config/crane_config.hpp"
-#include "craneassist/sim_backend/mhsb_simulator.hpp"
+#include "craneassist/mhsb/mhsb_simulator.hpp"
 
 namespace {
 
@@ -17,13 +17,13 @@ void BM_MhsbControlPeriod(benchmark::State& state) {
   constexpr double kDeg = std::numbers::pi / 180.0;
   dynamics::JointVector q0(3);
   q0 << -10 * kDeg, 0.0, 0.0;
-  sim_backend::MhsbSimulator sim(model, {}, q0);
-  sim_backend::MhsbReference ref;
+  mhsb::MhsbSimulator sim(model, {}, q0);
+  mhsb::MhsbReference ref;
   ref.q = q0;
   ref.qdot.setZero(3);
   ref.qdot[0] = 0.1;  // 4.5 mm/s of cylinder speed
   ref.qddot.setZero(3);
-  ref.modes = *dynamics::parse_mode_pattern("DB-N-N", 3);
+  ref.modes = *mhsb::parse_mode_pattern("DB-N-N", 3);
   const double period = sim.settings().controller.period_s;
   long periods = 0;
   for (auto _ : state) {

@@ -61,9 +61,11 @@ config::CraneConfig k70m_sway(const benchmark::State& state) {
 // One controller update (redundancy resolution, path scaling, valve mapping) of a crane moving
 // out, up and sideways from its start pose, on a machine that follows the reference; started over
 // every 3 s of motion so that it measures motion, not a crane come to rest at a workspace end.
-void BM_ControllerUpdate(benchmark::State& state) {
+// BM_ControllerUpdateWithPolytope: the same with the flow manipulability polytope on, as in a
+// run with a log, telemetry or the web view (control::PolytopeProbe).
+void controller_update(benchmark::State& state, bool polytope) {
   const auto cfg = k70m_sway(state);
-  control::Controller controller(cfg, {});
+  control::Controller controller(cfg, {.polytope = polytope});
   const valves::MachineState start = still_at_start(cfg);
   valves::MachineState s = start;
   controller.reset(s);
@@ -82,7 +84,14 @@ void BM_ControllerUpdate(benchmark::State& state) {
     }
   }
 }
+void BM_ControllerUpdate(benchmark::State& state) {
+  controller_update(state, false);
+}
 BENCHMARK(BM_ControllerUpdate)->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond);
+void BM_ControllerUpdateWithPolytope(benchmark::State& state) {
+  controller_update(state, true);
+}
+BENCHMARK(BM_ControllerUpdateWithPolytope)->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond);
 
 // The same stick held with the crane at the end of its workspace (every cycle resolves,
 // damps the ends and holds the reference at rest): the busiest case of the end handling.

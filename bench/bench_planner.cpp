@@ -7,7 +7,7 @@
 #include <sys/resource.h>
 
 #include "craneassist/config/crane_config.hpp"
-#include "craneassist/offline/planning.hpp"
+#include "craneassist/studies/planning.hpp"
 
 namespace {
 
@@ -24,11 +24,11 @@ void BM_DpPlannerPaperGrid(benchmark::State& state) {
   const auto cfg = config::default_crane_config();
   const auto path =
       input::PrescribedPath::load_file(CRANEASSIST_SOURCE_DIR "/examples/paths/horizontal.csv");
-  const planner::StageModel stages(cfg.model, offline::sample_path(path, 0.05), {});
+  const planner::StageModel stages(cfg.model, studies::sample_path(path, 0.05), {});
   planner::DpOptions options;  // the paper's grid
   options.refinement.passes = static_cast<int>(state.range(0));
   options.threads = static_cast<int>(state.range(1));
-  const double c0 = offline::start_extension(stages, offline::StartExtension::kShortest);
+  const double c0 = studies::start_extension(stages, studies::StartExtension::kShortest);
   planner::Plan plan;
   for (auto _ : state) {
     plan = planner::plan_dp(stages, c0, options);

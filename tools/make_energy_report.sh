@@ -8,5 +8,5 @@ cd "$(dirname "$0")/.."
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$(nproc)" --target craneassist
 mkdir -p build/energy docs/img
-./build/app/craneassist energy --out build/energy/results.csv "$@"
+./build/app/craneassist research energy --out build/energy/results.csv "$@"
 /usr/bin/python3 tools/energy_report.py build/energy/results.csv docs/energy.md docs/img/energy.png

@@ -32,11 +32,11 @@ tools/plot_direction.py "$out/hl_flow.csv" "$out/hl_full.csv" docs/img/heavy_lif
   --labels "flow prescaling only" "full scaling (LS power bound)" --power-limit 35
 
 # docs/scaling.md: the 2R experiment of the power-limited scaling paper.
-$bin experiment-2r --power-bound actuator_sum --log "$out/2r_sum.csv" >/dev/null
-$bin experiment-2r --power-bound load_sensing --log "$out/2r_ls.csv" >/dev/null
+$bin research experiment-2r --power-bound actuator_sum --log "$out/2r_sum.csv" >/dev/null
+$bin research experiment-2r --power-bound load_sensing --log "$out/2r_ls.csv" >/dev/null
 tools/plot_power.py "$out/2r_sum.csv" "$out/2r_ls.csv" 5000 docs/img/scaling_2r.png
 # docs/polytope.md: the flow manipulability polytope at the start pose, with a 120 L/min pump so
 # that the flow cuts it, and a stick pushed out and sideways at 0.5 m/s.
-$bin polytope --pump-max-flow "120 L/min" --direction 1,0,0.5 --speed 0.5 \
+$bin research polytope --pump-max-flow "120 L/min" --direction 1,0,0.5 --speed 0.5 \
   --plot docs/img/polytope.png >/dev/null
 echo "figures written to docs/img/"

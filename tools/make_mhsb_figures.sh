@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Regenerates paper 001's results on our MHSB arm (docs/mhsb.md#the-papers-results-reproduced):
-# runs every case of the paper with `craneassist ptp` (planned, and on the MHSB simulator), writes
+# runs every case of the paper with `craneassist research ptp` (planned, and on the MHSB simulator), writes
 # docs/data/mhsb_cases.csv, the figures docs/img/mhsb_*.png and the table in docs/mhsb.md made
 # from that file. Build first (cmake --build build);
 # needs python3-matplotlib. About a minute with the posture tables cached (~/.cache/craneassist;

@@ -11,8 +11,8 @@ trap 'rm -rf "$out"' EXIT
 path=examples/paths/mobile_s_curve.csv
 for pump in shared separate; do
   echo "== --pump $pump"
-  $bin follow $path --pump $pump --no-error-scaling --log "$out/case1_$pump.csv"
-  $bin follow $path --pump $pump --log "$out/case2_$pump.csv"
+  $bin research follow $path --pump $pump --no-error-scaling --log "$out/case1_$pump.csv"
+  $bin research follow $path --pump $pump --log "$out/case2_$pump.csv"
 done
 /usr/bin/python3 tools/plot_mobile.py "$out/case1_shared.csv" "$out/case2_shared.csv" \
   docs/img/mobile_follow.png

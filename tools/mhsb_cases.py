@@ -89,7 +89,7 @@ class Runner:
             config=CONFIG, files=True, paper=(None, None, None), note="", extra=(),
             paper_error=None):
         (fx, fz), (tx, tz) = points
-        cmd = [self.bin, "ptp", "--config", config, "--from", f"{fx},{fz}", "--to", f"{tx},{tz}",
+        cmd = [self.bin, "research", "ptp", "--config", config, "--from", f"{fx},{fz}", "--to", f"{tx},{tz}",
                "--weights", ",".join(str(w) for w in weights), *options]
         if self.grid:
             cmd += ["--grid", self.grid]
@@ -215,7 +215,7 @@ def main():
               extra=["--goal-at", "3:0.8,0.2", "--goal-at", "6:0.6,0.5", "--sim-log",
                      os.path.join(args.work, "4.2.sim.csv")])
     # The mode regions (Figure 5) from the optimal table.
-    cmd = [args.bin, "ptp", "--config", CONFIG, "--from", "0.55,-0.05", "--to", "0.55,0.6",
+    cmd = [args.bin, "research", "ptp", "--config", CONFIG, "--from", "0.55,-0.05", "--to", "0.55,0.6",
            "--workspace-out", os.path.join(args.work, "workspace.csv")]
     if args.grid:
         cmd += ["--grid", args.grid]

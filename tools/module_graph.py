@@ -23,13 +23,14 @@ set(GRAPHVIZ_IGNORE_TARGETS "^test_;^bench_;^socketcan_smoke$;^can_backend_check
 
 # Rooms, for the drawing: which folder holds each target.
 ROOMS = [
-    ("app", ["craneassist", "control", "offline", "dds"]),
+    ("app", ["craneassist", "control", "offline", "dds", "web", "net", "foxglove"]),
     ("input", ["input", "input_devices", "files"]),
     ("config", ["config", "joystick_config"]),
     ("valves", ["valves", "can", "can_backend"]),
-    ("dynamics", ["dynamics", "planner"]),
+    ("dynamics", ["dynamics"]),
     ("scaling", ["scaling"]),
     ("sim_backend", ["sim_backend"]),
+    ("research", ["mhsb", "paths", "planner", "studies"]),
 ]
 
 

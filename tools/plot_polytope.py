@@ -4,12 +4,12 @@
 from above and from behind, and in 3-D, with the stick direction's admissible speed over every
 joint motion (LP) and along the controller's resolution. A planar arm's polygon is one plot.
 
-    build/app/craneassist polytope --pose "lift=20 deg, tilt=-70 deg" --direction 1,0,0.5 \\
+    build/app/craneassist research polytope --pose "lift=20 deg, tilt=-70 deg" --direction 1,0,0.5 \\
         --pump-max-flow "120 L/min" --out poly.csv
     tools/plot_polytope.py poly.csv poly.png
     tools/plot_polytope.py poly.csv --check   # Qhull's volume against craneassist's
 
-`craneassist polytope --plot FILE.png` runs this script itself. --check computes the hull of the
+`craneassist research polytope --plot FILE.png` runs this script itself. --check computes the hull of the
 vertices with Qhull (scipy.spatial.ConvexHull), an implementation independent of craneassist's,
 prints both volumes (areas) and exits 1 when they differ by more than 1e-9 of the volume.
 Needs python3-matplotlib and python3-scipy (Debian packages).

@@ -2,8 +2,8 @@
 """Plot two craneassist logs of the same path under different power bounds.
 
 The 2R experiment of docs/scaling.md:
-    craneassist experiment-2r --power-bound actuator_sum --log old.csv
-    craneassist experiment-2r --power-bound load_sensing --log ls.csv
+    craneassist research experiment-2r --power-bound actuator_sum --log old.csv
+    craneassist research experiment-2r --power-bound load_sensing --log ls.csv
     tools/plot_power.py old.csv ls.csv 8000 docs/img/scaling_2r.png
 
 Arguments: the baseline log, the load-sensing log, P_max in W, the output PNG.

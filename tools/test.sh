@@ -14,7 +14,7 @@ export CRANEASSIST_CAN_VM_REQUIRED=1  # here the VM tests must run, never be ski
 export CRANEASSIST_WEB_REQUIRED=1     # and the browser test of the web view
 
 echo "== formatting (clang-format)"
-find app bench config dynamics input scaling sim_backend tests valves \( -name '*.cpp' -o -name '*.hpp' \) \
+find app bench config dynamics input research scaling sim_backend tests valves \( -name '*.cpp' -o -name '*.hpp' \) \
   -print0 | xargs -0 clang-format --dry-run --Werror
 
 echo "== release build and tests"

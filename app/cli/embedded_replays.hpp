@@ -6,7 +6,7 @@ namespace craneassist::cli::embedded {
 extern const char* const kDemoReplayCsv;
 // config/can/k70m_can.yaml, the default CAN mapping of `replay --backend can` and `emulate`.
 extern const char* const kK70mCanMappingYaml;
-// tools/plot_polytope.py, which `craneassist polytope --plot` runs with python3.
+// tools/plot_polytope.py, which `craneassist research polytope --plot` runs with python3.
 extern const char* const kPlotPolytopePy;
 
 }  // namespace craneassist::cli::embedded

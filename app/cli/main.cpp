@@ -8,21 +8,22 @@
 #include <exception>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
-#include "bound_command.hpp"
 #include "calibrate_command.hpp"
 #include "can_commands.hpp"
 #include "can_tool_command.hpp"
-#include "energy_command.hpp"
 #include "exit_codes.hpp"
-#include "experiment_command.hpp"
 #include "fields_command.hpp"
-#include "follow_command.hpp"
-#include "plan_command.hpp"
-#include "polytope_command.hpp"
-#include "ptp_command.hpp"
 #include "replay_command.hpp"
+#include "research/bound_command.hpp"
+#include "research/energy_command.hpp"
+#include "research/experiment_command.hpp"
+#include "research/follow_command.hpp"
+#include "research/plan_command.hpp"
+#include "research/polytope_command.hpp"
+#include "research/ptp_command.hpp"
 #include "sim_command.hpp"
 #include "suite_command.hpp"
 #include "urdf_command.hpp"
@@ -59,20 +60,41 @@ int main(int argc, char** argv) {
 
   std::vector<Subcommand> commands;
   add(commands, cli, add_replay_command, run_replay_command);
-  add(commands, cli, add_experiment_command, run_experiment_command);
-  add(commands, cli, add_plan_command, run_plan_command);
   add(commands, cli, add_emulate_command, run_emulate_command);
   add(commands, cli, add_can_tool_command, run_can_tool_command);
-  add(commands, cli, add_energy_command, run_energy_command);
   add(commands, cli, add_calibrate_command, run_calibrate_command);
   add(commands, cli, add_sim_command, run_sim_command);
   add(commands, cli, add_suite_command, run_suite_command);
-  add(commands, cli, add_bound_command, run_bound_command);
   add(commands, cli, add_urdf_command, run_urdf_command);
   add(commands, cli, add_fields_command, run_fields_command);
-  add(commands, cli, add_polytope_command, run_polytope_command);
-  add(commands, cli, add_follow_command, run_follow_command);
-  add(commands, cli, add_ptp_command, run_ptp_command);
+  // The papers' studies and offline analyses (research/, docs/research.md): craneassist research
+  // <study>.
+  CLI::App* research = cli.add_subcommand(
+      "research",
+      "The papers' studies and offline analyses: the 2R and energy experiments, "
+      "planning, the time-optimal bound, the flow polytope, the crane on wheels, "
+      "the MHSB point-to-point planner");
+  research->require_subcommand(1);
+  add(commands, *research, add_experiment_command, run_experiment_command);
+  add(commands, *research, add_energy_command, run_energy_command);
+  add(commands, *research, add_plan_command, run_plan_command);
+  add(commands, *research, add_bound_command, run_bound_command);
+  add(commands, *research, add_polytope_command, run_polytope_command);
+  add(commands, *research, add_follow_command, run_follow_command);
+  add(commands, *research, add_ptp_command, run_ptp_command);
+  // Where the studies were before: a hidden command that says where they are now (exit 2).
+  for (CLI::App* study : research->get_subcommands([](CLI::App*) { return true; })) {
+    CLI::App* moved = cli.add_subcommand(study->get_name(), "")->group("");
+    moved->allow_extras()->prefix_command();
+    const std::string name = study->get_name();
+    commands.push_back({moved, [name] {
+                          spdlog::error(
+                              "`craneassist {0}` is now `craneassist research {0}` "
+                              "(docs/research.md)",
+                              name);
+                          return kExitUsage;
+                        }});
+  }
 #if CRANEASSIST_WITH_DDS  // a build without DDS (CRANEASSIST_DDS=OFF) has none of these
   add(commands, cli, add_remote_command, run_remote_command);
   add(commands, cli, add_echo_command, run_echo_command);

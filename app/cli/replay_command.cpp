@@ -273,8 +273,8 @@ void print_trajectory_summary(const control::TrajectoryRunSummary& s,
   }
 }
 
-// replay --trajectory: execute a plan (craneassist plan) in the simulator, starting at its first
-// configuration.
+// replay --trajectory: execute a plan (craneassist research plan) in the simulator, starting at its
+// first configuration.
 int run_trajectory_command(const ReplayArgs& args, const config::CraneConfig& cfg) {
   std::optional<input::JointTrajectory> traj;
   if (uses_can_backend(args.machine, cfg)) {
@@ -428,7 +428,7 @@ CLI::App* add_replay_command(CLI::App& cli, ReplayArgs& args) {
       ->check(CLI::ExistingFile);
   replay
       ->add_option("--trajectory", args.trajectory_file,
-                   "Execute a planned joint trajectory (craneassist plan; "
+                   "Execute a planned joint trajectory (craneassist research plan; "
                    "docs/trajectory-format.md) instead of a replay, from its first configuration")
       ->check(CLI::ExistingFile);
   add_config_option(*replay, args.config_file);

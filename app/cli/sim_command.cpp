@@ -26,11 +26,10 @@
 #include "craneassist/offline/sim_setup.hpp"
 #include "craneassist/valves/reference_follower.hpp"
 #include "exit_codes.hpp"
-#include "goal_planning.hpp"
 #include "option_checks.hpp"
-#include "ptp_command.hpp"
 #include "remote_input.hpp"
 #include "replay_command.hpp"
+#include "research/goal_move.hpp"
 
 namespace craneassist::cli {
 namespace {
@@ -337,33 +336,14 @@ int run_sim_command(const SimArgs& args) {
   }
 
   // --input goal: the planner, its posture table (cached) and the goals, before anything moves.
-  std::optional<planner::PlanarArm> goal_arm;
-  std::optional<LoadedTable> goal_table;
-  std::optional<planner::PtpPlanner> goal_planner;
-  std::vector<GoalAt> goals;
-  planner::PtpWeights goal_weights;
+  std::unique_ptr<input::GoalPlanning> goal_move;
   if (kind == "goal") {
-    goals = parse_goals(args.goal, args.goal_at);
-    goal_weights = parse_weights("--goal-weights", args.goal_weights);
-    try {
-      goal_arm.emplace(cfg.model, cfg.simulation.q_initial);
-    } catch (const std::invalid_argument& e) {
-      throw CLI::ValidationError("--input goal", cfg.model.name + ": " + e.what());
-    }
-    planner::PostureTableSettings table_settings;
-    if (!args.goal_grid.empty()) {
-      table_settings.spacing_m = parse_grid_spacing("--goal-grid", args.goal_grid);
-      check_grid_size(*goal_arm, cfg.model.name, table_settings.spacing_m, "--goal-grid");
-    }
-    std::vector<std::pair<std::string, Eigen::Vector2d>> points;
-    for (const auto& g : goals)
-      points.emplace_back(g.t_s == 0.0 && !args.goal.empty() ? "--goal" : "--goal-at", g.xz);
-    goal_table.emplace(posture_table_for(cfg, *goal_arm, table_settings, args.goal_table, points));
-    goal_planner.emplace(*goal_arm, goal_table->table, planner::PtpSettings{});
-    spdlog::info(
-        "goal planner: {} nodes, {:.0f} mm grid, posture table {}",
-        goal_table->table.grid().nodes(), 1000.0 * goal_table->table.grid().spacing_m,
-        goal_table->loaded ? "loaded from " + goal_table->file->string() : std::string("built"));
+    goal_move = make_goal_move(cfg, GoalMoveOptions{.goal = args.goal,
+                                                    .goal_at = args.goal_at,
+                                                    .weights = args.goal_weights,
+                                                    .grid = args.goal_grid,
+                                                    .table = args.goal_table,
+                                                    .speed_m_s = args.goal_speed_m_s});
   }
 
   try {
@@ -479,13 +459,7 @@ int run_sim_command(const SimArgs& args) {
                                            : "the crane on its own pump");
     }
 
-    std::optional<GoalPlanner> goal_thread;
-    if (goal_source != nullptr) {
-      // Goals typed on standard input replan too (a terminal in line mode, or a pipe).
-      goal_thread.emplace(*goal_planner, *goal_source, goals, goal_weights,
-                          TipLimits{args.goal_speed_m_s, cfg.scaling.acceleration_max_m_s2}, true);
-      goal_thread->start();
-    }
+    if (goal_source != nullptr) goal_move->start(*goal_source);
     std::atomic<bool> done{false};
     StatusReporter reporter(board, keyboard, remote);
     std::thread ui([&] { reporter.run(done); });
@@ -495,10 +469,10 @@ int run_sim_command(const SimArgs& args) {
     } catch (...) {
       done.store(true);
       ui.join();
-      if (goal_thread) goal_thread->stop();
+      if (goal_move) goal_move->stop();
       throw;
     }
-    if (goal_thread) goal_thread->stop();
+    if (goal_move) goal_move->stop();
     // Every valve to its safe state at once (Machine::finish() below deactivates and reports).
     machine.safe_stop();
     done.store(true);
@@ -541,8 +515,8 @@ int run_sim_command(const SimArgs& args) {
       if (!r.refused.empty()) spdlog::warn("real time: {}", r.refused);
     }
     std::printf("  input device: %d disconnects, %d re-attaches\n", s.disconnects, s.reconnects);
-    if (goal_thread) {
-      for (const std::string& line : goal_thread->report()) std::printf("  %s\n", line.c_str());
+    if (goal_move) {
+      for (const std::string& line : goal_move->report()) std::printf("  %s\n", line.c_str());
       std::printf("  goal input at the end: %s\n", goal_state);
     }
     if (base) {

@@ -36,7 +36,7 @@ struct FieldRange {
 };
 
 // The machine's geometry and masses, within what the simulator and the dynamics model run
-// (docs/config.md#ranges; tests/test_config.cpp runs a model at these edges).
+// (docs/config.md#ranges; tests/config/test_config.cpp runs a model at these edges).
 constexpr double kMaxLengthM = 100.0;  // every length, offset and centre of mass
 constexpr FieldRange kLength{-kMaxLengthM, kMaxLengthM, "within +-100 m"};
 constexpr FieldRange kPositiveLength{1e-6, kMaxLengthM, "positive and at most 100 m"};

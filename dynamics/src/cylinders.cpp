@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "craneassist/dynamics/hydraulics.hpp"
+
 namespace craneassist::dynamics {
 namespace {
 
@@ -80,8 +82,7 @@ void cylinder_arms(const CraneModel& model, const JointVector& q, JointVector& d
 
 double pump_flow_demand(const CraneModel& model, const JointVector& v) {
   double q = 0.0;
-  for (int i = 0; i < model.dof(); ++i)
-    q += flow_area_m2(model.cylinders[i], v[i]) * std::abs(v[i]);
+  for (int i = 0; i < model.dof(); ++i) q += cylinder_flow_m3_s(model.cylinders[i], v[i]);
   return q;
 }
 

@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 
+#include "craneassist/dynamics/hydraulics.hpp"
+
 namespace craneassist::dynamics {
 namespace {
 
@@ -38,8 +40,7 @@ void joint_velocity_set(const CraneModel& model, const JointVector& q, const Joi
   out.qdot_max.resize(n);
   out.flow_positive_m3.resize(n);
   out.flow_negative_m3.resize(n);
-  out.max_flow_m3_s = model.pump.max_flow_m3_s * (1.0 - settings.flow_reserve);
-  const double keep = 1.0 - settings.cylinder_speed_reserve;
+  out.max_flow_m3_s = flow_budget_m3_s(model, settings.flow_reserve);
   for (int i = 0; i < n; ++i) {
     const Cylinder& cyl = model.cylinders[at(i)];
     const DhJoint& joint = model.joints[at(i)];
@@ -49,12 +50,12 @@ void joint_velocity_set(const CraneModel& model, const JointVector& q, const Joi
       out.flow_positive_m3[i] = out.flow_negative_m3[i] = 0.0;
       continue;
     }
-    const double rate = keep * cyl.v_max_m_s / std::abs(r);
+    const double rate = cylinder_speed_cap_m_s(cyl, settings.cylinder_speed_reserve) / std::abs(r);
     out.qdot_max[i] = rate;
     out.qdot_min[i] = -rate;
     // A positive joint rate moves the cylinder in the sign of r.
-    out.flow_positive_m3[i] = std::abs(r) * flow_area_m2(cyl, r);
-    out.flow_negative_m3[i] = std::abs(r) * flow_area_m2(cyl, -r);
+    out.flow_positive_m3[i] = cylinder_flow_m3_s(cyl, r);
+    out.flow_negative_m3[i] = cylinder_flow_m3_s(cyl, -r);
     if (settings.joint_ends) {
       if (q[i] >= joint.q_max - settings.end_tolerance) out.qdot_max[i] = 0.0;
       if (q[i] <= joint.q_min + settings.end_tolerance) out.qdot_min[i] = 0.0;

@@ -6,6 +6,8 @@
 #include <array>
 #include <cmath>
 
+#include "craneassist/dynamics/hydraulics.hpp"
+
 namespace craneassist::dynamics {
 namespace {
 
@@ -120,7 +122,7 @@ class Line {
     double q = 0.0;
     for (int i = 0; i < model_.dof(); ++i) {
       const double v = arms_[i] * (line_.p[i] + tau * line_.n[i]);
-      q += flow_area_m2(model_.cylinders[static_cast<std::size_t>(i)], v) * std::abs(v);
+      q += cylinder_flow_m3_s(model_.cylinders[static_cast<std::size_t>(i)], v);
     }
     return q;
   }

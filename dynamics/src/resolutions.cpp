@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 
+#include "craneassist/dynamics/hydraulics.hpp"
+
 namespace craneassist::dynamics {
 namespace {
 
@@ -39,9 +41,9 @@ double resolution_cost(const CraneModel& model, Resolution resolution, const Joi
     const auto& cyl = model.cylinders[static_cast<std::size_t>(i)];
     const double v = dc_dq[i] * qdot[i];
     squares += v * v;
-    flow += flow_area_m2(cyl, v) * std::abs(v);
+    flow += cylinder_flow_m3_s(cyl, v);
     if (cylinder_force != nullptr && std::abs(v) > kTiny) {
-      p_max = std::max(p_max, std::copysign(1.0, v) * (*cylinder_force)[i] / flow_area_m2(cyl, v));
+      p_max = std::max(p_max, load_pressure_pa(cyl, (*cylinder_force)[i], v));
     }
   }
   switch (resolution) {

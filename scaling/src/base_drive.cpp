@@ -5,6 +5,20 @@
 
 namespace craneassist::scaling {
 
+const char* to_string(BaseLimit limit) {
+  switch (limit) {
+    case BaseLimit::kFlow:
+      return "flow";
+    case BaseLimit::kMotorSpeed:
+      return "motor_speed";
+    case BaseLimit::kTrackingError:
+      return "tracking_error";
+    case BaseLimit::kEnd:
+      return "end";
+  }
+  return "?";
+}
+
 void flow_bounded_drive(const dynamics::MobileBaseModel& model, double speed_fraction,
                         double curvature_fraction, double flow_budget_m3_s,
                         BaseDriveOutput& out) noexcept {

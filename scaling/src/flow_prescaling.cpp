@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "craneassist/dynamics/cylinders.hpp"
+#include "craneassist/dynamics/hydraulics.hpp"
 
 namespace craneassist::scaling {
 
@@ -16,7 +17,7 @@ void flow_prescale(const dynamics::CraneModel& model, const dynamics::JointVecto
   for (int i = 0; i < model.dof(); ++i) {
     const auto& cyl = model.cylinders[static_cast<std::size_t>(i)];
     const double v = dc_dq[i] * qdot[i];
-    flow += dynamics::flow_area_m2(cyl, v) * std::abs(v);
+    flow += dynamics::cylinder_flow_m3_s(cyl, v);
     if (std::abs(v) * out.scale > cyl.v_max_m_s) {
       out.scale = cyl.v_max_m_s / std::abs(v);
       out.limit = ActiveLimit::kCylinderSpeed;
@@ -24,7 +25,7 @@ void flow_prescale(const dynamics::CraneModel& model, const dynamics::JointVecto
     }
   }
   out.flow_demand_m3_s = flow;
-  const double flow_budget = model.pump.max_flow_m3_s * (1.0 - flow_reserve);
+  const double flow_budget = dynamics::flow_budget_m3_s(model, flow_reserve);
   if (flow * out.scale > flow_budget) {
     out.scale = flow_budget / flow;
     out.limit = ActiveLimit::kFlow;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "craneassist/dynamics/hydraulics.hpp"
+
 namespace craneassist::scaling {
 namespace {
 
@@ -15,6 +17,16 @@ double motion_sign(const PathGeometry& path, int i) {
   const double v = path.dc_dq[i] * path.f1[i];
   if (std::abs(v) < kTinyRate) return 0.0;
   return v > 0.0 ? 1.0 : -1.0;
+}
+
+// The chamber pressure per unit joint load (torque or force) of joint i moving along the path in
+// the direction `sign`: sign / (dc/dq A), A the flow area of its cylinder's motion; times a
+// joint's m(s) or b(s), the share of the load pressure they make.
+double pressure_per_joint_load(const dynamics::CraneModel& model, const PathGeometry& path, int i,
+                               double sign) {
+  const double area = dynamics::flow_area_m2(model.cylinders[static_cast<std::size_t>(i)],
+                                             path.dc_dq[i] * path.f1[i]);
+  return sign / (path.dc_dq[i] * area);
 }
 
 // One side of a linear inequality k x + c <= limit, folded into [lo, hi].
@@ -64,9 +76,7 @@ void constant_pressure_bounds(const dynamics::CraneModel& model, const PathGeome
   for (int i = 0; i < model.dof(); ++i) {
     const double sign = motion_sign(path, i);
     if (sign == 0.0) continue;
-    const double area = dynamics::flow_area_m2(model.cylinders[static_cast<std::size_t>(i)],
-                                               path.dc_dq[i] * path.f1[i]);
-    const double scale = sign / (path.dc_dq[i] * area);
+    const double scale = pressure_per_joint_load(model, path, i, sign);
     apply_power(scale * terms.m[i], scale * terms.b[i], b.pressure_limit_pa, ActiveLimit::kPressure,
                 b);
   }
@@ -87,17 +97,17 @@ void path_speed_limits(const dynamics::CraneModel& model, const PathGeometry& pa
   for (int i = 0; i < model.dof(); ++i) {
     const auto& cyl = model.cylinders[static_cast<std::size_t>(i)];
     const double v = path.dc_dq[i] * path.f1[i];  // cylinder velocity per unit path speed
-    flow += dynamics::flow_area_m2(cyl, v) * std::abs(v);
+    flow += dynamics::cylinder_flow_m3_s(cyl, v);
     // The reserve keeps room above the reference for the valves' feedback corrections, here as
     // for the pump flow: a fully open valve cannot correct anything.
-    const double v_max = cyl.v_max_m_s * (1.0 - flow_reserve);
+    const double v_max = dynamics::cylinder_speed_cap_m_s(cyl, flow_reserve);
     if (std::abs(v) > kTinyRate && v_max / std::abs(v) < out.sdot_cylinder) {
       out.sdot_cylinder = v_max / std::abs(v);
       out.cylinder = i;
     }
   }
   out.flow_per_speed_m3 = flow;
-  out.sdot_flow = flow > 0.0 ? model.pump.max_flow_m3_s * (1.0 - flow_reserve) / flow : kInf;
+  out.sdot_flow = flow > 0.0 ? dynamics::flow_budget_m3_s(model, flow_reserve) / flow : kInf;
 }
 
 void path_acceleration_bounds(const dynamics::CraneModel& model, const PathGeometry& path,
@@ -135,10 +145,10 @@ void path_acceleration_bounds(const dynamics::CraneModel& model, const PathGeome
     for (int i = 0; i < n; ++i) {
       const double sign = motion_sign(path, i);
       if (sign == 0.0) continue;
-      const auto& cyl = model.cylinders[static_cast<std::size_t>(i)];
       const double v = path.dc_dq[i] * path.f1[i];
-      flow_per_speed += dynamics::flow_area_m2(cyl, v) * std::abs(v);
-      const double scale = sign / (path.dc_dq[i] * dynamics::flow_area_m2(cyl, v));
+      flow_per_speed +=
+          dynamics::cylinder_flow_m3_s(model.cylinders[static_cast<std::size_t>(i)], v);
+      const double scale = pressure_per_joint_load(model, path, i, sign);
       max_static_pressure = std::max(max_static_pressure, scale * terms.b[i]);
     }
     if (pump.mode == dynamics::PumpMode::kConstantPressure) {
@@ -154,9 +164,7 @@ void path_acceleration_bounds(const dynamics::CraneModel& model, const PathGeome
     for (int i = 0; i < n; ++i) {
       const double sign = motion_sign(path, i);
       if (sign == 0.0) continue;
-      const double area = dynamics::flow_area_m2(model.cylinders[static_cast<std::size_t>(i)],
-                                                 path.dc_dq[i] * path.f1[i]);
-      const double scale = sign / (path.dc_dq[i] * area);
+      const double scale = pressure_per_joint_load(model, path, i, sign);
       apply_power(scale * terms.m[i], scale * terms.b[i], b.pressure_limit_pa, kind, b);
     }
     // Quasi-static limit: the speed at which the current loads take exactly P_max at sddot = 0.
@@ -188,7 +196,7 @@ double load_sensing_power(const dynamics::CraneModel& model, const PathGeometry&
     if (sign == 0.0) continue;
     const double v = path.dc_dq[i] * path.f1[i];
     const double area = dynamics::flow_area_m2(model.cylinders[static_cast<std::size_t>(i)], v);
-    flow += area * std::abs(v) * sdot;
+    flow += dynamics::cylinder_flow_m3_s(model.cylinders[static_cast<std::size_t>(i)], v) * sdot;
     p_max = std::max(p_max, sign * (terms.m[i] * sddot + terms.b[i]) / (path.dc_dq[i] * area));
   }
   return (p_max + model.pump.ls_margin_pa) * flow;
@@ -203,8 +211,7 @@ double pump_power(const dynamics::CraneModel& model, const PathGeometry& path,
   for (int i = 0; i < model.dof(); ++i) {
     if (motion_sign(path, i) == 0.0) continue;
     const double v = path.dc_dq[i] * path.f1[i];
-    flow += dynamics::flow_area_m2(model.cylinders[static_cast<std::size_t>(i)], v) * std::abs(v) *
-            sdot;
+    flow += dynamics::cylinder_flow_m3_s(model.cylinders[static_cast<std::size_t>(i)], v) * sdot;
   }
   return dynamics::supply_pressure_ceiling_pa(model.pump) * flow;
 }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "craneassist/dynamics/cylinders.hpp"
+#include "craneassist/dynamics/hydraulics.hpp"
 #include "craneassist/dynamics/ode_crane.hpp"
 #include "craneassist/dynamics/pendulum.hpp"
 #include "craneassist/sim_backend/pump_model.hpp"
@@ -273,7 +274,7 @@ struct SimBackend::Impl {
       // Direction of the requested motion decides which chamber is pressurised; a closed
       // section reports the chamber that holds the load.
       const double dir = requested_velocity[i] != 0.0 ? requested_velocity[i] : force[i];
-      const double p = std::copysign(1.0, dir) * force[i] / dynamics::flow_area_m2(cyl, dir);
+      const double p = dynamics::load_pressure_pa(cyl, force[i], dir);
       load_pressure[i] += alpha * (p - load_pressure[i]);
     }
   }
@@ -378,8 +379,7 @@ struct SimBackend::Impl {
     for (int i = 0; i < n; ++i) {
       const auto& cyl = model.cylinders[static_cast<std::size_t>(i)];
       requested_velocity[i] = sections[static_cast<std::size_t>(i)].step(spool_command[i]);
-      demand[i] =
-          dynamics::flow_area_m2(cyl, requested_velocity[i]) * std::abs(requested_velocity[i]);
+      demand[i] = dynamics::cylinder_flow_m3_s(cyl, requested_velocity[i]);
     }
     pump.solve(demand, load_pressure, pump_result);
     step_physics(false);

@@ -14,9 +14,9 @@ path="path: $data/bad_path.csv:4: field 'y': not a number: '2.O4'"
 trajectory="trajectory: $data/bad_trajectory.csv:3: field 'qdot_2': not a number: 'abc'"
 expect replay "$replay" replay "$data/bad_replay.csv" --no-log
 expect sim_replay "$replay" sim --input replay "$data/bad_replay.csv" --no-realtime
-expect bound_replay "$replay" bound "$data/bad_replay.csv"
-expect plan_path "$path" plan "$data/bad_path.csv" --quiet --out "$work/plan.csv"
-expect bound_path "$path" bound "$data/bad_path.csv"
+expect bound_replay "$replay" research bound "$data/bad_replay.csv"
+expect plan_path "$path" research plan "$data/bad_path.csv" --quiet --out "$work/plan.csv"
+expect bound_path "$path" research bound "$data/bad_path.csv"
 expect trajectory "$trajectory" replay --trajectory "$data/bad_trajectory.csv" --no-log
 # A plan's positions must lie in the crane's joint ranges (the K70M's lift ends at 1.097 rad).
 printf 't,q_1,q_2,q_3,q_4,qdot_1,qdot_2,qdot_3,qdot_4,qddot_1,qddot_2,qddot_3,qddot_4\n%s\n%s\n' \
@@ -49,8 +49,8 @@ expect zero_trajectory "trajectory: $(limit /dev/zero 64 'joint trajectory')" \
   replay --trajectory /dev/zero --no-log
 expect zero_telemetry "config: $(limit /dev/zero 1 'telemetry config')" \
   replay --telemetry-config /dev/zero --no-log
-expect zero_plan "path: $(limit /dev/zero 64 'tip path')" plan /dev/zero --quiet --out "$work/plan.csv"
-expect zero_bound "replay: $(limit /dev/zero 64 'tip path and replay')" bound /dev/zero
+expect zero_plan "path: $(limit /dev/zero 64 'tip path')" research plan /dev/zero --quiet --out "$work/plan.csv"
+expect zero_bound "replay: $(limit /dev/zero 64 'tip path and replay')" research bound /dev/zero
 expect zero_sim "replay: $(limit /dev/zero 64 replay)" sim --input replay /dev/zero --no-realtime
 expect zero_joystick "config: $(limit /dev/zero 1 'joystick mapping')" \
   sim --input replay "$demo" --no-realtime --joystick /dev/zero
@@ -88,11 +88,11 @@ expect nan_feedback_timeout "--can-feedback-timeout: 'nan' is not a finite numbe
 expect nan_payload "--payload: 'nan' is not a finite number" replay --payload nan --no-log
 expect inf_duration "--duration: 'inf' is not a finite number" \
   sim --input replay "$demo" --no-realtime --duration inf
-expect nan_dt "--dt: 'nan' is not a finite number" plan "$data/../../examples/paths/vertical.csv" --dt nan
-expect nan_ds "--ds: 'nan' is not a finite number" bound "$data/../../examples/paths/vertical.csv" --ds nan
+expect nan_dt "--dt: 'nan' is not a finite number" research plan "$data/../../examples/paths/vertical.csv" --dt nan
+expect nan_ds "--ds: 'nan' is not a finite number" research bound "$data/../../examples/paths/vertical.csv" --ds nan
 expect nan_emulate "--feedback-period: 'nan' is not a finite number" \
   emulate --can vcan0 --feedback-period nan
-expect nan_speed "--speed: '-nan' is not a finite number" experiment-2r --speed -nan
+expect nan_speed "--speed: '-nan' is not a finite number" research experiment-2r --speed -nan
 # A command-line override of a config field goes through that field's range check (it skipped
 # it: --pump-max-flow "1e30 L/min" ran).
 expect big_flow "--pump-max-flow: must be positive and at most 60000 L/min" \
@@ -110,39 +110,39 @@ expect calibrate_nan_level "--levels: 'nan' is not a finite number" calibrate --
 expect calibrate_zero_level "--levels: each level must be in (0, 1], got 0" calibrate --levels 0,1
 expect calibrate_level_order "--levels: the levels must be strictly ascending" \
   calibrate --levels 0.6,0.3
-# craneassist ptp (docs/mhsb.md#the-planner): bad points and weights, a point outside the
+# craneassist research ptp (docs/mhsb.md#the-planner): bad points and weights, a point outside the
 # workspace, an option the crane cannot take; all found before a posture table is built.
 arm=$data/../../config/cranes/mhsb_3link.yaml
 nt=$work/no-table.bin
 expect ptp_bad_point "--from: '0.55': expected two numbers X,Z (m)" \
-  ptp --config "$arm" --table "$nt" --from 0.55 --to 0.5,0
+  research ptp --config "$arm" --table "$nt" --from 0.55 --to 0.5,0
 expect ptp_nan_point "--to: 'nan,0': expected two numbers X,Z (m)" \
-  ptp --config "$arm" --table "$nt" --from 0.5,0 --to nan,0
+  research ptp --config "$arm" --table "$nt" --from 0.5,0 --to nan,0
 expect ptp_outside "--to: (3.000, 0.000) m is outside the workspace of MHSB three-link arm (paper 001)" \
-  ptp --config "$arm" --table "$nt" --from 0.55,-0.05 --to 3,0
+  research ptp --config "$arm" --table "$nt" --from 0.55,-0.05 --to 3,0
 expect ptp_bad_weights "--weights: '1,x,2': expected three numbers w1,w2,w3" \
-  ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --weights 1,x,2
+  research ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --weights 1,x,2
 expect ptp_negative_weight "--weights: '1,-1,2': negative" \
-  ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --weights 1,-1,2
+  research ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --weights 1,-1,2
 expect ptp_no_circuit "--energy-model: K70M forestry loader (reference crane) has no MHSB circuit" \
-  ptp --table "$nt" --from 4,1 --to 7,4 --energy-model paper
+  research ptp --table "$nt" --from 4,1 --to 7,4 --energy-model paper
 expect ptp_bad_velocity "--velocity-limit: unit 'bar' is not a velocity unit" \
-  ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --velocity-limit "3 bar"
+  research ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --velocity-limit "3 bar"
 expect ptp_bad_grid "--grid: must be between 5 mm and 5 m" \
-  ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --grid "1 mm"
+  research ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --grid "1 mm"
 expect ptp_grid_too_fine "--grid: 10 mm gives up to 2.3e+06 grid cells for K70M forestry loader (reference crane) (reach 7.58 m): its table would take hours; at most 1e+06 cells, 16 mm or coarser" \
-  ptp --table "$nt" --from 4,1 --to 7,4 --grid "1 cm"
+  research ptp --table "$nt" --from 4,1 --to 7,4 --grid "1 cm"
 expect sim_goal_grid_too_fine "--goal-grid: 5 mm gives up to 9.19e+06 grid cells" \
   sim --input goal --goal 5,1 --goal-grid "5 mm" --no-telemetry
 expect ptp_bad_continuity "--continuity-tolerance: '2' is not a finite number in [0, 0.99]" \
-  ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --continuity-tolerance 2
+  research ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --continuity-tolerance 2
 expect ptp_bad_posture "--posture: 'fixed-j3': expected optimal or fixed-last:ANGLE" \
-  ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --posture fixed-j3
+  research ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --posture fixed-j3
 expect ptp_posture_nan "--posture: 'abc' is not a finite number" \
-  ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --posture fixed-last:abc
+  research ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --posture fixed-last:abc
 expect ptp_posture_range "--posture: MHSB three-link arm (paper 001): 130.0 deg is outside J3's range" \
-  ptp --config "$arm" --from 0.5,0 --to 0.6,0 --posture fixed-last:130
+  research ptp --config "$arm" --from 0.5,0 --to 0.6,0 --posture fixed-last:130
 expect ptp_posture_prismatic "--posture: K70M forestry loader (reference crane): the last moving joint (extension) is not revolute" \
-  ptp --from 4,1 --to 7,4 --posture fixed-last:10
+  research ptp --from 4,1 --to 7,4 --posture fixed-last:10
 [ "$failed" -eq 0 ] && echo "bad input files OK"
 exit "$failed"

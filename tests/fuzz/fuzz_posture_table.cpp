@@ -1,6 +1,6 @@
 // Posture table files of the point-to-point planner (planner::PostureTable::read, the cache file
-// of `craneassist ptp` and `sim --input goal`, docs/mhsb.md#s1-the-optimal-posture-table): a
-// damaged or foreign file is refused (nullopt, never an exception or a crash), and a table that
+// of `craneassist research ptp` and `sim --input goal`, docs/mhsb.md#s1-the-optimal-posture-table):
+// a damaged or foreign file is refused (nullopt, never an exception or a crash), and a table that
 // is read keeps what the planner relies on: each node on its own cell, postures within the joint
 // ranges with the tip on the node, finite non-negative areas; the planner builds its graph on it
 // and plans between two of its nodes.

@@ -1,8 +1,8 @@
 // Tool-path files of the mobile crane (input::parse_tool_path, docs/mobile.md#tool-path-files):
 // any bytes are rejected with a FileError naming the file, or give via points that keep the
 // rules; the composite Bezier path through them and the platform's offset path are finite
-// everywhere, and the check `craneassist follow` runs before it moves (cusp, steering limit)
-// gives a finite verdict.
+// everywhere, and the check `craneassist research follow` runs before it moves (cusp, steering
+// limit) gives a finite verdict.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -10,7 +10,7 @@
 #include <string_view>
 
 #include "craneassist/input/tool_path_file.hpp"
-#include "craneassist/scaling/planar_path.hpp"
+#include "craneassist/paths/planar_path.hpp"
 #include "fuzz_check.hpp"
 
 using craneassist::input::FileError;
@@ -41,11 +41,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FUZZ_CHECK(i == 0 || file.lines[i] > file.lines[i - 1], "lines increase");
   }
 
-  const craneassist::scaling::CompositeBezierPath path(via);
+  const craneassist::paths::CompositeBezierPath path(via);
   FUZZ_CHECK(path.segments() == static_cast<int>(via.size()) - 1, "a segment between via points");
   FUZZ_CHECK(std::isfinite(path.length_m()) && path.length_m() > 0.0, "a finite, positive length");
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  craneassist::scaling::CompositeBezierPath::Point point;
+  craneassist::paths::CompositeBezierPath::Point point;
   for (double s : {0.0, 0.125, 0.5, 0.999, 1.0, -1.0, 2.0, nan}) {
     path.evaluate(s, point);
     FUZZ_CHECK(point.p.allFinite() && point.d1.allFinite() && point.d2.allFinite(),
@@ -60,7 +60,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   // What `follow` checks before it moves, on both sides of the path.
   for (double offset : {4.5, -4.5}) {
-    const auto check = craneassist::scaling::check_offset_path(path, offset, 400);
+    const auto check = craneassist::paths::check_offset_path(path, offset, 400);
     FUZZ_CHECK(!std::isinf(check.min_v_prime_m), "the lowest v' is finite or NaN");
     FUZZ_CHECK(std::isfinite(check.max_curvature_1_m) && check.max_curvature_1_m >= 0.0,
                "the sharpest turn is finite");

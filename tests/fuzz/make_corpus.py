@@ -57,7 +57,7 @@ write("fuzz_joint_trajectory", "six_joints.csv",
       ",".join(f"qddot_{i}" for i in range(1, 7)) + "\n0" + ",0" * 18 + "\n2" + ",1" * 18 + "\n")
 write("fuzz_joint_trajectory", "bad_trajectory.csv", read("tests/data/bad_trajectory.csv"))
 
-# Tool paths of the crane on wheels (craneassist follow).
+# Tool paths of the crane on wheels (craneassist research follow).
 write("fuzz_tool_path", "mobile_s_curve.csv", read("examples/paths/mobile_s_curve.csv"))
 write("fuzz_tool_path", "edge_two_points.csv", "x,y\n0,0\n0.01,0\n")
 write("fuzz_tool_path", "edge_crlf_bom_turn.csv",

@@ -75,6 +75,9 @@ LoopSummary run_control_loop(CycleTask& task, valves::MachineInterface& machine,
   CycleTime time;
 
   machine.read(state);
+  bool polytope = options.log != nullptr;
+  for (const CycleObserver* o : options.observers) polytope = polytope || o->reads_polytope();
+  task.set_polytope(polytope);
   task.start(state, machine.command_period_s());
   summary.realtime_result = apply_realtime_setup(options.realtime_setup);
   const timespec wall_start = monotonic_now();

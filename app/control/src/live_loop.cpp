@@ -22,6 +22,7 @@ class RecordingObserver final : public CycleObserver {
     record_.clear();
     record_.reserve(capacity);
   }
+  bool reads_polytope() const noexcept override { return false; }
   void on_cycle(const CycleRecord& c) noexcept override {
     if (c.stop_cause != nullptr) return;
     last_t_s_ = c.time.t_s;
@@ -57,6 +58,7 @@ class StatusObserver final : public CycleObserver {
  public:
   StatusObserver(LiveStatusBoard& board, const MonitoredInput& input)
       : board_(board), input_(input) {}
+  bool reads_polytope() const noexcept override { return false; }
   void on_cycle(const CycleRecord& c) noexcept override {
     const LogRow& r = c.row;
     status_.t = c.time.t_s;

@@ -12,7 +12,7 @@
 //
 // Why not Qhull (libqhull-dev): it allocates through its own memory manager and reports errors
 // by longjmp, neither of which the control cycle may do; for the point counts here a focused
-// implementation is small, and tests/test_flow_polytope.cpp checks it against brute force.
+// implementation is small, and tests/dynamics/test_flow_polytope.cpp checks it against brute force.
 //
 // A point set of lower dimension (all points on a plane, a line, or one point) has volume 0: the
 // 3-D hull then gives the polygon in that plane (its area), or the two ends of the segment.

@@ -73,7 +73,7 @@ class RigidBodyTerms {
   //
   // Cost: 2 ODE steps whatever sdot is (compute() takes n + 1 + 2 n (n - 1) = 29 for the K70M);
   // about 9 us on the K70M. Exact up to rounding: no finite differences, about 1e-13 relative
-  // against recursive Newton-Euler (tests/test_path_dynamics.cpp).
+  // against recursive Newton-Euler (tests/dynamics/test_path_dynamics.cpp).
   //
   // Method: inverse dynamics with ODE velocity motors. Every joint gets a motor with unlimited
   // force (dParamFMax = dInfinity, motor CFM = 0) and target rate dParamVel = dt a_j. From rest

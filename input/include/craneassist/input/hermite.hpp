@@ -1,6 +1,6 @@
 // Cubic Hermite interpolation between two samples of a position and its rate: position and rate
 // both continuous from one interval to the next. Used where a sampled plan is followed between its
-// samples (input::GoalSource's tip plan, offline::simulate_ptp's joint plan).
+// samples (input::GoalSource's tip plan, studies::simulate_ptp's joint plan).
 #pragma once
 
 namespace craneassist::input {

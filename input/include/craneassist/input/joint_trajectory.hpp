@@ -1,6 +1,6 @@
 // Joint trajectories: a planned motion as joint positions, rates and accelerations over time
-// (what `craneassist plan` writes and `craneassist replay --trajectory` executes). CSV in the
-// style of the replay format; specified in docs/trajectory-format.md.
+// (what `craneassist research plan` writes and `craneassist replay --trajectory` executes). CSV in
+// the style of the replay format; specified in docs/trajectory-format.md.
 #pragma once
 
 #include <Eigen/Core>
@@ -70,7 +70,7 @@ class JointTrajectory {
   void sample(double t_s, Eigen::Ref<Eigen::VectorXd> q, Eigen::Ref<Eigen::VectorXd> qdot) const;
 
   // Whether the samples carry modes (the file's optional mode_1..mode_n columns), and joint j's
-  // (0-based) mode at sample i: 0 N, 1 DB, 2 SB (dynamics::MhsbMode's order).
+  // (0-based) mode at sample i: 0 N, 1 DB, 2 SB (mhsb::MhsbMode's order).
   bool has_modes() const { return !modes_.empty(); }
   int mode(std::size_t i, int j) const {
     return modes_[i * static_cast<std::size_t>(joints_) + static_cast<std::size_t>(j)];

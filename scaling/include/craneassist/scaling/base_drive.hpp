@@ -13,9 +13,12 @@
 #pragma once
 
 #include "craneassist/dynamics/mobile_base.hpp"
-#include "craneassist/scaling/base_path_follower.hpp"
 
 namespace craneassist::scaling {
+
+// What set the forward speed (here and in the studies' path follower).
+enum class BaseLimit { kFlow, kMotorSpeed, kTrackingError, kEnd };
+const char* to_string(BaseLimit limit);  // "flow", "motor_speed", "tracking_error", "end"
 
 struct BaseDriveOutput {
   double v_m_s = 0.0, omega_rad_s = 0.0;  // the command

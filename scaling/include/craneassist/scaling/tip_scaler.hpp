@@ -34,8 +34,8 @@
 
 #include "craneassist/dynamics/path_terms.hpp"
 #include "craneassist/scaling/path_constraints.hpp"
-#include "craneassist/scaling/path_scaler.hpp"
 #include "craneassist/scaling/scaling_filter.hpp"
+#include "craneassist/scaling/speed_caps.hpp"
 #include "craneassist/scaling/sway_shaper.hpp"
 
 namespace craneassist::dynamics {

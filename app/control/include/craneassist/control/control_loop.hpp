@@ -1,8 +1,8 @@
 // The one fixed-rate control loop of craneassist. Every run of the product goes through it:
 // replay, live `sim`, trajectory execution, the 2R experiment and the valve calibration. Two
 // studies of the papers run their own loops on their own simulators and do not: `follow` (paper
-// 003's base and crane, app/offline/mobile_follow) and `ptp --simulate` (paper 001's MHSB arm,
-// app/offline/ptp_simulation on sim_backend's MHSB simulator). Each cycle:
+// 003's base and crane, research/studies/mobile_follow) and `ptp --simulate` (paper 001's MHSB arm,
+// research/studies/ptp_simulation on sim_backend's MHSB simulator). Each cycle:
 //
 //   read the machine -> the cycle task (command source + controller) -> write the valves
 //   -> the CSV log and the observers -> let one period pass -> pace (real time, or machine time)
@@ -69,6 +69,10 @@ class CycleTask {
   // takes). The loop then ends the run as at LoopOptions::max_cycles. Tasks that run for a given
   // time never finish.
   virtual bool finished() const noexcept { return false; }
+  // Before start(): whether the run's log or an observer reads the flow manipulability
+  // polytope's figures of the row (the controller computes them only then; PolytopeProbe).
+  // May allocate.
+  virtual void set_polytope(bool on) { (void)on; }
 };
 
 // One finished cycle, as the observers see it (after the valves are written).
@@ -91,6 +95,10 @@ class CycleObserver {
  public:
   virtual ~CycleObserver() = default;
   virtual void on_cycle(const CycleRecord& cycle) noexcept = 0;
+  // Whether it reads the polytope's figures of the row (avail_speed_m_s, polytope_*): the
+  // controller computes them only for a run with a log or an observer that does. Unless it
+  // says otherwise, an observer does.
+  virtual bool reads_polytope() const noexcept { return true; }
   // After the last cycle, with the machine read once more (its integrated energy).
   virtual void on_finish(const CycleTime& last, const valves::MachineState& state) {
     (void)last;

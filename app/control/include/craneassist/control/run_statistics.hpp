@@ -143,6 +143,7 @@ struct RunSummary {
 class RunStatistics final : public CycleObserver {
  public:
   RunStatistics(double period_s, const RunStatisticsOptions& options = {});
+  bool reads_polytope() const noexcept override { return false; }
   void on_cycle(const CycleRecord& cycle) noexcept override;
   void on_finish(const CycleTime& last, const valves::MachineState& state) override;
 

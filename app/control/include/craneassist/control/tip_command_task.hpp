@@ -134,6 +134,7 @@ class TipCommandTask final : public CycleTask {
   CycleStatus step(const CycleTime& time, const valves::MachineState& state, const char* stop_cause,
                    valves::ValveCommand& command, LogRow& row) noexcept override;
   const ControllerOutput* controller_output() const noexcept override { return &out_; }
+  void set_polytope(bool on) override { controller_.set_polytope(on); }
   bool finished() const noexcept override { return input_.finished(next_cycle_); }
 
   double period_s() const noexcept { return controller_.period_s(); }

@@ -1,5 +1,5 @@
-// Executes a planned joint trajectory (input::JointTrajectory, from `craneassist plan`) on a
-// machine: the joint reference is sampled every control period and followed with the valves'
+// Executes a planned joint trajectory (input::JointTrajectory, from `craneassist research plan`) on
+// a machine: the joint reference is sampled every control period and followed with the valves'
 // reference follower (dead-zone inverse feed-forward plus P feedback), without path scaling: the
 // plan already respects the cylinder limits. Because the plan is known in advance, the reference
 // is previewed by the valve delay plus the spool time constant, so the machine, which lags its

@@ -49,7 +49,7 @@ struct CalibrationOptions {
   double settled_tolerance = 0.01;
   // On a machine the window is judged with this tolerance instead: at a steady speed the
   // halves of a window measured over CAN differ by up to 3 % (the encoders' resolution, the
-  // bus's and the machine's timing; tests/test_calibration_can.cpp), and a level found not
+  // bus's and the machine's timing; tests/offline/test_calibration_can.cpp), and a level found not
   // settled is measured again, from mid-stroke, up to machine_retries times.
   double machine_settled_tolerance = 0.03;
   int machine_retries = 2;
