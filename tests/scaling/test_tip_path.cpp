@@ -1,4 +1,4 @@
-// scaling::TipPath on its own (test_tip_motion.cpp runs it with the TipScaler): on the K70M,
+// scaling::TipPath on its own (test_tip_scaler.cpp runs it with the TipScaler): on the K70M,
 // for every resolution and directions all round, f' moves the tip exactly along u, f'' is the
 // derivative of f' along the path, a joint at an end is never driven into it (or the direction is
 // held at zero speed), and from the edge of the workspace moving back is not limited.

@@ -8,17 +8,8 @@
 namespace craneassist::control {
 namespace {
 
-// The rated capacity limiter's thresholds on the load-moment ratio (docs/loads.md).
-constexpr double kOverloadWarning = 0.9;
-constexpr double kOverloadTrip = 1.0;
-constexpr double kOverloadRelease = 0.95;
 // A chamber at this share of the load-holding valves' setting is at their port relief.
 constexpr double kReliefShare = 0.99;
-
-// A tip's horizontal distance from the slew axis (crane frame: y up), the load chart's reach.
-double reach_of(const Eigen::Vector3d& tip) {
-  return std::hypot(tip.x(), tip.z());
-}
 
 }  // namespace
 
@@ -91,7 +82,7 @@ void Controller::update_load(const valves::MachineState& state, ControllerOutput
   const auto& est = estimator_->update(state_ok, state.q, state.qdot, state.chamber_pressures,
                                        state.pressure_a_pa, state.pressure_b_pa);
   if (state_ok) {
-    load.reach_m = reach_of(dynamics::tip_position(model_, kin_, state.q));
+    load.reach_m = horizontal_reach_m(dynamics::tip_position(model_, kin_, state.q));
   }
   load.rated_kg = chart_.empty() ? 0.0 : chart_.rated_kg_at(load.reach_m);
   load.weighed = std::isfinite(est.sigma_kg);

@@ -13,9 +13,6 @@ namespace {
 
 // Overloaded, a motion whose radial share (d reach / d path) is above this raises the moment.
 constexpr double kOutwardShare = 0.02;
-// The limiter trips at 100 % of the chart and releases below 95 % (docs/loads.md).
-constexpr double kOverloadTrip = 1.0;
-constexpr double kOverloadRelease = 0.95;
 // The dynamics' payload follows the scale in steps of this (kg).
 constexpr double kPayloadModelStepKg = 0.5;
 
@@ -143,7 +140,7 @@ void PathScalingStage::update_sway(const TipStageInput& in, ControllerOutput& ou
 bool PathScalingStage::refuse_outward(const Eigen::Vector3d& command, const Eigen::Vector3d& u,
                                       const LoadOutput& load) noexcept {
   const Eigen::Vector3d tip = dynamics::tip_position(model_, kin_, q_ref_);
-  const double reach = std::hypot(tip.x(), tip.z());
+  const double reach = horizontal_reach_m(tip);
   const double outwards = reach > 0.0 ? (tip.x() * u.x() + tip.z() * u.z()) / reach : 0.0;
   const bool out_bound = outwards > kOutwardShare && command.norm() > 0.0;
   const double stop = scaling::braking_distance(scaler_.speed(), std::max(scaler_out_.sddot, 0.0),

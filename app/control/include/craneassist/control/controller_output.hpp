@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cmath>
 #include <optional>
 #include <string_view>
 
@@ -49,6 +50,16 @@ enum class StopEnd {
   kTimeout,     // still moving control.rest_timeout after the reference came to rest
   kUnmeasured,  // no valid measurement: the reference at rest is all there is
 };
+
+// The rated capacity limiter's thresholds on the load-moment ratio (docs/loads.md): a warning at
+// 90 %, the trip at 100 %, released below 95 %; and a load's reach, its horizontal distance from
+// the slew axis (crane frame: y up), as the load chart reads it.
+inline constexpr double kOverloadWarning = 0.9;
+inline constexpr double kOverloadTrip = 1.0;
+inline constexpr double kOverloadRelease = 0.95;
+inline double horizontal_reach_m(const Eigen::Vector3d& tip) {
+  return std::hypot(tip.x(), tip.z());
+}
 
 // The load in the grapple as the controller sees it (docs/loads.md).
 struct LoadOutput {

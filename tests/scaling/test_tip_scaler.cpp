@@ -1,4 +1,4 @@
-// The tip motion of the controller at the reference level (scaling::TipPath and TipScaler, a
+// scaling::TipScaler, the tip motion of the controller at the reference level (with TipPath, a
 // machine that follows perfectly): velocity changes along the straight segment to the command,
 // reversals at rest on the line, jerk-limited stops, no slow-down for a joint end while the
 // others carry on, and every singular pose of the K70M approached smoothly, with every cylinder
