@@ -1,18 +1,17 @@
 #!/usr/bin/env bash
-# Regenerates docs/img/mobile_follow.png and the figures of docs/mobile.md: the crane on wheels
-# on the example tool path in the paper's two cases, with one pump for the drive and the crane
-# (the plot and the first table) and with the crane on its own pump (the second table). Build
-# first (cmake --build build). Needs python3-matplotlib.
+# Regenerates the figures and tables of docs/mobile.md: the crane on wheels on the example tool
+# path in paper 003's two cases, on the paper's machine (drive and crane on separate circuits:
+# docs/img/mobile_follow.png and the first table), with a sluggish arm (the measured cause of the
+# difference to the paper's figure 6: the second table) and with one pump for the drive and the
+# crane, craneassist's own addition (docs/img/mobile_follow_shared.png and the third table).
+# Build first (cmake --build build). Needs python3-matplotlib.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=build/app/craneassist
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-path=examples/paths/mobile_s_curve.csv
-for pump in shared separate; do
-  echo "== --pump $pump"
-  $bin research follow $path --pump $pump --no-error-scaling --log "$out/case1_$pump.csv"
-  $bin research follow $path --pump $pump --log "$out/case2_$pump.csv"
-done
-/usr/bin/python3 tools/plot_mobile.py "$out/case1_shared.csv" "$out/case2_shared.csv" \
+/usr/bin/python3 tools/mobile_cases.py "$bin" "$out" --doc docs/mobile.md
+/usr/bin/python3 tools/plot_mobile.py "$out/separate_case1.csv" "$out/separate_case2.csv" \
   docs/img/mobile_follow.png
+/usr/bin/python3 tools/plot_mobile.py "$out/shared_case1.csv" "$out/shared_case2.csv" \
+  docs/img/mobile_follow_shared.png
