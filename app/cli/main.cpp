@@ -85,6 +85,7 @@ int main(int argc, char** argv) {
   // Where the studies were before: a hidden command that says where they are now (exit 2).
   for (CLI::App* study : research->get_subcommands([](CLI::App*) { return true; })) {
     CLI::App* moved = cli.add_subcommand(study->get_name(), "")->group("");
+    moved->set_help_flag();  // --help too says where the study is now
     moved->allow_extras()->prefix_command();
     const std::string name = study->get_name();
     commands.push_back({moved, [name] {
