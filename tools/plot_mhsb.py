@@ -400,11 +400,18 @@ def verdict_table(work):
         oo = [c for c, _, o in sorted(four, key=lambda x: x[2])]
         rows.append(f"| Case 4: the energy order of the three postures | {' < '.join(po)} | "
                     f"{' < '.join(oo)} | | {direction(po == oo)} |")
-    pg, og = f("4.2", "paper_max_error_deg"), f("4.2", "sim_max_error_deg")
-    if None not in (pg, og):
-        rows.append(f"| Section 4.2: the largest joint error with a moving goal | {pg:.2f} deg | "
-                    f"{og:.2f} deg | {og / pg:.2f} | {within(og / pg)} (the paper's controller "
-                    "gains and servo parameters are not all used) |")
+    for case, cond in (("4.2", "Table 1's P0 and assumed valves and pumps"),
+                       ("4.2-t3", "Table 3's pump, servo-valve and micro-pump")):
+        pg, og = f(case, "paper_max_error_deg"), f(case, "sim_max_error_deg")
+        if None not in (pg, og):
+            rows.append(f"| Section 4.2, {cond}: the largest joint error with a moving goal | "
+                        f"{pg:.2f} deg | {og:.2f} deg | {og / pg:.2f} | {within(og / pg)} (the "
+                        "paper's controller gains are not given) |")
+        op = f(case, "sim_max_p_supply_mpa")
+        if op is not None:
+            rows.append(f"| Section 4.2, {cond}: the highest supply pressure (the paper: J1's "
+                        f"P1 at about 3.4 s) | 9.8 MPa | {op:.1f} MPa | {op / 9.8:.2f} | "
+                        f"{within(op / 9.8)} |")
     return "\n".join(rows) + "\n"
 
 
