@@ -162,6 +162,18 @@ def p0_config(work, p0_mpa):
     return path
 
 
+def leakage_config(work, leak_lpm):
+    """The arm's config with another servo-valve leakage (the assumed 0.25 L/min's effect)."""
+    with open(CONFIG) as f:
+        text = f.read()
+    text, n = re.subn(r"leakage: 0\.25 L/min, assumed", f"leakage: {leak_lpm} L/min, assumed", text)
+    assert n == 1, "the config's leakage line changed"
+    path = os.path.join(work, f"mhsb_3link_leak_{leak_lpm}.yaml")
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
 def table3_config(work):
     """The arm's config with paper 001's Table 3 (the specifications of its section 4
     simulation): the main pump at 5.5 MPa, the servo-valve rated 6.9 L/min, the micro-pump's
@@ -230,6 +242,12 @@ def main():
         for p0, paper in ((2.5, 1054), (10, 1011)):
             r.ptp(f"5-p0-{p0:g}", "5p", f"P0 {p0:g} MPa on Case 1-1", CASE1, W11,
                   config=p0_config(args.work, p0), simulate=sim, paper=(None, paper, None))
+        for leak in (0.05, 0):
+            cfg = leakage_config(args.work, leak)
+            r.ptp(f"5-leak{leak:g}-1", "5l", f"leakage {leak:g} L/min, Case 1-1", CASE1, W11,
+                  config=cfg, simulate=sim, paper=(7.96, 532, 552))
+            r.ptp(f"5-leak{leak:g}-2", "5l", f"leakage {leak:g} L/min, Case 1-2", CASE1, W12,
+                  config=cfg, simulate=sim, paper=(6.74, 698, None))
         print("Section 4.2: the moving goal")
         r.ptp("4.2", "goal", "moving goal (switches at 3 and 6 s)", ((0.7, 0.5), (0.6, 0.2)), W11,
               simulate=True, paper_error=2.43,

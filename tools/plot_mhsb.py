@@ -319,7 +319,7 @@ def markdown_table(work):
             "energy, tip path | ours simulated: energy (against planned), largest joint error |",
             "| --- | --- | --- | --- | --- |"]
     for r in work.results.values():
-        if r["group"] not in ("1", "2", "3", "4", "5p", "goal"):
+        if r["group"] not in ("1", "2", "3", "4", "5p", "5l", "goal"):
             continue
         paper = ", ".join(x for x in (f"{r['paper_time_s']} s" if r["paper_time_s"] else "",
                                       f"{r['paper_energy_j']} J" if r["paper_energy_j"] else "",
@@ -382,6 +382,17 @@ def verdict_table(work):
         rows.append(f"| Case 1: the energy-optimal plan is the detour (the longer tip path) | "
                     f"longer | {l11:.3f} m against {l12:.3f} m | | "
                     f"{direction(l11 > l12)} |")
+    for leak in ("0.05", "0"):
+        a, b = f"5-leak{leak}-1", f"5-leak{leak}-2"
+        ea, eb, la, lb = energy(a), energy(b), f(a, "length_m"), f(b, "length_m")
+        if None in (ea, eb, la, lb, p11, p12):
+            continue
+        ps, os_ = (p12 - p11) / p12, (eb - ea) / eb
+        rows.append(f"| Case 1 with a servo-valve leakage of {leak} L/min (0.25 assumed): saving, "
+                    f"detour | 23.8 %, longer | {100 * os_:.1f} %, {la:.3f} m against {lb:.3f} m | "
+                    f"{os_ / ps:.2f} | saving "
+                    f"{'within 5 points' if abs(ps - os_) <= 0.05 else 'not reproduced'}, detour "
+                    f"{direction(la > lb)} |")
     p25, o25 = f("5-p0-2.5", "paper_energy_j"), energy("5-p0-2.5")
     if None not in (p25, o25, p11, o11):
         err = f("5-p0-2.5", "sim_max_error_deg")
