@@ -162,13 +162,20 @@ def p0_config(work, p0_mpa):
     return path
 
 
-def leakage_config(work, leak_lpm):
-    """The arm's config with another servo-valve leakage (the assumed 0.25 L/min's effect)."""
+def leakage_config(work, leak_lpm, p0_mpa=None):
+    """The arm's config with another servo-valve leakage (the assumed 0.25 L/min's effect), and
+    another main-pump pressure when p0_mpa is given."""
     with open(CONFIG) as f:
         text = f.read()
     text, n = re.subn(r"leakage: 0\.25 L/min, assumed", f"leakage: {leak_lpm} L/min, assumed", text)
     assert n == 1, "the config's leakage line changed"
-    path = os.path.join(work, f"mhsb_3link_leak_{leak_lpm}.yaml")
+    name = f"mhsb_3link_leak_{leak_lpm}"
+    if p0_mpa is not None:
+        text, n = re.subn(r"supply_pressure: 4\.0 MPa, paper", f"supply_pressure: {p0_mpa} MPa, paper",
+                          text)
+        assert n == 1, "the config's supply_pressure line changed"
+        name += f"_p0_{p0_mpa}"
+    path = os.path.join(work, f"{name}.yaml")
     with open(path, "w") as f:
         f.write(text)
     return path
@@ -248,6 +255,9 @@ def main():
                   config=cfg, simulate=sim, paper=(7.96, 532, 552))
             r.ptp(f"5-leak{leak:g}-2", "5l", f"leakage {leak:g} L/min, Case 1-2", CASE1, W12,
                   config=cfg, simulate=sim, paper=(6.74, 698, None))
+        for p0, paper in ((2.5, 1054), (10, 1011)):
+            r.ptp(f"5-leak0-p0-{p0:g}", "5l", f"leakage 0, P0 {p0:g} MPa on Case 1-1", CASE1, W11,
+                  config=leakage_config(args.work, 0, p0), simulate=sim, paper=(None, paper, None))
         print("Section 4.2: the moving goal")
         r.ptp("4.2", "goal", "moving goal (switches at 3 and 6 s)", ((0.7, 0.5), (0.6, 0.2)), W11,
               simulate=True, paper_error=2.43,

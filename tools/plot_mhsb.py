@@ -354,7 +354,8 @@ def verdict_table(work):
         return "within 10 %, conditions differ" if abs(ratio - 1.0) <= 0.10 else \
             f"off by {100.0 * (ratio - 1.0):+.0f} %"
 
-    for case in ("1-1", "1-2", "2-2", "3-1", "3-2", "4-1", "4-2", "4-3", "5-p0-2.5", "5-p0-10"):
+    for case in ("1-1", "1-2", "2-2", "3-1", "3-2", "4-1", "4-2", "4-3", "5-p0-2.5", "5-p0-10",
+                 "5-leak0-p0-2.5", "5-leak0-p0-10"):
         pe, oe = f(case, "paper_energy_j"), energy(case)
         if pe is None or oe is None:
             continue
