@@ -10,10 +10,17 @@
 namespace craneassist::test {
 
 inline std::atomic<long> g_heap_allocations{0};
+// The same, counted per thread: what a code path allocates on the thread that runs it, whatever
+// the other threads of the program (an observer's writer thread, a server's I/O thread) do.
+inline thread_local long t_heap_allocations = 0;
 
 // Heap allocations through operator new since the program started.
 inline long heap_allocations() {
   return g_heap_allocations.load(std::memory_order_relaxed);
+}
+// Heap allocations through operator new on this thread since it started.
+inline long heap_allocations_on_this_thread() {
+  return t_heap_allocations;
 }
 
 }  // namespace craneassist::test
@@ -22,6 +29,7 @@ inline long heap_allocations() {
 // and warns (-Wmismatched-new-delete).
 [[gnu::noinline]] void* operator new(std::size_t size) {
   craneassist::test::g_heap_allocations.fetch_add(1, std::memory_order_relaxed);
+  ++craneassist::test::t_heap_allocations;
   if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
   throw std::bad_alloc();
 }
