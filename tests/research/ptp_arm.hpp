@@ -41,5 +41,4 @@ inline const planner::PostureTable& small_table() {
   return t;
 }
 
-
 }  // namespace craneassist::test

@@ -243,4 +243,3 @@ TEST(JointTrajectoryModes, RoundTripAndErrors) {
 }
 
 }  // namespace
-
