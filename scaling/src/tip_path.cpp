@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "craneassist/dynamics/cylinders.hpp"
+#include "craneassist/dynamics/hydraulics.hpp"
 #include "craneassist/scaling/scaling_filter.hpp"
 
 namespace craneassist::scaling {
@@ -93,14 +94,14 @@ void TipPath::resolve(const JointVector& q, const Eigen::Vector3d& u, const Shap
     problem_.dc_dq = &arms_;
     problem_.cylinder_force = &force_;  // this update's copy of the forces (update())
     problem_.position = bounds_;
-    const double keep = 1.0 - config_.flow_reserve;
     for (int i = 0; i < n; ++i) {
       const auto& cyl = model_.cylinders[static_cast<std::size_t>(i)];
-      const double rate = keep * cyl.v_max_m_s / std::max(std::abs(arms_[i]), 1e-12) / sigma;
+      const double rate = dynamics::cylinder_speed_cap_m_s(cyl, config_.flow_reserve) /
+                          std::max(std::abs(arms_[i]), 1e-12) / sigma;
       problem_.hydraulic.upper[i] = rate;
       problem_.hydraulic.lower[i] = -rate;
     }
-    problem_.flow_limit_m2 = keep * model_.pump.max_flow_m3_s / sigma;
+    problem_.flow_limit_m2 = dynamics::flow_budget_m3_s(model_, config_.flow_reserve) / sigma;
     // Hand-over bounds: a joint moving towards an end slows down no faster than the others can
     // take its motion over through the null space (n_k / n_i of it each) within a share of their
     // accelerations, ending kHandoverMargin of its range before the end.

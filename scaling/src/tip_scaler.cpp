@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "craneassist/dynamics/hydraulics.hpp"
+
 namespace craneassist::scaling {
 namespace {
 
@@ -138,8 +140,8 @@ double TipScaler::cylinder_speed_ahead(const PathGeometry& g, double speed,
     for (int i = 0; i < model_.dof(); ++i) {
       const double rate = g.f1[i];
       if (!(rate * g.f2[i] > 0.0)) continue;  // not growing along the path
-      const double v_max =
-          (1.0 - config_.flow_reserve) * model_.cylinders[static_cast<std::size_t>(i)].v_max_m_s;
+      const double v_max = dynamics::cylinder_speed_cap_m_s(
+          model_.cylinders[static_cast<std::size_t>(i)], config_.flow_reserve);
       cap =
           std::min(cap, v_max / (std::abs(g.dc_dq[i]) * (std::abs(rate) + std::abs(g.f2[i]) * x)));
     }

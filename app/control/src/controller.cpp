@@ -45,7 +45,6 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
   rest_confirm_cycles_ = std::max(
       1L, std::lround((model_.valves.delay_s + model_.valves.time_constant_s) / period_s_));
   rest_arms_.setZero(n);
-  q_resolved_ = stage_->q_ref();
   chart_ = config.load_chart;
   known_payload_kg_ = dynamics::payload_mass_kg(model_);
   dynamics::PayloadEstimatorSettings scale;
@@ -134,7 +133,8 @@ ControllerStatus Controller::update(const valves::MachineState& state, const Eig
 
   update_load(state, out);
   const Eigen::Vector3d command = command_ok ? v_cmd : Eigen::Vector3d::Zero();
-  q_resolved_ = stage_->q_ref();  // the stage resolves here, then integrates its reference
+  // The stage resolves at its reference, then integrates it; the polytope is of where it resolved.
+  if (polytope_) q_resolved_ = stage_->q_ref();
   const TipStageInput stage_in{.command = command,
                                .stale = stale,
                                .state = &state,

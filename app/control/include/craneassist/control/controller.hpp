@@ -81,8 +81,8 @@ class Controller {
   std::unique_ptr<PolytopeProbe> polytope_;  // null while nothing reads it
   // Per-cycle working data (Pinocchio's Data), preallocated.
   dynamics::KinematicsData kin_;
-  JointVector q_resolved_;
-  bool neutral_ = false;  // the last update returned kStopped (valves neutral)
+  JointVector q_resolved_;  // where the stage resolved this cycle (for the polytope only)
+  bool neutral_ = false;    // the last update returned kStopped (valves neutral)
   double rest_speed_m_s_ = 0.005;
   double hold_error_m_ = 0.0;
   long rest_timeout_cycles_ = 0, rest_confirm_cycles_ = 1;
