@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates paper 001's results on our MHSB arm (docs/mhsb.md#the-papers-results-reproduced):
+# Regenerates paper 001's results on our MHSB arm (docs/mhsb.md#the-papers-results-compared):
 # runs every case of the paper with `craneassist research ptp` (planned, and on the MHSB simulator), writes
 # docs/data/mhsb_cases.csv, the figures docs/img/mhsb_*.png and the table in docs/mhsb.md made
 # from that file. Build first (cmake --build build);

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Runs paper 001's cases (its Table 2, sections 3.1-3.4 and 4.2) with `craneassist ptp` on the
 MHSB three-link arm and writes one row per run to a CSV (docs/data/mhsb_cases.csv), the table of
-docs/mhsb.md#the-papers-results-reproduced, plus each run's files (trajectory, S2 path, simulator
+docs/mhsb.md#the-papers-results-compared, plus each run's files (trajectory, S2 path, simulator
 log) in a work directory for tools/plot_mhsb.py. Run through tools/make_mhsb_figures.sh.
 
 Every figure comes from the binary's output; the paper's own figures, for the side-by-side
@@ -9,6 +9,7 @@ columns, are those printed in its text (paper_* columns, empty where it gives no
 """
 import argparse
 import csv
+import math
 import os
 import re
 import subprocess
@@ -29,10 +30,9 @@ CASE4 = ((0.5, -0.15), (0.65, 0.45))
 W11 = (0.5, 0, 2)
 W12 = (0, 15, 2)
 
-# The conventional method's held J3 (the paper's [18], Cases 4-2 and 4-3: 70 and 130 deg). Our
-# optimal table has J3 at +61 deg at Case 4's start, so the sign convention seems the same; 130 deg
-# is beyond our assumed range (+-120 deg), so 4-3 holds J3 at that limit.
-CASE4_J3_DEG = (70.0, 120.0)
+# The conventional method's held J3 (the paper's [18], Cases 4-2 and 4-3: 70 and 130 deg; our
+# optimal table has J3 positive at Case 4's start, as the paper's).
+CASE4_J3_DEG = (70.0, 130.0)
 
 FIELDS = [
     "case", "group", "description", "from_x_m", "from_z_m", "to_x_m", "to_z_m", "w1", "w2", "w3",
@@ -149,57 +149,75 @@ class Runner:
                 w.writerow(r)
 
 
+def variant_config(work, name, substitutions):
+    """A copy of the arm's config in WORK with each (old line text, new text) substituted once
+    (the sensitivity runs: another P0, leakage, torque arms or Table 3's specifications)."""
+    with open(CONFIG) as f:
+        text = f.read()
+    for old, new in substitutions:
+        text, n = re.subn(re.escape(old), lambda _m: new, text)
+        assert n == 1, f"the config's '{old}' line changed"
+    path = os.path.join(work, f"mhsb_3link_{name}.yaml")
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
+P0_LINE = "supply_pressure: 4.0 MPa, paper"
+LEAK_LINE = "leakage: 0.015 L/min, derived"
+
+
 def p0_config(work, p0_mpa):
-    """The arm's config with another main-pump pressure (section 3.4)."""
-    with open(CONFIG) as f:
-        text = f.read()
-    text, n = re.subn(r"supply_pressure: 4\.0 MPa, paper", f"supply_pressure: {p0_mpa} MPa, paper  # "
-                      "section 3.4's variation", text)
-    assert n == 1, "the config's supply_pressure line changed"
-    path = os.path.join(work, f"mhsb_3link_p0_{p0_mpa}.yaml")
-    with open(path, "w") as f:
-        f.write(text)
-    return path
+    """Section 3.4's variation of the main-pump pressure."""
+    return variant_config(work, f"p0_{p0_mpa:g}", [(P0_LINE, f"supply_pressure: {p0_mpa} MPa, paper")])
 
 
-def leakage_config(work, leak_lpm, p0_mpa=None):
-    """The arm's config with another servo-valve leakage (the assumed 0.25 L/min's effect), and
-    another main-pump pressure when p0_mpa is given."""
-    with open(CONFIG) as f:
-        text = f.read()
-    text, n = re.subn(r"leakage: 0\.25 L/min, assumed", f"leakage: {leak_lpm} L/min, assumed", text)
-    assert n == 1, "the config's leakage line changed"
-    name = f"mhsb_3link_leak_{leak_lpm}"
-    if p0_mpa is not None:
-        text, n = re.subn(r"supply_pressure: 4\.0 MPa, paper", f"supply_pressure: {p0_mpa} MPa, paper",
-                          text)
-        assert n == 1, "the config's supply_pressure line changed"
-        name += f"_p0_{p0_mpa}"
-    path = os.path.join(work, f"{name}.yaml")
-    with open(path, "w") as f:
-        f.write(text)
-    return path
+def leakage_config(work, leak_lpm):
+    """Another servo-valve leakage than the data sheet's (what the leakage changes)."""
+    return variant_config(work, f"leak_{leak_lpm:g}", [(LEAK_LINE, f"leakage: {leak_lpm} L/min, assumed")])
 
 
 def table3_config(work):
-    """The arm's config with paper 001's Table 3 (the specifications of its section 4
-    simulation): the main pump at 5.5 MPa, the servo-valve rated 6.9 L/min, the micro-pump's
-    0.54 L/min, and the boost its servo-motor's 0.427 N m gives on the 0.18 cm^3 micro-pump
-    (2 pi T / D = 14.9 MPa; still capped by the 14 MPa relief)."""
+    """Paper 001's Table 3 (the specifications of its section 4 simulation): the main pump at
+    5.5 MPa, the micro-pump's 0.54 L/min, and the boost its servo-motor's 0.427 N m gives on the
+    0.18 cm^3 micro-pump (2 pi T / D = 14.9 MPa; still capped by the 14 MPa relief). The
+    servo-valve's 6.9 L/min is the config's own."""
+    return variant_config(work, "table3", [
+        (P0_LINE, "supply_pressure: 5.5 MPa, paper  # Table 3"),
+        ("servo_pump_max_flow: 0.2415 L/min, derived",
+         "servo_pump_max_flow: 0.54 L/min, paper  # Table 3 (micro-pump)"),
+        ("max_boost: 10 MPa, assumed", "max_boost: 14.9 MPa, derived  # Table 3: 2 pi 0.427 N m / 0.18 cm^3")])
+
+
+def linkage_config(work, beta):
+    """The paper's joints are driven through four-bar linkages whose dimensions it does not give;
+    the config has a constant torque arm r0 per joint. This copy gives each joint a torque arm
+    that varies over its range as a linkage's does, r(q) = r0 (1 - beta ((q - qc) / h)^2) (qc the
+    range's middle, h its half-width; beta 0.5: the arm falls to half at both ends, -0.5: it
+    grows by half), the cylinder length its integral (a cubic, the config's polynomial linkage)
+    and the stroke what the range needs."""
     with open(CONFIG) as f:
         text = f.read()
-    for old, new in (("supply_pressure: 4.0 MPa, paper", "supply_pressure: 5.5 MPa, paper  # Table 3"),
-                     ("rated_flow: 2 L/min, assumed", "rated_flow: 6.9 L/min, paper  # Table 3"),
-                     ("servo_pump_max_flow: 0.2415 L/min, derived",
-                      "servo_pump_max_flow: 0.54 L/min, paper  # Table 3 (micro-pump)"),
-                     ("max_boost: 10 MPa, assumed",
-                      "max_boost: 14.9 MPa, derived  # Table 3: 2 pi 0.427 N m / 0.18 cm^3")):
-        text, n = re.subn(re.escape(old), new, text)
-        assert n == 1, f"the config's '{old}' line changed"
-    path = os.path.join(work, "mhsb_3link_table3.yaml")
-    with open(path, "w") as f:
-        f.write(text)
-    return path
+    subs = []
+    for block in text.split("\n  - name: ")[1:]:
+        if "linkage: constant_arm" not in block:
+            continue  # a body, or a joint without a constant arm
+        m = re.search(r"(linkage: constant_arm\n\s+arm: ([\d.]+) mm[^\n]*\n\s+"
+                      r"length_at_zero: ([\d.]+) mm[^\n]*)", block)
+        q_min = math.radians(float(re.search(r"min: (-?[\d.]+) deg", block)[1]))
+        q_max = math.radians(float(re.search(r"max: (-?[\d.]+) deg", block)[1]))
+        r0, c0 = float(m[2]) / 1000.0, float(m[3]) / 1000.0
+        qc, h = (q_min + q_max) / 2.0, (q_max - q_min) / 2.0
+        k = r0 * beta / (3.0 * h * h)
+        coeffs = [-k, 3.0 * k * qc, r0 - 3.0 * k * qc * qc, c0 + k * qc ** 3]
+        lengths = [sum(a * q ** (3 - i) for i, a in enumerate(coeffs))
+                   for q in (q_min + (q_max - q_min) * s / 64.0 for s in range(65))]
+        indent = re.search(r"\n(\s+)arm:", m[1])[1]
+        subs.append((m[1], f"linkage: polynomial\n{indent}coefficients: "
+                     f"{' '.join('%.9g' % a for a in coeffs)} m, assumed  # beta {beta:g}"))
+        stroke = re.search(r"stroke: [\d.]+ mm, assumed[^\n]*", block)[0]
+        subs.append((stroke, f"stroke: {(max(lengths) - min(lengths)) * 1000.0 + 0.5:.1f} mm, assumed"))
+    return variant_config(work, f"linkage_{beta:g}", subs)
 
 
 def main():
@@ -225,16 +243,26 @@ def main():
               ["--energy-model", "paper"], simulate=sim, paper=(6.74, 698, None))
         print("Cases 2 and 3: unloading, full range")
         r.ptp("2-1", "2", "unloading", CASE2_1, W11, simulate=sim)
-        r.ptp("2-2", "2", "unloading, far", CASE2_2, W11, simulate=sim, paper=(8.0, 589, 576))
-        r.ptp("3-1", "3", "full range", CASE3_1, W11, simulate=sim, paper=(13.0, 989, None))
-        r.ptp("3-2", "3", "full range, outwards", CASE3_2, W11, simulate=sim,
-              paper=(9.02, 1059, None))
+        for suffix, options, what in (("", [], ""),
+                                      ("-paper", ["--energy-model", "paper"], ", paper's eq. 9")):
+            r.ptp("2-2" + suffix, "2", "unloading, far" + what, CASE2_2, W11, options,
+                  simulate=sim, paper=(8.0, 589, 576))
+            r.ptp("3-1" + suffix, "3", "full range" + what, CASE3_1, W11, options, simulate=sim,
+                  paper=(13.0, 989, None))
+            r.ptp("3-2" + suffix, "3", "full range, outwards" + what, CASE3_2, W11, options,
+                  simulate=sim, paper=(9.02, 1059, None))
     print("Case 4: the optimal posture table against the conventional fixed-J3 method")
-    r.ptp("4-1", "4", "proposed (posture table)", CASE4, W11, simulate=sim, paper=(None, 593, None))
-    j3s = CASE4_J3_DEG[:1] if args.quick else CASE4_J3_DEG
-    for i, (j3, paper) in enumerate(zip(j3s, (501, 742))):
-        r.ptp(f"4-{i + 2}", "4", f"fixed J3 {j3:g} deg (paper: {(70, 130)[i]} deg)", CASE4, W11,
-              ["--posture", f"fixed-last:{j3:g}"], simulate=sim, paper=(None, paper, None))
+    for suffix, model, what in (("", [], ""), ("-paper", ["--energy-model", "paper"],
+                                                 ", paper's eq. 9")):
+        if suffix and args.quick:
+            break
+        r.ptp("4-1" + suffix, "4", "proposed (posture table)" + what, CASE4, W11, model,
+              simulate=sim, paper=(None, 593, None))
+        j3s = CASE4_J3_DEG[:1] if args.quick else CASE4_J3_DEG
+        for i, (j3, paper) in enumerate(zip(j3s, (501, 742))):
+            r.ptp(f"4-{i + 2}" + suffix, "4", f"fixed J3 {j3:g} deg" + what, CASE4, W11,
+                  ["--posture", f"fixed-last:{j3:g}", *model], simulate=sim,
+                  paper=(None, paper, None))
     if not args.quick:
         print("Case 5: weights, V_L, w3, P0")
         for w1 in (0, 0.01, 0.1):
@@ -247,23 +275,30 @@ def main():
         for w3 in range(0, 21, 2):
             r.ptp(f"5-w3-{w3}", "5s", "w3 sweep on Case 1-2", CASE1, (0, 15, w3), files=False)
         for p0, paper in ((2.5, 1054), (10, 1011)):
+            cfg = p0_config(args.work, p0)
             r.ptp(f"5-p0-{p0:g}", "5p", f"P0 {p0:g} MPa on Case 1-1", CASE1, W11,
-                  config=p0_config(args.work, p0), simulate=sim, paper=(None, paper, None))
-        for leak in (0.05, 0):
+                  config=cfg, simulate=sim, paper=(None, paper, None))
+            r.ptp(f"5-p0-{p0:g}-paper", "5p", f"P0 {p0:g} MPa on Case 1-1, paper's eq. 9", CASE1,
+                  W11, ["--energy-model", "paper"], config=cfg, simulate=sim,
+                  paper=(None, paper, None))
+        for leak in (0, 0.25):
             cfg = leakage_config(args.work, leak)
             r.ptp(f"5-leak{leak:g}-1", "5l", f"leakage {leak:g} L/min, Case 1-1", CASE1, W11,
                   config=cfg, simulate=sim, paper=(7.96, 532, 552))
             r.ptp(f"5-leak{leak:g}-2", "5l", f"leakage {leak:g} L/min, Case 1-2", CASE1, W12,
                   config=cfg, simulate=sim, paper=(6.74, 698, None))
-        for p0, paper in ((2.5, 1054), (10, 1011)):
-            r.ptp(f"5-leak0-p0-{p0:g}", "5l", f"leakage 0, P0 {p0:g} MPa on Case 1-1", CASE1, W11,
-                  config=leakage_config(args.work, 0, p0), simulate=sim, paper=(None, paper, None))
+        for beta in (0.5, -0.5):
+            cfg = linkage_config(args.work, beta)
+            r.ptp(f"5-arm{beta:g}-1", "5a", f"torque arm beta {beta:g}, Case 1-1", CASE1, W11,
+                  config=cfg, simulate=sim, paper=(7.96, 532, 552))
+            r.ptp(f"5-arm{beta:g}-2", "5a", f"torque arm beta {beta:g}, Case 1-2", CASE1, W12,
+                  config=cfg, simulate=sim, paper=(6.74, 698, None))
         print("Section 4.2: the moving goal")
-        r.ptp("4.2", "goal", "moving goal (switches at 3 and 6 s)", ((0.7, 0.5), (0.6, 0.2)), W11,
+        r.ptp("4.2", "goal", "moving goal, Table 1's P0 and Table 2's servo-pump flow", ((0.7, 0.5), (0.6, 0.2)), W11,
               simulate=True, paper_error=2.43,
               extra=["--goal-at", "3:0.8,0.2", "--goal-at", "6:0.6,0.5", "--sim-log",
                      os.path.join(args.work, "4.2.sim.csv")])
-        r.ptp("4.2-t3", "goal", "moving goal, Table 3's pumps and servo-valve",
+        r.ptp("4.2-t3", "goal", "moving goal, Table 3 (the paper's section 4 setup)",
               ((0.7, 0.5), (0.6, 0.2)), W11, config=table3_config(args.work), simulate=True,
               paper_error=2.43,
               extra=["--goal-at", "3:0.8,0.2", "--goal-at", "6:0.6,0.5", "--sim-log",

@@ -140,8 +140,8 @@ expect ptp_bad_posture "--posture: 'fixed-j3': expected optimal or fixed-last:AN
   research ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --posture fixed-j3
 expect ptp_posture_nan "--posture: 'abc' is not a finite number" \
   research ptp --config "$arm" --table "$nt" --from 0.5,0 --to 0.6,0 --posture fixed-last:abc
-expect ptp_posture_range "--posture: MHSB three-link arm (paper 001): 130.0 deg is outside J3's range" \
-  research ptp --config "$arm" --from 0.5,0 --to 0.6,0 --posture fixed-last:130
+expect ptp_posture_range "--posture: MHSB three-link arm (paper 001): 140.0 deg is outside J3's range" \
+  research ptp --config "$arm" --from 0.5,0 --to 0.6,0 --posture fixed-last:140
 expect ptp_posture_prismatic "--posture: K70M forestry loader (reference crane): the last moving joint (extension) is not revolute" \
   research ptp --from 4,1 --to 7,4 --posture fixed-last:10
 [ "$failed" -eq 0 ] && echo "bad input files OK"

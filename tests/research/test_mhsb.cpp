@@ -53,7 +53,7 @@ TEST(MhsbConfig, ErrorsNameTheField) {
   EXPECT_GT(e.line(), 0);
   e = error_after_edit("servo_pump_efficiency: 0.56", "servo_pump_efficiency: 1.5");
   EXPECT_EQ(e.field(), "hydraulics.mhsb.servo_pump_efficiency");
-  e = error_after_edit("leakage: 0.25 L/min", "leakage: 0.25 MPa");
+  e = error_after_edit("leakage: 0.015 L/min", "leakage: 0.015 MPa");
   EXPECT_EQ(e.field(), "hydraulics.mhsb.servo_valve.leakage");
   e = error_after_edit("    velocity_limit:", "    velocity_limt:");
   EXPECT_EQ(e.field(), "hydraulics.mhsb.velocity_limt");

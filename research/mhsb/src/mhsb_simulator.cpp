@@ -249,10 +249,11 @@ struct MhsbSimulator::Impl {
         x_ff = a2 * v_ref / (k_valve * std::sqrt(std::max(ps - p_b[j], dp_min)));
       }
       const double ef = f_ref - f;
-      int_force[j] = std::clamp(int_force[j] + c.force_ki_1_n_s * ef * dt, -c.force_integral_limit,
-                                c.force_integral_limit);
-      spool_cmd[j] =
-          std::clamp(c.flow_feedforward * x_ff + c.force_kp_1_n * ef + int_force[j], -1.0, 1.0);
+      const double gain_scale = c.force_gain_rated_flow_m3_s / mhsb.valve.rated_flow_m3_s;
+      int_force[j] = std::clamp(int_force[j] + gain_scale * c.force_ki_1_n_s * ef * dt,
+                                -c.force_integral_limit, c.force_integral_limit);
+      spool_cmd[j] = std::clamp(
+          c.flow_feedforward * x_ff + gain_scale * c.force_kp_1_n * ef + int_force[j], -1.0, 1.0);
 
       // Servo-pump loop: pressure target from the gravity load.
       double p_target = 0.0;
@@ -264,7 +265,8 @@ struct MhsbSimulator::Impl {
         // gravity load presses on.
         double v = v_ref / c.pressure_target_opening;
         if (v_ref == 0.0) v = f_g >= 0.0 ? 0.0 : -1e-12;
-        p_target = mhsb::required_supply_pressure_pa(cyl, mhsb.valve, pt, f_g, v);
+        const double f_p = c.pressure_target_from_force_ref ? f_ref : f_g;
+        p_target = mhsb::required_supply_pressure_pa(cyl, mhsb.valve, pt, f_p, v);
         p_target += c.pressure_target_margin_pa;
         const double w_total_max = sp * w_max;
         const double ep = p_target - ps;

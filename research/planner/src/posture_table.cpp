@@ -176,6 +176,34 @@ bool solve_with_last_fixed(const PlanarArm& arm, dynamics::KinematicsData& data,
   return true;
 }
 
+// The polytope area is not smooth (its vertices change), and SLSQP can stop at a kink. A pattern
+// search along the arm's self-motion (the last joint stepped, the others solved onto the node)
+// from a, steps from 8 degrees down to 1/16 degree; a and its area updated when it finds more.
+void polish_along_last(const PlanarArm& arm, PolytopeArea& area, dynamics::KinematicsData& data,
+                       const mhsb::ModePattern& pattern, const Eigen::Vector2d& target,
+                       ArmVector& a, double& best) {
+  const int last = arm.moving() - 1;
+  ArmVector b = a;
+  for (double step = 8.0 * M_PI / 180.0; step > M_PI / 180.0 / 16.0; step *= 0.5) {
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (const double dir : {1.0, -1.0}) {
+        const double q = a[last] + dir * step;
+        if (q < arm.lower(last) || q > arm.upper(last)) continue;
+        b = a;
+        if (!solve_with_last_fixed(arm, data, target, q, b)) continue;
+        const double s = area(b, pattern);
+        if (s > best * (1.0 + 1e-9)) {
+          a = b;
+          best = s;
+          moved = true;
+          break;
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 
 int WorkspaceGrid::node_at(int ix, int iz) const {
@@ -456,6 +484,17 @@ PostureTable PostureTable::build(const PlanarArm& arm, const PostureTableSetting
             converged = true;
             found.push_back({a, s});
             best_area = std::max(best_area, s);
+          }
+          // The best found, polished along the self-motion (one more candidate when it gains).
+          const auto best = std::max_element(
+              found.begin(), found.end(),
+              [](const Candidate& l, const Candidate& r) { return l.area < r.area; });
+          ArmVector a = best->a;
+          double s = best->area;
+          polish_along_last(arm, area, data, full[at(p)], target, a, s);
+          if (s > best_area) {
+            found.push_back({a, s});
+            best_area = s;
           }
           return std::pair{converged, best_area};
         };
@@ -812,7 +851,7 @@ std::optional<PostureTable> PostureTable::read(std::istream& in, const PlanarArm
 std::uint64_t posture_table_fingerprint(const PlanarArm& arm,
                                         const PostureTableSettings& settings) {
   Fingerprint f;
-  f.add(3);  // the table's own version: bump when the build changes
+  f.add(4);  // the table's own version: bump when the build changes
   const auto& m = arm.model();
   for (const auto& j : m.joints) {
     f.add(static_cast<int>(j.type));

@@ -74,9 +74,12 @@ struct MhsbControllerSettings {
   double position_ki_n_m_s = 1e5;             // N per m s
   double position_kd_n_s_m = 5e3;             // N per m/s (damping; see the docs)
   double position_integral_limit_n = 2000.0;  // |ki int(e)| at most
-  // Force loop: spool = flow feedforward + kp (f_ref - f) + ki int(f_ref - f).
+  // Force loop: spool = flow feedforward + kp (f_ref - f) + ki int(f_ref - f), kp and ki scaled
+  // by force_gain_rated_flow_m3_s / the valve's rated flow, so that the loop's flow per newton of
+  // error is the same for any valve size (the gains were tuned on a 2 L/min valve).
   double force_kp_1_n = 1e-4;
   double force_ki_1_n_s = 2e-3;
+  double force_gain_rated_flow_m3_s = 2.0 / 60000.0;
   double force_integral_limit = 0.5;  // spool fraction
   double flow_feedforward = 1.0;      // 0: none; 1: the opening that passes v_ref at the drop
   // Servo-pump loop: speed = flow feedforward + kp (P_ref - p_s) + ki int(P_ref - p_s), per
@@ -86,6 +89,7 @@ struct MhsbControllerSettings {
   double pump_ki_rad_s2_pa = 2e-3;
   double pressure_target_opening = 0.8;
   double pressure_target_margin_pa = 0.1e6;
+  bool pressure_target_from_force_ref = true;
 };
 
 struct MhsbSettings {
