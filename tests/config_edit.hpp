@@ -7,6 +7,8 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "craneassist/config/config_error.hpp"
 #include "craneassist/config/crane_config.hpp"
@@ -19,15 +21,22 @@ inline std::string read_text_file(const std::string& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-// The file's text with the first occurrence of `from` replaced by `to` (a failure when `from` is
-// not there).
+// The file's text with, in order, the first occurrence of each edit's `from` replaced by its
+// `to` (a failure when a `from` is not there).
+inline std::string edited_text(const std::string& path,
+                               const std::vector<std::pair<std::string, std::string>>& edits) {
+  std::string text = read_text_file(path);
+  for (const auto& [from, to] : edits) {
+    const auto pos = text.find(from);
+    EXPECT_NE(pos, std::string::npos) << from;
+    if (pos != std::string::npos) text.replace(pos, from.size(), to);
+  }
+  return text;
+}
+
 inline std::string edited_text(const std::string& path, const std::string& from,
                                const std::string& to) {
-  std::string text = read_text_file(path);
-  const auto pos = text.find(from);
-  EXPECT_NE(pos, std::string::npos) << from;
-  if (pos != std::string::npos) text.replace(pos, from.size(), to);
-  return text;
+  return edited_text(path, {{from, to}});
 }
 
 // The error parsing the edited file throws (a failure when it parses), as "edited.yaml".

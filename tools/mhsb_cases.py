@@ -29,6 +29,9 @@ CASE3_2 = ((0.55, -0.7), (0.75, 0.55))
 CASE4 = ((0.5, -0.15), (0.65, 0.45))
 W11 = (0.5, 0, 2)
 W12 = (0, 15, 2)
+# Each case planned with the series circuit's energy (ptp's default) and with the paper's eq. 9
+# as printed (the "-paper" rows: the paper's own figures are its planner's): suffix, options, words.
+ENERGY_MODELS = (("", [], ""), ("-paper", ["--energy-model", "paper"], ", paper's eq. 9"))
 
 # The conventional method's held J3 (the paper's [18], Cases 4-2 and 4-3: 70 and 130 deg; our
 # optimal table has J3 positive at Case 4's start, as the paper's).
@@ -243,8 +246,7 @@ def main():
               ["--energy-model", "paper"], simulate=sim, paper=(6.74, 698, None))
         print("Cases 2 and 3: unloading, full range")
         r.ptp("2-1", "2", "unloading", CASE2_1, W11, simulate=sim)
-        for suffix, options, what in (("", [], ""),
-                                      ("-paper", ["--energy-model", "paper"], ", paper's eq. 9")):
+        for suffix, options, what in ENERGY_MODELS:
             r.ptp("2-2" + suffix, "2", "unloading, far" + what, CASE2_2, W11, options,
                   simulate=sim, paper=(8.0, 589, 576))
             r.ptp("3-1" + suffix, "3", "full range" + what, CASE3_1, W11, options, simulate=sim,
@@ -252,8 +254,7 @@ def main():
             r.ptp("3-2" + suffix, "3", "full range, outwards" + what, CASE3_2, W11, options,
                   simulate=sim, paper=(9.02, 1059, None))
     print("Case 4: the optimal posture table against the conventional fixed-J3 method")
-    for suffix, model, what in (("", [], ""), ("-paper", ["--energy-model", "paper"],
-                                                 ", paper's eq. 9")):
+    for suffix, model, what in ENERGY_MODELS:
         if suffix and args.quick:
             break
         r.ptp("4-1" + suffix, "4", "proposed (posture table)" + what, CASE4, W11, model,
@@ -294,8 +295,8 @@ def main():
             r.ptp(f"5-arm{beta:g}-2", "5a", f"torque arm beta {beta:g}, Case 1-2", CASE1, W12,
                   config=cfg, simulate=sim, paper=(6.74, 698, None))
         print("Section 4.2: the moving goal")
-        r.ptp("4.2", "goal", "moving goal, Table 1's P0 and Table 2's servo-pump flow", ((0.7, 0.5), (0.6, 0.2)), W11,
-              simulate=True, paper_error=2.43,
+        r.ptp("4.2", "goal", "moving goal, Table 1's P0 and Table 2's servo-pump flow",
+              ((0.7, 0.5), (0.6, 0.2)), W11, simulate=True, paper_error=2.43,
               extra=["--goal-at", "3:0.8,0.2", "--goal-at", "6:0.6,0.5", "--sim-log",
                      os.path.join(args.work, "4.2.sim.csv")])
         r.ptp("4.2-t3", "goal", "moving goal, Table 3 (the paper's section 4 setup)",

@@ -11,9 +11,7 @@
 #include <iostream>
 #include <numbers>
 #include <sstream>
-#include <stdexcept>
 #include <string>
-#include <utility>
 
 #include "config_edit.hpp"
 #include "craneassist/config/crane_config.hpp"
@@ -36,18 +34,13 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 // The shipped arm with J2 on both elbows: these tests hold postures with J2 negative (the
 // shipped config keeps one elbow for the posture table, docs/mhsb.md).
 const dynamics::CraneModel& arm_model() {
-  static const dynamics::CraneModel model = [] {
-    std::string text = test::read_text_file(std::string(CRANEASSIST_SOURCE_DIR) +
-                                            "/config/cranes/mhsb_3link.yaml");
-    for (const auto& [from, to] :
-         {std::pair<std::string, std::string>{"min: 0 deg, assumed", "min: -150 deg, assumed"},
-          {"stroke: 105 mm", "stroke: 210 mm"}}) {
-      const auto pos = text.find(from);
-      if (pos == std::string::npos) throw std::logic_error("mhsb_3link.yaml: no '" + from + "'");
-      text.replace(pos, from.size(), to);
-    }
-    return config::parse_crane_config(text, "mhsb_3link.yaml, both elbows").model;
-  }();
+  static const dynamics::CraneModel model =
+      config::parse_crane_config(
+          test::edited_text(std::string(CRANEASSIST_SOURCE_DIR) + "/config/cranes/mhsb_3link.yaml",
+                            {{"min: 0 deg, assumed", "min: -150 deg, assumed"},
+                             {"stroke: 105 mm", "stroke: 210 mm"}}),
+          "mhsb_3link.yaml, both elbows")
+          .model;
   return model;
 }
 

@@ -57,6 +57,7 @@ struct MhsbSimulator::Impl {
     pt = mhsb.tank_pressure_pa;
     p_relief = model.pump.max_pressure_pa;
     k_valve = mhsb.valve.rated_flow_m3_s / std::sqrt(mhsb.valve.rated_pressure_drop_pa);
+    force_gain_scale = settings.controller.force_gain_rated_flow_m3_s / mhsb.valve.rated_flow_m3_s;
     k_check = p.check_rated_flow_m3_s / std::sqrt(p.check_rated_drop_pa);
     k_relief = p.relief_rated_flow_m3_s / p.relief_override_pa;
     inv_sqrt_laminar = 1.0 / std::sqrt(p.laminar_drop_pa);
@@ -249,13 +250,13 @@ struct MhsbSimulator::Impl {
         x_ff = a2 * v_ref / (k_valve * std::sqrt(std::max(ps - p_b[j], dp_min)));
       }
       const double ef = f_ref - f;
-      const double gain_scale = c.force_gain_rated_flow_m3_s / mhsb.valve.rated_flow_m3_s;
-      int_force[j] = std::clamp(int_force[j] + gain_scale * c.force_ki_1_n_s * ef * dt,
+      int_force[j] = std::clamp(int_force[j] + force_gain_scale * c.force_ki_1_n_s * ef * dt,
                                 -c.force_integral_limit, c.force_integral_limit);
       spool_cmd[j] = std::clamp(
-          c.flow_feedforward * x_ff + gain_scale * c.force_kp_1_n * ef + int_force[j], -1.0, 1.0);
+          c.flow_feedforward * x_ff + force_gain_scale * c.force_kp_1_n * ef + int_force[j], -1.0,
+          1.0);
 
-      // Servo-pump loop: pressure target from the gravity load.
+      // Servo-pump loop: pressure target from the desired force (or the gravity load).
       double p_target = 0.0;
       double w_cmd = 0.0;
       const int sp = mhsb::modules_used(modes.mode[at(j)]);
@@ -428,6 +429,7 @@ struct MhsbSimulator::Impl {
 
   double p0 = 0.0, pt = 0.0, p_relief = 0.0;
   double k_valve = 0.0, k_check = 0.0, k_relief = 0.0, inv_sqrt_laminar = 0.0;
+  double force_gain_scale = 1.0;  // the force loop's gains for this valve size
   double check_laminar = 0.0, inv_sqrt_check = 0.0;
   int pumps = 0;
   double w_max = 0.0;

@@ -179,7 +179,7 @@ bool solve_with_last_fixed(const PlanarArm& arm, dynamics::KinematicsData& data,
 // The polytope area is not smooth (its vertices change), and SLSQP can stop at a kink. A pattern
 // search along the arm's self-motion (the last joint stepped, the others solved onto the node)
 // from a, steps from 0.14 (8 degrees; metres on a prismatic last joint, the K70M's extension)
-// halved down to 1/128 of that; a and its area updated when it finds more.
+// halved down to 1/64 of that (1/8 degree); a and its area updated when it finds more.
 void polish_along_last(const PlanarArm& arm, PolytopeArea& area, dynamics::KinematicsData& data,
                        const mhsb::ModePattern& pattern, const Eigen::Vector2d& target,
                        ArmVector& a, double& best) {
