@@ -192,13 +192,13 @@ def table3_config(work):
         ("max_boost: 10 MPa, assumed", "max_boost: 14.9 MPa, derived  # Table 3: 2 pi 0.427 N m / 0.18 cm^3")])
 
 
-def linkage_config(work, beta):
+def linkage_config(work, beta, p0_mpa=None):
     """The paper's joints are driven through four-bar linkages whose dimensions it does not give;
     the config has a constant torque arm r0 per joint. This copy gives each joint a torque arm
     that varies over its range as a linkage's does, r(q) = r0 (1 - beta ((q - qc) / h)^2) (qc the
     range's middle, h its half-width; beta 0.5: the arm falls to half at both ends, -0.5: it
     grows by half), the cylinder length its integral (a cubic, the config's polynomial linkage)
-    and the stroke what the range needs."""
+    and the stroke what the range needs; with P0_MPA also another main-pump pressure."""
     with open(CONFIG) as f:
         text = f.read()
     subs = []
@@ -220,7 +220,11 @@ def linkage_config(work, beta):
                      f"{' '.join('%.9g' % a for a in coeffs)} m, assumed  # beta {beta:g}"))
         stroke = re.search(r"stroke: [\d.]+ mm, assumed[^\n]*", block)[0]
         subs.append((stroke, f"stroke: {(max(lengths) - min(lengths)) * 1000.0 + 0.5:.1f} mm, assumed"))
-    return variant_config(work, f"linkage_{beta:g}", subs)
+    name = f"linkage_{beta:g}"
+    if p0_mpa is not None:
+        subs.append((P0_LINE, f"supply_pressure: {p0_mpa} MPa, paper"))
+        name += f"_p0_{p0_mpa:g}"
+    return variant_config(work, name, subs)
 
 
 def main():
@@ -253,6 +257,9 @@ def main():
                   paper=(13.0, 989, None))
             r.ptp("3-2" + suffix, "3", "full range, outwards" + what, CASE3_2, W11, options,
                   simulate=sim, paper=(9.02, 1059, None))
+        # What eq. 9 charges the paper's 3-2 route: the quickest plan, boosted from the start.
+        r.ptp("3-2-paper-quick", "3q", "full range, outwards, shortest time, paper's eq. 9",
+              CASE3_2, W12, ["--energy-model", "paper"], files=False)
     print("Case 4: the optimal posture table against the conventional fixed-J3 method")
     for suffix, model, what in ENERGY_MODELS:
         if suffix and args.quick:
@@ -265,6 +272,12 @@ def main():
                   ["--posture", f"fixed-last:{j3:g}", *model], simulate=sim,
                   paper=(None, paper, None))
     if not args.quick:
+        # The optimal table's posture jumps (docs/mhsb.md#the-dearest-steps): the same S1 with
+        # ptp's continuity tie-break, postures within 15 % of the largest area kept near their
+        # neighbours'.
+        r.ptp("4-1-paper-cont", "4c", "proposed, continuity tie-break 0.15, paper's eq. 9", CASE4,
+              W11, ["--continuity-tolerance", "0.15", "--energy-model", "paper"],
+              paper=(None, 593, None))
         print("Case 5: weights, V_L, w3, P0")
         for w1 in (0, 0.01, 0.1):
             for w2 in (0, 1.3, 13):
@@ -294,6 +307,12 @@ def main():
                   config=cfg, simulate=sim, paper=(7.96, 532, 552))
             r.ptp(f"5-arm{beta:g}-2", "5a", f"torque arm beta {beta:g}, Case 1-2", CASE1, W12,
                   config=cfg, simulate=sim, paper=(6.74, 698, None))
+        # The main-pump trend on an arm whose torque arms grow towards the range ends (eq. 9).
+        for p0, paper in ((2.5, 1054), (4.0, 532), (10, 1011)):
+            r.ptp(f"5-arm-0.5-p0-{p0:g}-paper", "5ap",
+                  f"torque arm beta -0.5, P0 {p0:g} MPa on Case 1-1, paper's eq. 9", CASE1, W11,
+                  ["--energy-model", "paper"], config=linkage_config(args.work, -0.5, p0),
+                  files=False, paper=(None, paper, None))
         print("Section 4.2: the moving goal")
         r.ptp("4.2", "goal", "moving goal, Table 1's P0 and Table 2's servo-pump flow",
               ((0.7, 0.5), (0.6, 0.2)), W11, simulate=True, paper_error=2.43,

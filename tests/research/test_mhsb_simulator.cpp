@@ -31,14 +31,16 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-// The shipped arm with J2 on both elbows: these tests hold postures with J2 negative (the
-// shipped config keeps one elbow for the posture table, docs/mhsb.md).
+// The shipped arm with J2 and J3 on both elbows: these tests hold postures with J2 and J3
+// negative (the shipped config keeps one elbow for the posture table, docs/mhsb.md).
 const dynamics::CraneModel& arm_model() {
   static const dynamics::CraneModel model =
       config::parse_crane_config(
           test::edited_text(std::string(CRANEASSIST_SOURCE_DIR) + "/config/cranes/mhsb_3link.yaml",
                             {{"min: 0 deg, assumed", "min: -150 deg, assumed"},
-                             {"stroke: 105 mm", "stroke: 210 mm"}}),
+                             {"stroke: 105 mm", "stroke: 210 mm"},
+                             {"min: 0 deg, assumed  # one elbow, as J2", "min: -120 deg, assumed"},
+                             {"stroke: 71 mm", "stroke: 134 mm"}}),
           "mhsb_3link.yaml, both elbows")
           .model;
   return model;

@@ -193,6 +193,38 @@ TEST(PostureTable, JumpsCountEveryNeighbourPairOnce) {
   EXPECT_EQ(t.jumps(arm(), 0, 1.0), 0);  // no joint moves more than its range
 }
 
+// The shipped arm bends J2 and J3 one way (docs/mhsb.md#the-posture-table-one-elbow): the all-N
+// table's neighbouring nodes never take mirror postures. With J3 allowed to -120 degrees, J3's
+// sign flipped between dozens of neighbouring pairs (by up to 249 degrees) and Case 2-2's first
+// step moved J3 175 degrees.
+TEST(PostureTable, TheShippedArmsNeighboursNeverFlipAnElbow) {
+  planner::PostureTableSettings s;
+  s.spacing_m = 0.05;
+  s.max_patterns = 1;  // all N
+  const auto t = planner::PostureTable::build(arm(), s);
+  const auto& g = t.grid();
+  int pairs = 0;
+  double largest_deg = 0.0;
+  for (int a = 0; a < g.nodes(); ++a) {
+    for (int b = a + 1; b < g.nodes(); ++b) {
+      const auto sa = static_cast<std::size_t>(a), sb = static_cast<std::size_t>(b);
+      if (std::max(std::abs(g.node_i[sa] - g.node_i[sb]), std::abs(g.node_k[sa] - g.node_k[sb])) !=
+          1) {
+        continue;
+      }
+      ++pairs;
+      const ArmVector qa = t.posture(a, 0), qb = t.posture(b, 0);
+      for (int k = 1; k < 3; ++k) {  // the elbows J2, J3
+        EXPECT_GE(qa[k] * qb[k], -1e-6)
+            << "J" << k + 1 << " flips between nodes " << a << ", " << b;
+        largest_deg = std::max(largest_deg, std::abs(qa[k] - qb[k]) * 180.0 / M_PI);
+      }
+    }
+  }
+  EXPECT_GT(pairs, 2500);        // the whole workspace
+  EXPECT_LT(largest_deg, 90.0);  // 65 degrees measured (J3, where the area is flat)
+}
+
 // The 2R inverse kinematics of the paper's arm with J3 held at q3: both elbows, within the ranges.
 std::vector<ArmVector> fixed_j3_solutions(const Eigen::Vector2d& node, double q3) {
   const double l1 = 0.45, l2 = 0.4, l3 = 0.179;
