@@ -441,6 +441,16 @@ def verdict_table(work):
         oo = [c for c, _, o in sorted(four, key=lambda x: x[2])]
         add("Case 4: the energy order of the three postures (planned, eq. 9)", " < ".join(po), " < ".join(oo),
             None, STATED, order_verdict(po == oo, False, STATED))
+    areas = [(c, f(c + "-paper", "s2_mean_area_m2_s2"), f(c + "-paper", "s2_mean_n_area_m2_s2"))
+             for c in ("4-1", "4-2", "4-3")]
+    if all(a is not None and n is not None for _, a, n in areas):
+        largest = all(areas[0][1] > a and areas[0][2] > n for _, a, n in areas[1:])
+        add("Case 4: the optimal table's postures have the larger polytope along the path "
+            "(its Figure 9; planned, eq. 9)", "4-1 larger than 4-2 and 4-3",
+            "mean area in the modes each path uses " +
+            ", ".join(f"{a:.3f}" for _, a, _ in areas) + " m^2/s^2, all in N " +
+            ", ".join(f"{n:.3f}" for _, _, n in areas) + " (4-1, 4-2, 4-3)", None, STATED,
+            order_verdict(largest, False, STATED))
     for case, cond in (("4.2-t3", STATED), ("4.2", "goal-t1")):
         pg, og = f(case, "paper_max_error_deg"), f(case, "sim_max_error_deg")
         if None not in (pg, og):
