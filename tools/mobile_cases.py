@@ -16,6 +16,7 @@ import csv
 import math
 import os
 import re
+import statistics
 import subprocess
 import sys
 
@@ -40,15 +41,12 @@ def settled(d, tol_y=0.05, tol_phi=0.05, hold_s=5.0):
 
 
 def corr(a, b):
-    """Pearson's correlation of two equally long series (0 for fewer than two samples)."""
-    n = len(a)
-    if n < 2:
+    """Pearson's correlation of two equally long series (0 where it is undefined: fewer than two
+    samples, or one series constant)."""
+    try:
+        return statistics.correlation(a, b)
+    except statistics.StatisticsError:
         return 0.0
-    ma, mb = sum(a) / n, sum(b) / n
-    sab = sum((x - ma) * (y - mb) for x, y in zip(a, b))
-    saa = sum((x - ma) ** 2 for x in a)
-    sbb = sum((y - mb) ** 2 for y in b)
-    return sab / math.sqrt(saa * sbb) if saa > 0 and sbb > 0 else 0.0
 
 
 def measure(path):

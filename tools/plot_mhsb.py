@@ -56,7 +56,16 @@ class Work:
     def __init__(self, work, results, config):
         self.dir = work
         self.lengths = link_lengths(config)
+        with open(config) as f:
+            text = f.read()
+        self.leakage_lpm = float(re.search(r"^\s+leakage: ([\d.]+) L/min", text, re.M)[1])
+        self.p0_mpa = float(re.search(r"^\s+supply_pressure: ([\d.]+) MPa", text, re.M)[1])
         self.results = {r["case"]: r for r in read_csv(results)}
+
+    def value(self, case, key):
+        """A number of the results file, None where the run or the field is empty."""
+        v = self.results.get(case, {}).get(key, "")
+        return float(v) if v not in ("", None) else None
 
     def has(self, case, kind="traj"):
         return os.path.exists(os.path.join(self.dir, f"{case}.{kind}.csv"))
@@ -353,10 +362,7 @@ def verdict_table(work):
     "direction only" where the order or trend is the paper's and the value is not, else "not
     reproduced"."""
     r = work.results
-
-    def f(case, key):
-        v = r.get(case, {}).get(key, "")
-        return float(v) if v not in ("", None) else None
+    f = work.value
 
     def energy(case):  # ours: the simulator's metered energy, else the planned one
         return f(case, "sim_energy_j") or f(case, "energy_j")
@@ -503,22 +509,20 @@ def causes_table(work):
     """What each miss of the verdict table comes from, measured on the runs of
     tools/mhsb_cases.py (docs/mhsb.md#where-and-why-our-figures-differ)."""
     r = work.results
-
-    def f(case, key):
-        v = r.get(case, {}).get(key, "")
-        return float(v) if v not in ("", None) else None
+    f = work.value
 
     rows = ["| the miss | measured | so |", "| --- | --- | --- |"]
     e10, t10, p10 = f("5-p0-10-paper", "energy_j"), f("5-p0-10-paper", "time_s"), f(
         "5-p0-10", "paper_energy_j")
     if None not in (e10, t10, p10):
         q = (p10 - e10) / (10e6 * t10) / 3.0 * 6e4  # three valves, L/min
+        leak, p0 = work.leakage_lpm, work.p0_mpa
         rows.append(f"| every energy 38 to 60 % of the paper's | at P0 10 MPa both plans are N on "
                     f"the shortest path (the paper's words; ours {t10:.2f} s): ours {e10:.0f} J, "
                     f"the paper {p10:.0f} J; the difference over {t10:.2f} s at 10 MPa is "
                     f"{q:.2f} L/min per valve | the paper's servo-valve leaks about "
-                    f"{q / 0.015 * math.sqrt(4 / 10):.0f} times the data sheet's 0.015 L/min "
-                    "(at 4 MPa, by the orifice law) |")
+                    f"{q / leak * math.sqrt(p0 / 10):.0f} times the data sheet's {leak:g} L/min "
+                    f"(at {p0:g} MPa, by the orifice law) |")
     a9, aS, la9, laS = (f("1-2-paper", "energy_j"), f("1-2", "energy_j"), f("1-2-paper", "length_m"),
                         f("1-2", "length_m"))
     b9, bS = f("1-1-paper", "energy_j"), f("1-1", "energy_j")
@@ -543,7 +547,8 @@ def causes_table(work):
                     "prefers; the paper's arm (its linkages) has none cheaper |")
     c41, c42, c43, cc = (f("4-1-paper", "energy_j"), f("4-2-paper", "energy_j"),
                          f("4-3-paper", "energy_j"), f("4-1-paper-cont", "energy_j"))
-    if None not in (c41, c42, c43, cc) and work.has("4-1-paper", "path"):
+    p41, p43 = f("4-1", "paper_energy_j"), f("4-3", "paper_energy_j")
+    if None not in (c41, c42, c43, cc, p41, p43) and work.has("4-1-paper", "path"):
         step, a, b, pattern, sdt, de, joint, move = dearest_step(work.path("4-1-paper"))
         order = " < ".join(c for c, _ in sorted((("4-1", cc), ("4-2", c42), ("4-3", c43)),
                                                 key=lambda x: x[1]))
@@ -553,16 +558,18 @@ def causes_table(work):
                     f"({100 * de / c41:.0f} % of the plan); with the continuity tie-break 0.15 "
                     f"4-1 costs {cc:.0f} J: {order} | the optimal table's posture jump; the "
                     "paper's order holds without it, by "
-                    f"{100 * (c43 - cc) / cc:.0f} % where the paper's differ by 25 % |")
+                    f"{100 * (c43 - cc) / cc:.0f} % where the paper's differ by "
+                    f"{100 * (p43 - p41) / p41:.0f} % |")
     arm = [f(f"5-arm-0.5-p0-{p:g}-paper", "energy_j") for p in (2.5, 4.0, 10)]
     own = [f("5-p0-2.5-paper", "energy_j"), f("1-1-paper", "energy_j"), f("5-p0-10-paper", "energy_j")]
-    if None not in arm + own:
+    p25, p11 = f("5-p0-2.5", "paper_energy_j"), f("1-1", "paper_energy_j")
+    if None not in arm + own + [p25, p11]:
         rows.append(f"| the main-pump trend (2.5 MPa dearer than 4 MPa) | Case 1-1 by eq. 9 at "
                     f"2.5, 4 and 10 MPa: {own[0]:.0f}, {own[1]:.0f} and {own[2]:.0f} J on the "
                     f"config's constant torque arms; {arm[0]:.0f}, {arm[1]:.0f} and {arm[2]:.0f} J "
                     f"with arms growing by half to the range ends (beta -0.5) | the trend follows "
                     "the unstated linkages: the paper's direction with beta -0.5 "
-                    f"({pct(arm[0], arm[1])} at 2.5 MPa; the paper +98 %) |")
+                    f"({pct(arm[0], arm[1])} at 2.5 MPa; the paper {pct(p25, p11)}) |")
     log = os.path.join(work.dir, "4.2-t3.sim.csv")
     og = f("4.2-t3", "sim_max_error_deg")
     if os.path.exists(log) and og is not None:
@@ -587,7 +594,8 @@ def causes_table(work):
                 f"{float(sim[k]['j1_force_ref_n']):.0f} N) | J1 stays in N after its load outgrows "
                 f"P0 (the plan switches {float(sim[switch]['t_s']) - float(sim[stop[0]]['t_s']):.1f} s "
                 "later): the lag is the plan's mode timing at "
-                "P0 5.5 MPa; the controller's gains are not given, so the error's size is ours |")
+                f"P0 {float(sim[0]['p_main_pa']) / 1e6:.1f} MPa; the controller's gains are not "
+                "given, so the error's size is ours |")
     return "\n".join(rows) + "\n"
 
 
