@@ -21,8 +21,9 @@ class FoxgloveServerHandle {
   FoxgloveServerHandle(const FoxgloveServerHandle&) = delete;
   FoxgloveServerHandle& operator=(const FoxgloveServerHandle&) = delete;
 
-  // Listens on `address` ([HOST:]PORT, checked by the option); sim_time: the run is not real
-  // time. Logs the URL; returns kExitOk, or logs why it cannot listen and returns kExitRuntime.
+  // Listens on `address` ([HOST:]PORT, checked by the option); realtime: false offers the
+  // `time` capability (a run faster than real time). Logs the URL; returns kExitOk, or logs why it
+  // cannot listen and returns kExitRuntime.
   int open(const std::string& address, const config::CraneConfig& cfg, bool base, bool realtime);
   control::CycleObserver* observer();
   // Waits (logging it) until a client subscribes, at most timeout_s.

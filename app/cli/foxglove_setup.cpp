@@ -43,7 +43,6 @@ int FoxgloveOutputs::open(const FoxgloveArgs& args, const config::CraneConfig& c
       foxglove::McapRecorderOptions options;
       options.file.compression = args.mcap_compression == "none" ? foxglove::McapCompression::kNone
                                                                  : foxglove::McapCompression::kZstd;
-      options.wall_clock = realtime;
       outputs_->mcap.emplace(args.mcap_file, cfg.model, base, options);
     }
     if (!args.foxglove.empty()) {

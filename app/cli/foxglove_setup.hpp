@@ -29,9 +29,9 @@ class FoxgloveOutputs {
   FoxgloveOutputs(const FoxgloveOutputs&) = delete;
   FoxgloveOutputs& operator=(const FoxgloveOutputs&) = delete;
 
-  // Opens what the options ask for (base: the crane stands on a wheeled base; realtime: message
-  // times on the wall clock, else machine time). Returns kExitOk, or logs why (a file that cannot
-  // be written, a port in use) and returns kExitRuntime.
+  // Opens what the options ask for (base: the crane stands on a wheeled base; realtime: the live
+  // server follows the wall clock, else it offers the `time` capability). Returns kExitOk, or logs
+  // why (a file that cannot be written, a port in use) and returns kExitRuntime.
   int open(const FoxgloveArgs& args, const config::CraneConfig& cfg, bool base, bool realtime);
   // Appends the loop observers (none when nothing was asked for).
   void add_observers(std::vector<control::CycleObserver*>& observers);

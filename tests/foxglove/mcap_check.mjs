@@ -6,12 +6,15 @@
 //     (Data End) recomputed over the file;
 //   - /joint_states decoded with @foxglove/rosmsg2-serialization from the channel's own ros2msg
 //     schema, equal to the CSV's q columns cycle by cycle; the tip twists likewise;
-//   - every JSON channel validated against its JSON Schema (ajv, draft 2020-12);
+//   - every JSON channel's schema within what Foxglove-class viewers parse (viewer_schema.mjs),
+//     and every message valid against it (ajv, draft 2020-12; NaN travels as null);
 //   - with --flip: the same file with one byte flipped in a chunk must fail a CRC.
 // Usage: node mcap_check.mjs NODE_MODULES FILE.mcap LOG.csv [--flip] [--truncated]
 // (NODE_MODULES: the web page's npm packages, where the build installed these readers.)
 import { readFileSync } from "node:fs";
 import { createRequire } from "node:module";
+
+import { nanAsNull, viewerSchemaProblems } from "./viewer_schema.mjs";
 
 const [modules, file, csvFile, ...flags] = process.argv.slice(2);
 const require = createRequire(`${modules}/`);
@@ -179,13 +182,20 @@ const jsMessages = byChannel(js);
 if (!truncated && jsMessages.length !== rows.length) {
   fail(`/joint_states: ${jsMessages.length} messages, the CSV ${rows.length} rows`);
 }
+// The timeline: the wall clock when the run started plus machine time (not 1970, whether the run
+// was real time or faster): the first message within the last hour, then the CSV's t apart.
+const t0 = jsMessages.length > 0 ? jsMessages[0].logTime : 0n;
+const ageS = Date.now() / 1e3 - Number(t0) / 1e9;
+const startText = new Date(Number(t0 / 1000000n)).toISOString();
+if (!(ageS >= -5 && ageS < 3600)) fail(`the recording starts ${startText}, not at the run's wall clock`);
+console.log(`timeline starts ${startText} (${ageS.toFixed(1)} s ago)`);
 let worst = 0;
 const dof = header.filter((h) => /^q\d+$/.test(h)).length;
 jsMessages.forEach((m, k) => {
   const msg = jsReader.readMessage(m.data);
   if (msg.name.length !== msg.position.length) fail("/joint_states: names and positions differ");
-  const t = Number(m.logTime) / 1e9;
-  const rowT = Number(rows[k][col("t")]);
+  const t = Number(m.logTime - t0) / 1e9;
+  const rowT = Number(rows[k][col("t")]) - Number(rows[0][col("t")]);
   if (!truncated && Math.abs(t - rowT) > 1e-6) fail(`/joint_states ${k}: t ${t}, CSV ${rowT}`);
   for (let i = 0; i < dof; ++i) {
     const q = Number(rows[k][col(`q${i + 1}`)]);
@@ -226,12 +236,15 @@ for (const c of channels.values()) {
   if (c.messageEncoding !== "json") continue;
   const schema = schemas.get(c.schemaId);
   if (schema.encoding !== "jsonschema") fail(`${c.topic}: schema encoding ${schema.encoding}`);
-  const validate = ajv.compile(JSON.parse(new TextDecoder().decode(schema.data)));
+  const parsed = JSON.parse(new TextDecoder().decode(schema.data));
+  const problems = viewerSchemaProblems(parsed);
+  if (problems.length > 0) fail(`${c.topic}: a Foxglove-class viewer rejects its schema: ${problems}`);
+  const validate = ajv.compile(nanAsNull(parsed));
   for (const m of byChannel(c)) {
     const value = JSON.parse(new TextDecoder().decode(m.data));
     if (!validate(value)) fail(`${c.topic}: ${ajv.errorsText(validate.errors)}`);
     ++jsonChecked;
   }
 }
-console.log(`JSON channels: ${jsonChecked} messages valid against their schemas`);
+console.log(`JSON channels: schemas a viewer reads, ${jsonChecked} messages valid against them`);
 console.log(truncated ? "mcap truncated OK" : "mcap OK");

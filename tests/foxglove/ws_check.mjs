@@ -2,7 +2,8 @@
 // @foxglove/ws-protocol FoxgloveClient over the `ws` package, once with each subprotocol
 // (foxglove.websocket.v1, foxglove.sdk.v1), /joint_states decoded with
 // @foxglove/rosmsg2-serialization from the advertised ros2msg schema and checked against the CSV
-// log of the same run, the JSON channels validated against their advertised JSON Schemas (ajv).
+// log of the same run, the JSON channels' advertised JSON Schemas within what Foxglove-class viewers
+// parse (viewer_schema.mjs) and their messages valid against them (ajv; NaN travels as null).
 //
 //   node ws_check.mjs NODE_MODULES CRANEASSIST REPLAY.csv PORT OUTDIR live
 //     a real-time replay; clients reading at full speed (each subprotocol), at 100 Hz and at
@@ -13,6 +14,8 @@
 import { spawn } from "node:child_process";
 import { readFileSync } from "node:fs";
 import { createRequire } from "node:module";
+
+import { nanAsNull, viewerSchemaProblems } from "./viewer_schema.mjs";
 
 const [modules, craneassist, replay, port, outdir, mode] = process.argv.slice(2);
 const require = createRequire(`${modules}/`);
@@ -171,9 +174,20 @@ for (const c of clients) {
   const urdf = of("/robot_description");
   check(urdf.length === 1 && reader("/robot_description").readMessage(urdf[0].data).data.includes("<robot"),
         `${c.name}: /robot_description once, a URDF`);
+  if (!realtime && urdf.length > 0) {
+    // Subscribed before the first cycle (--foxglove-wait): the URDF waits for the first pose and
+    // comes with it, so a viewer never draws the crane with every joint at zero.
+    const tf = of("/tf");
+    const first = tf.length > 0 ? tf[0] : null;
+    check(first !== null && urdf[0].timestamp === first.timestamp &&
+          c.messages.indexOf(urdf[0]) < c.messages.indexOf(first),
+          `${c.name}: /robot_description comes with the first /tf (stamps ${urdf[0].timestamp}, ${first?.timestamp})`);
+  }
   let jsonOk = 0, jsonBad = "";
   for (const ch of c.channels.filter((x) => x.encoding === "json")) {
-    const validate = ajv.compile(JSON.parse(ch.schema));
+    const problems = viewerSchemaProblems(JSON.parse(ch.schema));
+    check(problems.length === 0, `${c.name}: ${ch.topic}'s schema read by a viewer ${problems}`);
+    const validate = ajv.compile(nanAsNull(JSON.parse(ch.schema)));
     for (const m of of(ch.topic)) {
       if (validate(JSON.parse(new TextDecoder().decode(m.data)))) ++jsonOk;
       else jsonBad = `${ch.topic}: ${ajv.errorsText(validate.errors)}`;
@@ -191,6 +205,12 @@ for (const c of clients) {
   if (!realtime) {
     const monotonic = c.times.every((t, i) => i === 0 || t >= c.times[i - 1]);
     check(c.times.length > 0 && monotonic, `${c.name}: ${c.times.length} time messages, machine time, in order`);
+    // Machine time on the wall clock of the run's start: not 1970, and as long as the run.
+    const first = Number(c.times[0] ?? 0n) / 1e9, last = Number(c.times[c.times.length - 1] ?? 0n) / 1e9;
+    const ageS = Date.now() / 1e3 - first;
+    const spanT = Math.max(...[...tOf.values()]) - Math.min(...[...tOf.values()]);
+    check(ageS > -5 && ageS < 600 && Math.abs(last - first - spanT) < 0.05,
+          `${c.name}: time starts at the run's wall clock (${ageS.toFixed(1)} s ago) and spans its ${spanT.toFixed(2)} s of machine time (${(last - first).toFixed(2)} s)`);
   }
 }
 check(garbageStatuses.length >= 4, `garbage client: ${garbageStatuses.length} status replies (${garbageStatuses.map((s) => s.message.slice(0, 30)).join(" | ")})`);

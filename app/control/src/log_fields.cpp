@@ -62,9 +62,12 @@ void append_value(const Field& f, const T& value, int dof, std::string& out) {
   }
 }
 
+// One string "type" per field, as Foxglove-class viewers parse JSON Schema (Foxglove, Lichtblick:
+// no type lists, no "null"). A value that is not a number (NaN, infinite) is still written as
+// null (append_number): the descriptions say so, and a viewer plots a gap there.
 template <class T>
 std::string schema_of(const Field& f, const T& value) {
-  const std::string number = R"({"type":["number","null"]})";
+  const std::string number = R"({"type":"number"})";
   std::string s;
   if constexpr (kIsArray<T>) {
     if (f.per_joint) {
@@ -90,10 +93,13 @@ std::string schema_of(const Field& f, const T& value) {
   } else if constexpr (std::is_integral_v<T>) {
     s = R"({"type":"integer")";
   } else {
-    s = R"({"type":["number","null"])";
+    s = R"({"type":"number")";
   }
   std::string description;
-  append_json_string(std::string(f.unit) + ": " + f.meaning, description);
+  append_json_string(
+      std::string(f.unit) + ": " + f.meaning +
+          (kIsArray<T> || std::is_floating_point_v<T> ? " (null: not a number)" : ""),
+      description);
   return s + ",\"description\":" + description + "}";
 }
 

@@ -10,6 +10,7 @@
 #include <future>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string_view>
 #include <thread>
@@ -119,7 +120,7 @@ struct FoxgloveServer::Impl {
   Impl(const ServerOptions& o, const dynamics::CraneModel& model)
       : options(o),
         channels(model, o.base),
-        cycles(o.ring_rows, !o.sim_time),
+        cycles(o.ring_rows),
         // Not a secret (the web view's token is): all zeros if /dev/urandom cannot be read.
         session_id(craneassist::net::random_hex(8).value_or(std::string(16, '0'))),
         acceptor(ioc),
@@ -161,6 +162,7 @@ struct FoxgloveServer::Impl {
   void on_text(FoxgloveSession& s, std::string_view text);
   void on_binary(FoxgloveSession& s);
   void status(FoxgloveSession& s, int level, const std::string& message);
+  void send_latched(FoxgloveSession& s, std::uint32_t id, std::uint64_t t_ns);
   void shutdown();
 
   ServerOptions options;
@@ -176,6 +178,11 @@ struct FoxgloveServer::Impl {
   // I/O thread only.
   std::vector<std::weak_ptr<FoxgloveSession>> sessions;
   std::vector<int> subscribers;  // per channel, over all sessions
+  // Subscriptions to the latched description made before the first cycle: it is sent with the
+  // first cycle, so a viewer never has the crane's URDF without its pose (the URDF alone draws
+  // every joint at zero).
+  std::vector<std::pair<std::weak_ptr<FoxgloveSession>, std::uint32_t>> latched_waiting;
+  std::optional<std::uint64_t> last_cycle_ns;  // the message time of the last cycle drained
   std::vector<std::uint8_t> encoded;
   Observer observer{cycles};
   // Counters (any thread reads them).
@@ -351,8 +358,13 @@ void FoxgloveServer::Impl::drain() {
   }
   sessions.resize(live);
   while (const CycleHandOver::Slot* slot = cycles.front()) {
+    const std::uint64_t t_ns = cycles.time_ns(slot->t_s);
+    last_cycle_ns = t_ns;
+    for (const auto& [weak, id] : latched_waiting) {
+      if (auto s = weak.lock()) send_latched(*s, id, t_ns);
+    }
+    latched_waiting.clear();
     if (!sessions.empty()) {
-      const std::uint64_t t_ns = cycles.time_ns(slot->t_s);
       if (options.sim_time) {
         auto m = std::make_shared<Outgoing>();
         m->bytes.push_back(kTime);
@@ -380,6 +392,14 @@ void FoxgloveServer::Impl::drain() {
     }
     cycles.pop();
   }
+}
+
+void FoxgloveServer::Impl::send_latched(FoxgloveSession& s, std::uint32_t id, std::uint64_t t_ns) {
+  const auto it = s.subscriptions.find(id);
+  if (it == s.subscriptions.end() || !channels.channels()[it->second].latched) return;  // gone
+  const std::size_t k = it->second;
+  channels.encode(k, control::LogRow{}, static_cast<std::int64_t>(t_ns), encoded);
+  s.send(message_data(id, t_ns, encoded), true);
 }
 
 void FoxgloveServer::Impl::status(FoxgloveSession& s, int level, const std::string& message) {
@@ -482,9 +502,12 @@ void FoxgloveServer::Impl::on_text(FoxgloveSession& s, std::string_view text) {
     ++subscribers[k];
     subscriptions_made.fetch_add(1);
     if (channels.channels()[k].latched) {
-      // The latched description: now, to this subscription.
-      channels.encode(k, control::LogRow{}, 0, encoded);
-      s.send(message_data(id, cycles.time_ns(0.0), encoded), true);
+      // The latched description: now, to this subscription, or with the first cycle.
+      if (last_cycle_ns) {
+        send_latched(s, id, *last_cycle_ns);
+      } else {
+        latched_waiting.emplace_back(s.shared_from_this(), id);
+      }
     }
   }
 }

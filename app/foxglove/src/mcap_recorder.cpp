@@ -11,7 +11,7 @@ McapRecorder::McapRecorder(const std::filesystem::path& path, const dynamics::Cr
     : options_(options),
       channels_(model, base),
       writer_(path, options.file),
-      cycles_(options.ring_rows, options.wall_clock) {
+      cycles_(options.ring_rows) {
   for (const Channel& c : channels_.channels()) ids_.push_back(writer_.add_channel(c));
   message_.reserve(1 << 16);
   thread_ = std::thread([this] { run(); });

@@ -25,18 +25,17 @@ class CycleHandOver {
     double t_s = 0.0;
   };
 
-  // wall_clock (a real-time run): message times on the wall clock, its reading at the first
-  // cycle plus machine time; false: machine time.
-  CycleHandOver(std::size_t capacity, bool wall_clock) : ring_(capacity), wall_clock_(wall_clock) {}
+  // Message times are the wall clock's reading at the first cycle plus machine time, in every
+  // run: a real-time run's follow the wall clock, a faster one's start when it ran and advance
+  // with machine time. Before the first cycle, machine time 0 is now.
+  explicit CycleHandOver(std::size_t capacity) : ring_(capacity), epoch_ns_(wall_clock_ns()) {}
 
   // The loop's side (its thread only).
   void push(const control::CycleRecord& cycle) noexcept {
     if (!epoch_set_) {
       epoch_set_ = true;
-      if (wall_clock_) {
-        epoch_ns_.store(wall_clock_ns() -
-                        static_cast<std::int64_t>(std::llround(cycle.time.t_s * 1e9)));
-      }
+      epoch_ns_.store(wall_clock_ns() -
+                      static_cast<std::int64_t>(std::llround(cycle.time.t_s * 1e9)));
     }
     slot_.row = cycle.row;
     slot_.t_s = cycle.time.t_s;
@@ -54,10 +53,9 @@ class CycleHandOver {
 
  private:
   control::SpscRing<Slot> ring_;
-  bool wall_clock_;
   bool epoch_set_ = false;  // loop thread only
   Slot slot_;               // loop thread only
-  std::atomic<std::int64_t> epoch_ns_{0};
+  std::atomic<std::int64_t> epoch_ns_;
   std::atomic<std::uint64_t> dropped_{0};
 };
 

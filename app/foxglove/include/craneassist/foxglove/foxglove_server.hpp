@@ -30,7 +30,7 @@ struct ServerOptions {
   std::string address = "127.0.0.1";      // loopback unless a host is given
   unsigned short port = 8765;             // Foxglove's default; 0: any free port (see port())
   bool base = false;                      // the crane stands on a wheeled base: /craneassist/base
-  bool sim_time = false;                  // not real time: the `time` capability, machine time
+  bool sim_time = false;                  // not real time: the `time` capability
   std::size_t max_queue_bytes = 1 << 20;  // per client
   std::size_t ring_rows = 1 << 10;
 };

@@ -19,9 +19,6 @@ namespace craneassist::foxglove {
 
 struct McapRecorderOptions {
   McapOptions file;
-  // true (a real-time run): message times on the wall clock (its reading at the first cycle
-  // plus machine time); false: machine time.
-  bool wall_clock = false;
   std::size_t ring_rows = 1 << 12;
 };
 
