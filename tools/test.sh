@@ -5,30 +5,59 @@
 # integer conversion checks) that also runs each libFuzzer harness briefly (label fuzz_smoke;
 # docs/fuzzing.md). Also checks the formatting and that the executable builds without DDS and
 # without the web view.
+# At its end (passed or not) it prints each stage's wall time: the budget is in docs/testing.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+# Stage times: `stage NAME` ends the stage before it and starts NAME; the table prints on exit.
+stage_names=() stage_secs=() stage_start=0 run_start=$SECONDS
+stage() {
+  if [ ${#stage_names[@]} -gt 0 ]; then stage_secs+=($((SECONDS - stage_start))); fi
+  stage_names+=("$1")
+  stage_start=$SECONDS
+}
+stage_report() {
+  local status=$?
+  [ ${#stage_names[@]} -gt 0 ] && stage_secs+=($((SECONDS - stage_start)))
+  echo "== stage times (wall clock, s)"
+  for i in "${!stage_names[@]}"; do printf '  %-52s %5d\n' "${stage_names[$i]}" "${stage_secs[$i]}"; done
+  printf '  %-52s %5d  (%s)\n' "total" $((SECONDS - run_start)) \
+    "$([ "$status" -eq 0 ] && echo passed || echo "failed, exit $status")"
+}
+trap stage_report EXIT
+
+stage "setup: packages and the VM kernel"
 tools/install-deps.sh
 tools/can-vm/prepare.sh  # Debian's stock kernel with CAN for the VM tests (cached in build/)
 jobs="$(nproc)"
+# Ninja for new build trees (an existing tree keeps the generator it was made with).
+command -v ninja >/dev/null && export CMAKE_GENERATOR=Ninja
 export CRANEASSIST_CAN_VM_REQUIRED=1  # here the VM tests must run, never be skipped
 export CRANEASSIST_WEB_REQUIRED=1     # and the browser test of the web view
 
+stage "formatting"
 echo "== formatting (clang-format)"
 find app bench config dynamics input research scaling sim_backend tests valves \( -name '*.cpp' -o -name '*.hpp' \) \
   -print0 | xargs -0 clang-format --dry-run --Werror
 
 echo "== release build and tests"
+stage "release: configure and build"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$jobs"
-ctest --test-dir build --output-on-failure -j"$jobs"
+stage "release: tests"
+ctest --test-dir build --output-on-failure -j"$jobs" -LE can_vm
+stage "release: the SocketCAN VM tests (label can_vm, one at a time)"
+ctest --test-dir build --output-on-failure -j"$jobs" -L can_vm
 
 echo "== build without DDS and the web view: the executable alone, unoptimised, and its CLI checks"
+stage "no DDS, no web view: build and CLI checks"
 cmake -S . -B build-nodds -DCMAKE_BUILD_TYPE=Debug -DCRANEASSIST_DDS=OFF -DCRANEASSIST_BUILD_BENCH=OFF \
   -DCRANEASSIST_CAN_VM_TESTS=OFF -DCRANEASSIST_WEB=OFF >/dev/null
 cmake --build build-nodds -j"$jobs" --target craneassist
 ctest --test-dir build-nodds --output-on-failure -R 'cli_sim_without_dds|cli_sim_without_web|cli_replay_initial|cli_sim_bad_input'
 
 echo "== clang AddressSanitizer + UndefinedBehaviorSanitizer build, tests and fuzz smoke runs"
+stage "clang ASan+UBSan: configure and build"
 cmake -S . -B build-clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCRANEASSIST_FUZZ=ON -DCRANEASSIST_BUILD_BENCH=OFF >/dev/null
 cmake --build build-clang -j"$jobs"
@@ -39,6 +68,7 @@ cmake --build build-clang -j"$jobs"
 # The fuzz soak runs (label fuzz_soak, minutes each) are left to `ctest -L fuzz_soak`; the papers'
 # offline studies (label research: planners, MHSB arm, mobile base; minutes under ASan) ran in
 # the release suite above.
+stage "clang ASan+UBSan: tests and fuzz smoke"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:new_delete_type_mismatch=0 \
   LSAN_OPTIONS="suppressions=$PWD/tests/lsan-fastdds.supp" \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \

@@ -20,7 +20,10 @@
 #
 # Usage: remote_commands.sh CASE CRANEASSIST MAKE_CERTS REPLAY_CSV DOMAIN WORKDIR [HELPER]
 #   HELPER: malformed: the dds_malformed_operator program
-# Prints "CASE OK" on success.
+# Prints "CASE OK" on success. The sim's loop runs at SCHED_FIFO priority 80 where the test may
+# have it (as root, as CI runs; without it a warning and the default policy), as on a machine: a
+# busy host must not stall the loop until the operator's input goes stale. Not --rt: locking all
+# memory under AddressSanitizer would fault in its shadow.
 set -eu
 case_name=$1 bin=$2 make_certs=$3 replay=$4 domain=$5 work=$6 helper=${7:-}
 # Under AddressSanitizer (CRANEASSIST_SANITIZE): Debian's Fast DDS 2.9 deletes its statistics
@@ -58,7 +61,7 @@ expect_usage_error() {
 wait=1 duration=4
 sim_remote() {
   remote_arg=$1 remote_exit=${2:-0}
-  "$bin" sim --input dds --telemetry-config "$work/certs/crane.yaml" --domain "$domain" \
+  "$bin" sim --rt-priority 80 --input dds --telemetry-config "$work/certs/crane.yaml" --domain "$domain" \
     --duration "$duration" --log "$work/log.csv" >"$work/sim.out" 2>&1 &
   sim_pid=$!
   if [ "$remote_arg" = "--insecure" ]; then
@@ -171,7 +174,7 @@ EOF
     ;;
   loss)
     "$make_certs" "$work/certs" >/dev/null
-    "$bin" sim --input dds --telemetry-config "$work/certs/crane.yaml" --domain "$domain" \
+    "$bin" sim --rt-priority 80 --input dds --telemetry-config "$work/certs/crane.yaml" --domain "$domain" \
       --duration 5 --log "$work/log.csv" >"$work/sim.out" 2>&1 &
     sim_pid=$!
     "$bin" remote --telemetry-config "$work/certs/operator.yaml" --domain "$domain" \
@@ -196,7 +199,7 @@ EOF
   malformed)
     [ -x "$helper" ] || fail "no dds_malformed_operator given"
     "$make_certs" "$work/certs" >/dev/null
-    "$bin" sim --input dds --telemetry-config "$work/certs/crane.yaml" --domain "$domain" \
+    "$bin" sim --rt-priority 80 --input dds --telemetry-config "$work/certs/crane.yaml" --domain "$domain" \
       --duration 6 --log "$work/log.csv" >"$work/sim.out" 2>&1 &
     sim_pid=$!
     rc=0

@@ -16,6 +16,7 @@
 #include "craneassist/can/valve_frames.hpp"
 #include "craneassist/config/crane_config.hpp"
 #include "fake_can_bus.hpp"
+#include "realtime_thread.hpp"
 
 namespace craneassist::can {
 namespace {
@@ -69,6 +70,9 @@ bool is_block(const JointMapping& j, const CanFrame& f) {
 }
 
 struct Rig {
+  // The rig's cycles and the backend's watchdog (started after it) as a machine runs them: a busy
+  // host would otherwise hold this thread back past the watchdog's 80 ms ("control loop frozen").
+  test::RealtimeThread realtime;
   CanMapping map = k70m_mapping();
   config::CraneConfig cfg = config::default_crane_config();
   FakeCanBus bus;

@@ -201,8 +201,14 @@ start="$(date +%s.%N)"
 # the emulator and the control loop in the guest do not take turns on one CPU
 # (CRANEASSIST_CAN_VM_CPUS overrides).
 cpus="${CRANEASSIST_CAN_VM_CPUS:-$(($(nproc) >= 2 ? 2 : 1))}"
+# The guest's control loop and emulator run in real time on the emulated CPUs, so the host must not
+# starve them: where it may (as root, as CI runs), qemu runs at nice -15, a scheduler share about
+# 28 times a normal process's, so a busy host (a build beside it, `stress-ng --cpu 2`) slows it
+# little. Not SCHED_FIFO: the emulated CPUs may spin, and would then starve the host.
+# CRANEASSIST_CAN_VM_NICE overrides (0: as the caller).
+nice_level="${CRANEASSIST_CAN_VM_NICE:-$([ "$(id -u)" -eq 0 ] && echo -15 || echo 0)}"
 set +e
-timeout --kill-after=10 "$timeout_s" qemu-system-x86_64 -accel tcg,thread=multi -m "$memory" -smp "$cpus" \
+timeout --kill-after=10 "$timeout_s" nice -n "$nice_level" qemu-system-x86_64 -accel tcg,thread=multi -m "$memory" -smp "$cpus" \
   -nodefaults -no-user-config -no-reboot -display none -serial stdio -nic none \
   -kernel "$kernel" -initrd "$work/initramfs.cpio" \
   -append "console=ttyS0 quiet loglevel=3 panic=-1 rdinit=/init ${CRANEASSIST_CAN_VM_APPEND:-}" \
