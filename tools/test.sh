@@ -18,7 +18,7 @@ stage() {
 }
 stage_report() {
   local status=$?
-  [ -n "${nodds_pid:-}" ] && kill "$nodds_pid" 2>/dev/null
+  [ -n "${nodds_pid:-}" ] && kill -- -"$nodds_pid" 2>/dev/null
   [ ${#stage_names[@]} -gt 0 ] && stage_secs+=($((SECONDS - stage_start)))
   echo "== stage times (wall clock, s)"
   for i in "${!stage_names[@]}"; do printf '  %-64s %5d\n' "${stage_names[$i]}" "${stage_secs[$i]}"; done
@@ -52,10 +52,11 @@ ctest --test-dir build --output-on-failure -j"$jobs" -LE can_vm
 # unoptimised) compiles beside them at the lowest priority, in the cores they leave idle.
 echo "== the SocketCAN VM tests; beside them, the build without DDS and the web view"
 stage "release: the SocketCAN VM tests (can_vm), the no-DDS build beside"
+# Its own process group (setsid), so a failure here ends the whole build, not only its shell.
 mkdir -p build-nodds
-(cmake -S . -B build-nodds -DCMAKE_BUILD_TYPE=Debug -DCRANEASSIST_DDS=OFF -DCRANEASSIST_BUILD_BENCH=OFF \
-  -DCRANEASSIST_CAN_VM_TESTS=OFF -DCRANEASSIST_WEB=OFF >/dev/null &&
-  nice -n 19 cmake --build build-nodds -j"$jobs" --target craneassist) >build-nodds/build.log 2>&1 &
+setsid bash -c 'cmake -S . -B build-nodds -DCMAKE_BUILD_TYPE=Debug -DCRANEASSIST_DDS=OFF \
+  -DCRANEASSIST_BUILD_BENCH=OFF -DCRANEASSIST_CAN_VM_TESTS=OFF -DCRANEASSIST_WEB=OFF >/dev/null &&
+  nice -n 19 cmake --build build-nodds -j"$1" --target craneassist' _ "$jobs" >build-nodds/build.log 2>&1 &
 nodds_pid=$!
 ctest --test-dir build --output-on-failure -j"$jobs" -L can_vm
 stage "no DDS, no web view: the rest of its build, its CLI checks"

@@ -79,14 +79,14 @@ for node in layout.get("userNodes", {}).values():
 paths = list(walk(layout["configById"]))
 for path in paths:
     script = next((o for o in script_fields if path.startswith(o + ".")), None)
-    if group_field(path):
-        pass
-    elif script:
+    if script:
         field = re.match(r"\.(\w+)", path[len(script):]).group(1)
         if field in script_fields[script]:
             print(f"ok   {path}")
         else:
             fail(f"{path}: the user script's Output has no field {field}")
+    elif group_field(path):
+        pass
     elif path in cdr:
         print(f"ok   {path}")
     else:
