@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -391,10 +392,18 @@ void read_valve_tables(Reader& r, const YAML::Node& tables, const std::string& p
     }
     if (index == model.joints.size()) r.fail(kv.first, tp, "no joint of that name");
     const YAML::Node entry = kv.second;
-    r.check_keys(entry, tp, {"command", "velocity"});
+    r.check_keys(entry, tp, {"command", "velocity", "time_constant", "delay"});
     dynamics::ValveTable table;
     table.command = r.values(entry, "command", tp, Dimension::kDimensionless, 0);
     table.velocity_m_s = r.values(entry, "velocity", tp, Dimension::kVelocity, 0);
+    if (entry["time_constant"].IsDefined()) {
+      table.time_constant_s =
+          r.value_in(entry, "time_constant", tp, Dimension::kTime, 0.0, 5.0, "between 0 and 5 s");
+    }
+    if (entry["delay"].IsDefined()) {
+      table.delay_s =
+          r.value_in(entry, "delay", tp, Dimension::kTime, 0.0, 1.0, "between 0 and 1 s");
+    }
     if (const std::string why = dynamics::check_valve_table(table); !why.empty()) {
       const bool about_command = why.rfind("command", 0) == 0;  // else about the velocities
       r.fail(entry[about_command ? "command" : "velocity"],
@@ -562,6 +571,98 @@ void read_simulated_grapple(Reader& r, const YAML::Node& sim, CraneConfig& cfg) 
   cfg.simulation.grapple = g;
 }
 
+// One valve section's deviation fields (simulation.valves and its per-joint entries): the ones
+// present replace those in v.
+void read_valve_deviation(Reader& r, const YAML::Node& node, const std::string& path,
+                          dynamics::ValveDeviation& v) {
+  auto opt = [&](const char* key, Dimension dim, double lo, double hi, const char* range,
+                 double& out) {
+    if (node[key].IsDefined()) out = r.value_in(node, key, path, dim, lo, hi, range);
+  };
+  opt("time_constant", Dimension::kTime, 0.0, 5.0, "between 0 and 5 s", v.time_constant_s);
+  opt("delay", Dimension::kTime, 0.0, 1.0, "between 0 and 1 s", v.delay_s);
+  opt("dead_zone", Dimension::kDimensionless, 0.0, 0.95, "between 0 and 0.95", v.dead_zone);
+  opt("gain", Dimension::kDimensionless, 0.1, 10.0, "between 0.1 and 10", v.gain);
+  opt("shape", Dimension::kDimensionless, 0.2, 5.0, "between 0.2 and 5", v.shape);
+  opt("hysteresis", Dimension::kDimensionless, 0.0, 0.5, "between 0 and 0.5", v.hysteresis);
+}
+
+// simulation.valves, simulation.joint_sensors, simulation.feedback: where the simulated machine
+// differs from the controller's model (docs/valves.md#the-machine-it-meets).
+void read_simulated_machine(Reader& r, const YAML::Node& sim, const std::string& prefix,
+                            CraneConfig& cfg) {
+  const auto& joints = cfg.model.joints;
+  if (sim["spool_time_constant"].IsDefined()) {
+    const double tau = r.value_in(sim, "spool_time_constant", prefix, Dimension::kTime, 0.0, 5.0,
+                                  "between 0 and 5 s");
+    for (auto& v : cfg.simulation.valves) v.time_constant_s = tau;
+  }
+  if (const YAML::Node valves = sim["valves"]; valves.IsDefined() && !valves.IsNull()) {
+    const std::string vp = prefix + ".valves";
+    if (!valves.IsMap()) r.fail(valves, vp, "expected a mapping of fields");
+    static constexpr std::array kFields{"time_constant", "delay", "dead_zone",
+                                        "gain",          "shape", "hysteresis"};
+    // The fields for every section first, then each joint's own.
+    dynamics::ValveDeviation all;
+    read_valve_deviation(r, valves, vp, all);
+    for (auto& v : cfg.simulation.valves) {
+      if (valves["time_constant"].IsDefined()) v.time_constant_s = all.time_constant_s;
+      if (valves["delay"].IsDefined()) v.delay_s = all.delay_s;
+      if (valves["dead_zone"].IsDefined()) v.dead_zone = all.dead_zone;
+      if (valves["gain"].IsDefined()) v.gain = all.gain;
+      if (valves["shape"].IsDefined()) v.shape = all.shape;
+      if (valves["hysteresis"].IsDefined()) v.hysteresis = all.hysteresis;
+    }
+    for (const auto& kv : valves) {
+      const std::string key = kv.first.Scalar();
+      if (std::find(kFields.begin(), kFields.end(), key) != kFields.end()) continue;
+      std::size_t index = joints.size();
+      for (std::size_t i = 0; i < joints.size(); ++i) {
+        if (joints[i].name == key) index = i;
+      }
+      if (index == joints.size()) {
+        std::string list;
+        for (const char* f : kFields) list += std::string(f) + ", ";
+        for (const auto& j : joints) list += j.name + (&j == &joints.back() ? "" : ", ");
+        r.fail(kv.first, vp + "." + key, "unknown field (expected one of: " + list + ")");
+      }
+      const std::string jp = vp + "." + key;
+      r.check_keys(kv.second, jp,
+                   {"time_constant", "delay", "dead_zone", "gain", "shape", "hysteresis"});
+      read_valve_deviation(r, kv.second, jp, cfg.simulation.valves[index]);
+    }
+  }
+  auto& js = cfg.simulation.joints;
+  if (const auto sensors = r.optional_section(
+          sim, "joint_sensors", prefix,
+          {"angle_noise", "angle_resolution", "length_noise", "length_resolution", "delay"})) {
+    const YAML::Node& n = *sensors;
+    const std::string p = prefix + ".joint_sensors";
+    auto opt = [&](const char* key, Dimension dim, double hi, const char* range, double& out) {
+      if (n[key].IsDefined()) out = r.value_in(n, key, p, dim, 0.0, hi, range);
+    };
+    opt("angle_noise", Dimension::kAngle, 0.1, "between 0 and 5.7 deg", js.angle_noise_rad);
+    opt("angle_resolution", Dimension::kAngle, 0.1, "between 0 and 5.7 deg",
+        js.angle_resolution_rad);
+    opt("length_noise", Dimension::kLength, 0.1, "between 0 and 0.1 m", js.length_noise_m);
+    opt("length_resolution", Dimension::kLength, 0.1, "between 0 and 0.1 m",
+        js.length_resolution_m);
+    opt("delay", Dimension::kTime, 1.0, "between 0 and 1 s", js.delay_s);
+  }
+  if (const auto fb = r.optional_section(sim, "feedback", prefix, {"delay", "jitter"})) {
+    const YAML::Node& n = *fb;
+    const std::string p = prefix + ".feedback";
+    if (n["delay"].IsDefined()) {
+      js.feedback_delay_s =
+          r.value_in(n, "delay", p, Dimension::kTime, 0.0, 1.0, "between 0 and 1 s");
+    }
+    if (n["jitter"].IsDefined()) {
+      js.feedback_jitter_s =
+          r.value_in(n, "jitter", p, Dimension::kTime, 0.0, 1.0, "between 0 and 1 s");
+    }
+  }
+}
+
 // Optional rated load against reach (docs/loads.md).
 void read_load_chart(Reader& r, const YAML::Node& root, LoadChart& chart) {
   const auto section = r.optional_section(root, "load_chart", "", {"reach", "rated_load"});
@@ -723,7 +824,7 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
   const YAML::Node sim = r.child(root, "simulation", "");
   r.check_keys(sim, "simulation",
                {"step", "initial", "pressure_sensors", "return_pressure", "spool_time_constant",
-                "swing_sensor", "grapple"});
+                "valves", "joint_sensors", "feedback", "swing_sensor", "grapple"});
   cfg.simulation.step_s =
       r.value_in(sim, "step", "simulation", Dimension::kTime, 1e-5, 1e-2, "between 0.01 and 10 ms");
   const double period = 1.0 / cfg.control.rate_hz;
@@ -765,10 +866,7 @@ CraneConfig read_config(Reader& r, const YAML::Node& root, std::string_view sour
         r.value_in(sim, "return_pressure", "simulation", Dimension::kPressure, 0.0,
                    model.pump.max_pressure_pa, "between 0 and the pump's max_pressure");
   }
-  if (sim["spool_time_constant"].IsDefined()) {
-    cfg.simulation.spool_time_constant_s = r.value_in(
-        sim, "spool_time_constant", "simulation", Dimension::kTime, 0.0, 5.0, "between 0 and 5 s");
-  }
+  read_simulated_machine(r, sim, "simulation", cfg);
   read_simulated_grapple(r, sim, cfg);
   read_load_chart(r, root, cfg.load_chart);
   read_backend(r, root, cfg.backend);
@@ -790,6 +888,13 @@ double LoadChart::rated_kg_at(double reach) const {
 
 const char* to_string(BackendKind kind) {
   return kind == BackendKind::kCan ? "can" : "sim";
+}
+
+void apply_simulated_machine(const YAML::Node& node, const std::string& source,
+                             const std::string& path, CraneConfig& cfg) {
+  Reader r{source};
+  r.check_keys(node, path, {"spool_time_constant", "valves", "joint_sensors", "feedback"});
+  read_simulated_machine(r, node, path, cfg);
 }
 
 CraneConfig parse_crane_config(std::string_view yaml_text, std::string_view source_name) {

@@ -102,6 +102,34 @@ double valve_table_dead_band_edge(const ValveTable& table, double side) {
   return v[k] == 0.0 ? c[k] : lerp(v[k - 1], c[k - 1], v[k], c[k], 0.0);
 }
 
+namespace {
+const ValveTable* section_table(const CraneModel& model, int i) {
+  const auto& tables = model.valves.tables;
+  return i >= 0 && static_cast<std::size_t>(i) < tables.size()
+             ? &tables[static_cast<std::size_t>(i)]
+             : nullptr;
+}
+}  // namespace
+
+double section_time_constant_s(const CraneModel& model, int i) {
+  const ValveTable* t = section_table(model, i);
+  return t != nullptr && std::isfinite(t->time_constant_s) ? t->time_constant_s
+                                                           : model.valves.time_constant_s;
+}
+
+double section_delay_s(const CraneModel& model, int i) {
+  const ValveTable* t = section_table(model, i);
+  return t != nullptr && std::isfinite(t->delay_s) ? t->delay_s : model.valves.delay_s;
+}
+
+double longest_valve_lag_s(const CraneModel& model) {
+  double lag = model.valves.delay_s + model.valves.time_constant_s;
+  for (int i = 0; i < model.dof(); ++i) {
+    lag = std::max(lag, section_delay_s(model, i) + section_time_constant_s(model, i));
+  }
+  return lag;
+}
+
 ValveTable straight_line_valve_table(double dead_zone, double v_max_m_s) {
   ValveTable t;
   if (dead_zone > 0.0) {

@@ -79,12 +79,10 @@ struct SimBackend::Impl {
     swing_rng.seed(s.noise_seed + 1);
     const int n = model.dof();
     feedback.resize(static_cast<std::size_t>(n) + 1);
-    dynamics::ValveSections valves = model.valves;
-    if (s.spool_time_constant_s >= 0.0) valves.time_constant_s = s.spool_time_constant_s;
     for (int i = 1; i <= n; ++i) {
+      const auto k = static_cast<std::size_t>(i - 1);
       dJointSetFeedback(crane->joint(i), &feedback[static_cast<std::size_t>(i)]);
-      sections.emplace_back(valves, model.cylinders[static_cast<std::size_t>(i - 1)].v_max_m_s,
-                            s.step_s);
+      sections.emplace_back(model.valves, s.valves[k], model.cylinders[k].v_max_m_s, s.step_s);
     }
     spool_command.setZero(n);
     requested_velocity.setZero(n);
@@ -101,8 +99,45 @@ struct SimBackend::Impl {
     stall.fill(false);
     load_alpha = 1.0 - std::exp(-s.step_s / kLoadPressureTimeConstantS);
     crane->read_state(q, qdot);
+    // The joint readings of the last steps, for the sensors' and the feedback's delay.
+    const auto& js = s.joints;
+    const double late_s = js.delay_s + js.feedback_delay_s + js.feedback_jitter_s;
+    history_q.assign(static_cast<std::size_t>(std::ceil(late_s / s.step_s - 1e-9)) + 1, q);
+    history_qdot.assign(history_q.size(), qdot);
+    joint_rng.seed(s.noise_seed + 2);
     // Start from the static holding loads so the first steps see the right pump pressure.
     settle_loads();
+  }
+
+  // The joints as the machine's sensors and its feedback report them (SimSettings::joints).
+  void measure_joints(JointVector& q_out, JointVector& qdot_out) {
+    const auto& js = settings.joints;
+    if (js.exact()) {
+      q_out = q;
+      qdot_out = qdot;
+      return;
+    }
+    double late_s = js.delay_s + js.feedback_delay_s;
+    if (js.feedback_jitter_s > 0.0) late_s += js.feedback_jitter_s * uniform(joint_rng);
+    const auto size = history_q.size();
+    const auto back =
+        std::min(static_cast<std::size_t>(std::lround(late_s / settings.step_s)), size - 1);
+    const std::size_t k = (history_head + size - back) % size;
+    q_out = history_q[k];
+    qdot_out = history_qdot[k];
+    for (int i = 0; i < model.dof(); ++i) {
+      const bool angle =
+          model.joints[static_cast<std::size_t>(i)].type == dynamics::JointType::kRevolute;
+      q_out[i] =
+          sensed(q_out[i], angle ? js.angle_noise_rad : js.length_noise_m,
+                 angle ? js.angle_resolution_rad : js.length_resolution_m, joint_rng, joint_normal);
+    }
+  }
+
+  void record_joints() {
+    history_head = (history_head + 1) % history_q.size();
+    history_q[history_head] = q;
+    history_qdot[history_head] = qdot;
   }
 
   ~Impl() {
@@ -384,6 +419,7 @@ struct SimBackend::Impl {
     pump.solve(demand, load_pressure, pump_result);
     step_physics(false);
     update_loads(load_alpha);
+    record_joints();
     t_s += settings.step_s;
     energy_j += pump_result.power_w * settings.step_s;
   }
@@ -396,6 +432,11 @@ struct SimBackend::Impl {
   std::unique_ptr<dynamics::OdeCrane> crane;
   std::vector<dJointFeedback> feedback;
   std::vector<ValveSection> sections;
+  std::vector<JointVector> history_q, history_qdot;  // ring, newest at history_head
+  std::size_t history_head = 0;
+  std::mt19937 joint_rng{3};
+  std::normal_distribution<double> joint_normal{0.0, 1.0};
+  std::uniform_real_distribution<double> uniform{0.0, 1.0};
   JointVector spool_command, requested_velocity, demand, load_pressure, force, q, qdot;
   JointVector force_filtered, pressure_a, pressure_b;
   std::array<bool, dynamics::kMaxJoints> creep{}, stall{};
@@ -439,8 +480,7 @@ SimBackend::~SimBackend() = default;
 valves::BackendStatus SimBackend::read(valves::MachineState& state) {
   Impl& s = *impl_;
   state.t_s = s.t_s;
-  state.q = s.q;
-  state.qdot = s.qdot;
+  s.measure_joints(state.q, state.qdot);
   state.load_pressure_pa = s.load_pressure;
   impl_->measure_chambers();
   state.pressure_a_pa = s.pressure_a;
@@ -453,7 +493,7 @@ valves::BackendStatus SimBackend::read(valves::MachineState& state) {
   state.pump.power_w = s.pump_result.power_w;
   state.pump.energy_j = s.energy_j;
   state.pump.limit = s.pump_result.limit;
-  state.valid = s.q.allFinite() && s.qdot.allFinite();
+  state.valid = state.q.allFinite() && state.qdot.allFinite();
   return state.valid ? valves::BackendStatus::kOk : valves::BackendStatus::kFault;
 }
 

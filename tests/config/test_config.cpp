@@ -1,6 +1,7 @@
 // Config loading: the shipped models, and every kind of error naming file, line and field.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <limits>
@@ -151,6 +152,50 @@ TEST(CraneConfig, OutOfRangeValuesAreRejected) {
   EXPECT_EQ(error_after_edit("step: 1 ms", "step: 3 ms").field(), "simulation.step");
 }
 
+// The simulated machine's valves, joint sensors and feedback where they differ from the model
+// (docs/valves.md#the-machine-it-meets): every section's fields, then a joint's own; refused with
+// the line and field.
+TEST(CraneConfig, SimulatedMachineDeviations) {
+  const std::string anchor = "  return_pressure: 0.3 MPa, assumed";
+  const auto cfg = config_after_edit(
+      anchor,
+      anchor +
+          "\n  valves:\n    time_constant: 25 ms\n    dead_zone: 0.4\n    lift: {gain: 1.2, "
+          "shape: 1.5, hysteresis: 0.02, delay: 0.17 s}\n"
+          "  joint_sensors: {angle_resolution: 0.01 deg, length_noise: 1 mm, delay: 5 ms}\n"
+          "  feedback: {delay: 10 ms, jitter: 4 ms}");
+  for (int i = 0; i < cfg.model.dof(); ++i) {
+    const auto& v = cfg.simulation.valves[static_cast<std::size_t>(i)];
+    EXPECT_DOUBLE_EQ(v.time_constant_s, 0.025) << i;
+    EXPECT_DOUBLE_EQ(v.dead_zone, 0.4) << i;
+    EXPECT_EQ(v.gain, i == 1 ? 1.2 : 1.0) << i;
+    EXPECT_EQ(v.shape, i == 1 ? 1.5 : 1.0) << i;
+    EXPECT_EQ(v.hysteresis, i == 1 ? 0.02 : 0.0) << i;
+    EXPECT_EQ(std::isnan(v.delay_s), i != 1) << i;
+  }
+  EXPECT_DOUBLE_EQ(cfg.simulation.valves[1].delay_s, 0.17);
+  const auto& js = cfg.simulation.joints;
+  EXPECT_NEAR(js.angle_resolution_rad, 0.01 * M_PI / 180.0, 1e-15);
+  EXPECT_DOUBLE_EQ(js.length_noise_m, 0.001);
+  EXPECT_DOUBLE_EQ(js.delay_s, 0.005);
+  EXPECT_DOUBLE_EQ(js.feedback_delay_s, 0.01);
+  EXPECT_DOUBLE_EQ(js.feedback_jitter_s, 0.004);
+  EXPECT_TRUE(craneassist::config::default_crane_config().simulation.joints.exact())
+      << "left out: exact";
+
+  const auto joint = error_after_edit(anchor, anchor + "\n  valves:\n    boom: {gain: 2}");
+  EXPECT_EQ(joint.field(), "simulation.valves.boom");
+  EXPECT_EQ(joint.line(), line_of(anchor) + 2);
+  const auto range = error_after_edit(anchor, anchor + "\n  valves:\n    lift: {gain: 20}");
+  EXPECT_EQ(range.field(), "simulation.valves.lift.gain");
+  EXPECT_EQ(error_after_edit(anchor, anchor + "\n  valves: {dead_zone: 0.99}").field(),
+            "simulation.valves.dead_zone");
+  EXPECT_EQ(error_after_edit(anchor, anchor + "\n  feedback: {delay: 10 ms, late: 1 s}").field(),
+            "simulation.feedback.late");
+  EXPECT_EQ(error_after_edit(anchor, anchor + "\n  joint_sensors: {delay: 2 s}").field(),
+            "simulation.joint_sensors.delay");
+}
+
 // The stop and the valves' slew-rate limit (docs/safety.md, docs/valves.md): read, defaulted
 // when left out, and refused out of range naming the line and field.
 TEST(CraneConfig, StopAndSlewRateSettings) {
@@ -158,13 +203,15 @@ TEST(CraneConfig, StopAndSlewRateSettings) {
   EXPECT_DOUBLE_EQ(cfg.model.valves.stroke_time_s, 0.05);
   EXPECT_DOUBLE_EQ(cfg.control.rest_speed_m_s, 0.005);
   EXPECT_DOUBLE_EQ(cfg.control.rest_timeout_s, 1.5);
-  EXPECT_LT(cfg.simulation.spool_time_constant_s, 0.0) << "left out: the model's";
+  EXPECT_TRUE(std::isnan(cfg.simulation.valves[0].time_constant_s)) << "left out: the model's";
   const auto without = config_after_edit("    stroke_time: 0.05 s, assumed\n", "");
   EXPECT_EQ(without.model.valves.stroke_time_s, 0.0) << "left out: no limit";
   const auto machine = config_after_edit("  return_pressure: 0.3 MPa, assumed",
                                          "  return_pressure: 0.3 MPa, assumed\n"
                                          "  spool_time_constant: 80 ms, assumed");
-  EXPECT_DOUBLE_EQ(machine.simulation.spool_time_constant_s, 0.08);
+  for (int i = 0; i < machine.model.dof(); ++i) {
+    EXPECT_DOUBLE_EQ(machine.simulation.valves[static_cast<std::size_t>(i)].time_constant_s, 0.08);
+  }
   const auto stroke = error_after_edit("stroke_time: 0.05 s", "stroke_time: 7 s");
   EXPECT_EQ(stroke.field(), "hydraulics.valves.stroke_time");
   EXPECT_EQ(stroke.line(), line_of("stroke_time: 0.05 s"));

@@ -70,9 +70,12 @@ struct Ending {
   std::vector<control::LogRow> rows;
 };
 
+// The K70M with its simulated spools' time constant (negative: the model's).
 config::CraneConfig crane(double spool_time_constant_s) {
   auto cfg = config::default_crane_config();
-  cfg.simulation.spool_time_constant_s = spool_time_constant_s;
+  if (spool_time_constant_s >= 0.0) {
+    for (auto& v : cfg.simulation.valves) v.time_constant_s = spool_time_constant_s;
+  }
   return cfg;
 }
 
@@ -164,7 +167,7 @@ TEST(StopAtRest, EveryRunEndLeavesTheCraneAtRestBeforeTheValvesGoNeutral) {
 TEST(StopAtRest, FasterAndSlowerSpoolsThanTheModelStopWithoutOvershootOrKick) {
   for (const double factor : {0.5, 2.0}) {
     const auto cfg = crane(factor * config::default_crane_config().model.valves.time_constant_s);
-    SCOPED_TRACE("spool time constant " + std::to_string(cfg.simulation.spool_time_constant_s));
+    SCOPED_TRACE("spool time constant " + std::to_string(cfg.simulation.valves[0].time_constant_s));
     expect_gentle_stop_at_rest(
         cfg, by_replay(cfg, "replay end", "t,v_x,v_y,v_z\n0,0.6,0,0\n3,0.6,0,0\n"));
   }

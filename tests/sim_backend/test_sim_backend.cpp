@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "craneassist/config/crane_config.hpp"
 #include "craneassist/dynamics/cylinders.hpp"
@@ -251,6 +252,86 @@ TEST(ValveSection, DelayLagAndDeadZone) {
   sim_backend::ValveSection lag(p, 0.2, 1e-3);
   for (int k = 0; k < 50; ++k) lag.step(1.0);
   EXPECT_NEAR(lag.spool_position(), 1.0 - std::exp(-1.0), 0.01);
+}
+
+// The machine's section where it differs from the model (docs/valves.md#the-machine-it-meets):
+// its own lag, delay and dead band, its gain and shape beyond the band, its hysteresis.
+TEST(ValveSection, AMachineSectionDiffersWhereItsDeviationSays) {
+  dynamics::ValveSections model;
+  model.dead_zone = 0.5;
+  model.time_constant_s = 0.05;
+  model.delay_s = 0.1;
+  dynamics::ValveDeviation d;
+  d.time_constant_s = 0.0;
+  d.delay_s = 0.02;
+  d.dead_zone = 0.25;
+  d.gain = 1.2;
+  d.shape = 2.0;
+  sim_backend::ValveSection valve(model, d, 0.2, 1e-3);
+  for (int k = 0; k < 20; ++k) EXPECT_EQ(valve.step(1.0), 0.0) << "its own delay, step " << k;
+  EXPECT_DOUBLE_EQ(valve.step(1.0), 1.2 * 0.2) << "full opening: gain x max_speed";
+  sim_backend::ValveSection half(model, d, 0.2, 1e-3);
+  double v = 0.0;
+  for (int k = 0; k < 50; ++k) v = half.step(-0.625);  // half way from its band to full
+  EXPECT_DOUBLE_EQ(v, -1.2 * 0.2 * 0.25) << "opening 0.5 squared";
+  sim_backend::ValveSection narrow(model, d, 0.2, 1e-3);
+  for (int k = 0; k < 50; ++k) v = narrow.step(0.45);
+  EXPECT_GT(v, 0.0) << "inside the model's band, outside the machine's";
+  EXPECT_DOUBLE_EQ(v, valve.velocity_at(0.45));
+
+  // Hysteresis 0.1: the effective spool trails the command by half of it, each way.
+  dynamics::ValveDeviation h;
+  h.time_constant_s = 0.0;
+  h.delay_s = 0.0;
+  h.hysteresis = 0.1;
+  sim_backend::ValveSection play(model, h, 0.2, 1e-3);
+  play.step(0.8);
+  EXPECT_NEAR(play.spool_position(), 0.75, 1e-12) << "rising: half the play below";
+  play.step(0.78);
+  EXPECT_NEAR(play.spool_position(), 0.75, 1e-12) << "a small reversal moves nothing";
+  play.step(0.6);
+  EXPECT_NEAR(play.spool_position(), 0.65, 1e-12) << "falling: half the play above";
+  // Left out, every field is the model's: the same velocities step by step.
+  sim_backend::ValveSection same(model, dynamics::ValveDeviation{}, 0.2, 1e-3);
+  sim_backend::ValveSection plain(model, 0.2, 1e-3);
+  for (int k = 0; k < 300; ++k) {
+    const double u = std::sin(0.02 * k);
+    ASSERT_DOUBLE_EQ(same.step(u), plain.step(u)) << k;
+  }
+}
+
+// The machine's joint sensors and feedback: late by their delays, rounded to their resolution;
+// exact and at once when left out.
+TEST(SimJointSensing, ReadingsAreLateAndCoarseAsConfigured) {
+  auto cfg = config::default_crane_config();
+  sim_backend::SimSettings exact{cfg.simulation.step_s, cfg.simulation.q_initial};
+  sim_backend::SimSettings coarse = exact;
+  coarse.joints.angle_resolution_rad = 0.01;
+  coarse.joints.length_resolution_m = 0.005;
+  coarse.joints.delay_s = 0.02;
+  coarse.joints.feedback_delay_s = 0.03;
+  sim_backend::SimBackend truth(cfg.model, exact), machine(cfg.model, coarse);
+  valves::ValveCommand cmd;
+  cmd.spool = JointVector::Constant(4, 0.9);
+  truth.write(cmd);
+  machine.write(cmd);
+  valves::MachineState now, seen;
+  std::vector<JointVector> history;
+  for (int k = 0; k < 60; ++k) {
+    truth.advance(0.01);
+    machine.advance(0.01);
+    truth.read(now);
+    machine.read(seen);
+    history.push_back(now.q);
+    if (k < 5) continue;
+    const JointVector& late = history[static_cast<std::size_t>(k - 5)];  // 50 ms ago
+    for (int i = 0; i < 4; ++i) {
+      const double res = i == 3 ? 0.005 : 0.01;
+      EXPECT_NEAR(seen.q[i], late[i], 0.5 * res + 1e-12) << "joint " << i << " cycle " << k;
+      EXPECT_NEAR(std::remainder(seen.q[i], res), 0.0, 1e-9) << "rounded, joint " << i;
+    }
+  }
+  EXPECT_GT((now.q - history.front()).norm(), 0.05) << "the crane moved";
 }
 
 class SimCrane : public ::testing::Test {

@@ -10,8 +10,13 @@
 
 #include "craneassist/config/config_error.hpp"
 #include "craneassist/dynamics/enum_names.hpp"
+#include "craneassist/dynamics/machine_deviation.hpp"
 #include "craneassist/dynamics/model.hpp"
 #include "craneassist/dynamics/resolutions.hpp"
+
+namespace YAML {
+class Node;
+}
 
 namespace craneassist::config {
 
@@ -67,9 +72,12 @@ struct SimulationSettings {
   double pressure_resolution_pa = 0.0;
   // Pressure in the chamber that returns to tank.
   double return_pressure_pa = 0.0;
-  // The simulated valves' spool lag when it differs from the controller's model
-  // (hydraulics.valves.time_constant); negative: the model's.
-  double spool_time_constant_s = -1.0;
+  // The simulated machine where it differs from the controller's model
+  // (docs/valves.md#the-machine-it-meets): its valve sections by joint index (simulation.valves,
+  // and the older simulation.spool_time_constant for every section's lag), its joint sensors
+  // and feedback path (simulation.joint_sensors, simulation.feedback).
+  dynamics::ValveDeviations valves{};
+  dynamics::JointSensing joints{};
   // The simulated machine's swing sensor on the grapple's link (docs/sway.md): white noise of
   // this standard deviation on each of its two angles, then rounded to the resolution (zero:
   // exact); swing_sensor false (`swing_sensor: none`): the machine has none.
@@ -129,6 +137,13 @@ struct CraneConfig {
 // Both throw ConfigError naming the file, line and field of the first problem found.
 CraneConfig load_crane_config(const std::filesystem::path& path);
 CraneConfig parse_crane_config(std::string_view yaml_text, std::string_view source_name);
+
+// A machine variant (`craneassist suite --variants`, docs/valves.md#the-machine-it-meets): the
+// simulated-machine fields of a crane config's simulation section (spool_time_constant, valves,
+// joint_sensors, feedback) read from node and applied to cfg.simulation. Throws ConfigError
+// naming source, the node's line and path plus the field.
+void apply_simulated_machine(const YAML::Node& node, const std::string& source,
+                             const std::string& path, CraneConfig& cfg);
 
 // The shipped models, embedded in the binary (config/cranes/k70m.yaml, planar_2r.yaml).
 CraneConfig default_crane_config();

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -159,6 +160,10 @@ inline double supply_pressure_ceiling_pa(const Pump& p) {
 struct ValveTable {
   std::vector<double> command;       // -1 .. 1
   std::vector<double> velocity_m_s;  // positive: extending
+  // The section's own spool dynamics where measured (craneassist calibrate); NaN:
+  // ValveSections' time_constant and delay.
+  double time_constant_s = std::numeric_limits<double>::quiet_NaN();
+  double delay_s = std::numeric_limits<double>::quiet_NaN();
   bool empty() const { return command.empty(); }
 };
 

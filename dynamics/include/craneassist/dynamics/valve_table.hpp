@@ -28,6 +28,13 @@ double valve_table_command(const ValveTable& table, double velocity_m_s);
 // that still gives no motion that way (signed; e.g. 0.53 and -0.53).
 double valve_table_dead_band_edge(const ValveTable& table, double side);
 
+// Section i's spool time constant and transport delay: its table's where measured, else the
+// valves' (hydraulics.valves.time_constant, delay); the longest delay plus time constant over
+// the sections.
+double section_time_constant_s(const CraneModel& model, int i);
+double section_delay_s(const CraneModel& model, int i);
+double longest_valve_lag_s(const CraneModel& model);
+
 // The straight-line characteristic of the model without a table: no flow over |u| <= dead_zone,
 // then linear up to v_max at |u| = 1, symmetric.
 ValveTable straight_line_valve_table(double dead_zone, double v_max_m_s);

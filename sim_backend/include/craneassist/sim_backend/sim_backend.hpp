@@ -16,13 +16,16 @@
 // to the tip, whose mass may change during a run (set_payload_mass: a log grabbed or lost);
 // load-holding valves hold a load the pump cannot move and let one beyond their port relief
 // creep at the valve's relief flow, never fall; cylinder friction (Coulomb each way, viscous);
-// both chambers' pressures measured with sensor noise and resolution.
-// Pump flow, pressure, power and integrated energy are measured on the way.
+// both chambers' pressures measured with sensor noise and resolution; valve sections and joint
+// sensors that differ from the model's (SimSettings::valves, joints;
+// dynamics/machine_deviation.hpp). Pump flow, pressure, power and integrated energy are measured on
+// the way.
 #pragma once
 
 #include <memory>
 #include <optional>
 
+#include "craneassist/dynamics/machine_deviation.hpp"
 #include "craneassist/dynamics/model.hpp"
 #include "craneassist/valves/machine_interface.hpp"
 
@@ -39,9 +42,12 @@ struct SimSettings {
   double pressure_resolution_pa = 0.0;
   unsigned noise_seed = 1;
   double return_pressure_pa = 0.0;  // in the chamber that returns to tank
-  // The spools' first-order lag when the machine's differs from the controller's model
-  // (hydraulics.valves.time_constant); negative: the model's.
-  double spool_time_constant_s = -1.0;
+  // The machine's valve sections where they differ from the controller's model (spool lag and
+  // delay, dead band, gain, shape, hysteresis), by joint index; the defaults: the model's.
+  dynamics::ValveDeviations valves{};
+  // The joint sensors' noise, resolution and delay and the feedback's transport delay and
+  // jitter; the default: exact and at once.
+  dynamics::JointSensing joints{};
   // The machine's two-axis swing sensor on the grapple's link (MachineState::swing_*;
   // docs/sway.md): white noise of this standard deviation on each angle, then rounded to the
   // resolution (0: exact). false: the machine has none (the swing is NaN, as on a machine without

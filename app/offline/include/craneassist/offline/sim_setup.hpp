@@ -14,7 +14,8 @@ inline sim_backend::SimSettings sim_settings(const config::CraneConfig& cfg) {
   s.pressure_noise_pa = cfg.simulation.pressure_noise_pa;
   s.pressure_resolution_pa = cfg.simulation.pressure_resolution_pa;
   s.return_pressure_pa = cfg.simulation.return_pressure_pa;
-  s.spool_time_constant_s = cfg.simulation.spool_time_constant_s;
+  s.valves = cfg.simulation.valves;
+  s.joints = cfg.simulation.joints;
   s.swing_sensor = cfg.simulation.swing_sensor;
   s.swing_noise_rad = cfg.simulation.swing_noise_rad;
   s.swing_resolution_rad = cfg.simulation.swing_resolution_rad;
