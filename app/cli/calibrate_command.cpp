@@ -63,6 +63,23 @@ void print_section(const dynamics::CraneModel& model, const offline::SectionCali
   std::printf("  %-10s %9.3f %9.3f %7.3f m/s %7.3f m/s %7zu",
               model.joints[static_cast<std::size_t>(r.section)].name.c_str(), r.dead_band_retract,
               r.dead_band_extend, r.max_retract_m_s, r.max_extend_m_s, r.table.command.size());
+  const auto& d = r.dynamics;
+  if (d.identified) {
+    std::printf("   %6.3f s %7.3f s %5.1f ms", d.delay_s, d.time_constant_s, 1e3 * d.residual_s);
+  } else {
+    std::printf("   %6s   %7s   %6s", "-", "-", "-");
+  }
+}
+
+// The sections whose spool dynamics were not identified, each with the reason (the table is
+// still written; the controller keeps hydraulics.valves' time_constant and delay for them).
+void print_unidentified(const dynamics::CraneModel& model,
+                        const std::vector<offline::SectionCalibration>& results) {
+  for (const auto& r : results) {
+    if (r.dynamics.identified) continue;
+    spdlog::warn("section {}: spool delay and time constant not identified: {}",
+                 model.joints[static_cast<std::size_t>(r.section)].name, r.dynamics.why_not);
+  }
 }
 
 // Whether the section's sweep gives a table the config takes (why not is logged).
@@ -82,7 +99,8 @@ CLI::App* add_calibrate_command(CLI::App& cli, CalibrateArgs& args) {
       "calibrate",
       "Sweep the valve command of each section on the simulator or on a machine (--backend can; "
       "both directions, each level from mid-stroke), measure the steady cylinder velocities and "
-      "write the fitted monotone velocity-vs-command tables as a YAML block for "
+      "identify each spool's delay and time constant from the levels' onsets, and write the "
+      "fitted monotone velocity-vs-command tables with them as a YAML block for "
       "hydraulics.valves (docs/valves.md)");
   add_config_option(*cmd, args.config_file);
   add_backend_options(*cmd, args.machine);
@@ -130,8 +148,8 @@ int run_calibrate_command(const CalibrateArgs& args) {
     std::printf("craneassist calibrate: %s on %s, %zu levels x 2 directions per section\n",
                 model.name.c_str(), on_machine ? "the machine (can backend)" : "the simulator",
                 options.levels.size());
-    std::printf("  %-10s %9s %9s %11s %11s %7s\n", "section", "dead -", "dead +", "v_max -",
-                "v_max +", "points");
+    std::printf("  %-10s %9s %9s %11s %11s %7s %9s %9s %8s\n", "section", "dead -", "dead +",
+                "v_max -", "v_max +", "points", "delay", "lag", "misfit");
   }
   int rc = kExitOk;
   if (!on_machine) {
@@ -188,6 +206,7 @@ int run_calibrate_command(const CalibrateArgs& args) {
     }
   }
 
+  print_unidentified(model, results);
   std::ofstream log_out(args.log_file);
   if (!log_out) {
     spdlog::error("cannot write {}", args.log_file);

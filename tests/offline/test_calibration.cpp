@@ -132,6 +132,51 @@ TEST(Calibration, CalibratedTablesTrackLikeTheStraightLine) {
 
 }  // namespace
 
+// The sweep identifies a machine's spool delay and time constant from the levels' onsets and
+// its dead band from the table, on machines that differ from the model: the lag within 10 %,
+// the dead band within 5 % (docs/valves.md#identification), on every section.
+TEST(Calibration, IdentifiesTheMachinesSpoolDelayLagAndDeadBand) {
+  struct Machine {
+    const char* name;
+    double time_constant_s, delay_s, dead_zone, gain;
+  };
+  for (const Machine& m : {Machine{"the model's", 0.05, 0.15, 0.53, 1.0},
+                           Machine{"fast, late, narrow, strong", 0.025, 0.17, 0.265, 1.2},
+                           Machine{"slow, wide, weak", 0.1, 0.15, 0.795, 0.8}}) {
+    SCOPED_TRACE(m.name);
+    auto cfg = config::default_crane_config();
+    for (auto& v : cfg.simulation.valves) {
+      v.time_constant_s = m.time_constant_s;
+      v.delay_s = m.delay_s;
+      v.dead_zone = m.dead_zone;
+      v.gain = m.gain;
+    }
+    for (int i = 0; i < cfg.model.dof(); ++i) {
+      SCOPED_TRACE("section " + std::to_string(i));
+      const auto r = offline::calibrate_section(cfg, i, offline::CalibrationOptions{});
+      ASSERT_TRUE(r.dynamics.identified) << r.dynamics.why_not;
+      EXPECT_NEAR(r.dynamics.time_constant_s, m.time_constant_s, 0.1 * m.time_constant_s);
+      EXPECT_NEAR(r.dynamics.delay_s, m.delay_s, 0.1 * m.delay_s);
+      EXPECT_NEAR(r.dead_band_extend, m.dead_zone, 0.05 * m.dead_zone);
+      EXPECT_NEAR(-r.dead_band_retract, m.dead_zone, 0.05 * m.dead_zone);
+      EXPECT_NEAR(r.max_extend_m_s,
+                  m.gain * cfg.model.cylinders[static_cast<std::size_t>(i)].v_max_m_s,
+                  0.01 * r.max_extend_m_s);
+      EXPECT_GE(r.dynamics.levels, 6);  // a wide band leaves 3 levels each way
+      EXPECT_LT(r.dynamics.residual_s, 0.005);
+    }
+  }
+}
+
+// Not identified, with the reason: too few levels that move.
+TEST(Calibration, RefusesSpoolDynamicsFromTooFewMovingLevels) {
+  auto options = offline::CalibrationOptions{};
+  options.levels = {0.3, 0.6};  // one level beyond the 0.53 band each way
+  const auto r = offline::calibrate_section(config::default_crane_config(), 1, options);
+  EXPECT_FALSE(r.dynamics.identified);
+  EXPECT_NE(r.dynamics.why_not.find("3 needed"), std::string::npos) << r.dynamics.why_not;
+}
+
 namespace {
 
 // The sweep a machine gets (moves to mid-stroke in between, ramped spools, levels cut short

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "craneassist/dynamics/cylinders.hpp"
+#include "craneassist/dynamics/valve_table.hpp"
 
 namespace craneassist::valves {
 namespace {
@@ -25,9 +26,6 @@ ReferenceFollower::ReferenceFollower(const dynamics::CraneModel& model, double p
     : model_(model),
       valves_(model, position_gain_1_s, activation_speed_m_s, activation_error_m),
       period_s_(period_s),
-      lag_alpha_(model.valves.time_constant_s > 0.0
-                     ? 1.0 - std::exp(-period_s / model.valves.time_constant_s)
-                     : 1.0),
       max_step_(max_spool_step(model.valves, period_s)) {
   const int n = model.dof();
   in_.velocity_ref_m_s.setZero(n);
@@ -38,9 +36,17 @@ ReferenceFollower::ReferenceFollower(const dynamics::CraneModel& model, double p
   spool_estimate_.setZero(n);
   last_command_.setZero(n);
   zero_.setZero(n);
-  const double lag_s = model.valves.delay_s + model.valves.time_constant_s;
-  q_ref_history_.assign(static_cast<std::size_t>(std::lround(lag_s / period_s)) + 1,
-                        JointVector::Zero(n));
+  lag_alpha_.setZero(n);
+  std::size_t longest = 0;
+  for (int i = 0; i < n; ++i) {
+    const double tau = dynamics::section_time_constant_s(model, i);
+    lag_alpha_[i] = tau > 0.0 ? 1.0 - std::exp(-period_s / tau) : 1.0;
+    const double lag_s = dynamics::section_delay_s(model, i) + tau;
+    lag_cycles_[static_cast<std::size_t>(i)] =
+        static_cast<std::size_t>(std::lround(lag_s / period_s));
+    longest = std::max(longest, lag_cycles_[static_cast<std::size_t>(i)]);
+  }
+  q_ref_history_.assign(longest + 1, JointVector::Zero(n));
 }
 
 void ReferenceFollower::reset(const JointVector& q) {
@@ -57,7 +63,7 @@ void ReferenceFollower::set_command_period(double command_period_s) {
 double ReferenceFollower::send(int i, double command) {
   const double last = last_command_[i];
   command = std::clamp(std::clamp(command, -1.0, 1.0), last - max_step_, last + max_step_);
-  spool_estimate_[i] += lag_alpha_ * (command - spool_estimate_[i]);
+  spool_estimate_[i] += lag_alpha_[i] * (command - spool_estimate_[i]);
   last_command_[i] = command;
   return command;
 }
@@ -93,7 +99,14 @@ void ReferenceFollower::follow(const JointVector& q_ref, const JointVector& qdot
   q_ref_history_[head_] = q_ref;
   head_ = (head_ + 1) % q_ref_history_.size();  // now the oldest entry
   if (q_meas != nullptr) {
-    dynamics::cylinder_lengths(model_, q_ref_history_[head_], c_ref_);
+    // Each section against the reference of its own valve lag ago.
+    const std::size_t size = q_ref_history_.size();
+    for (int i = 0; i < n; ++i) {
+      const std::size_t age = lag_cycles_[static_cast<std::size_t>(i)];
+      const JointVector& q_old = q_ref_history_[(head_ + (size - 1 - age)) % size];
+      c_ref_[i] =
+          dynamics::cylinder_length(model_.cylinders[static_cast<std::size_t>(i)], q_old[i]);
+    }
     dynamics::cylinder_lengths(model_, *q_meas, c_meas_);
     in_.position_error_m = c_ref_ - c_meas_;
   } else {
@@ -116,13 +129,16 @@ void ReferenceFollower::follow(const JointVector& q_ref, const JointVector& qdot
       const double side = wanted > 0.0 ? 1.0 : -1.0;
       const double band = std::abs(valves_.dead_band_edge(i, wanted));
       const double x = side * spool_estimate_[i];  // how far towards the wanted edge
-      if (x < band) command = side * lead(x, side * last_command_[i], std::abs(wanted), band);
+      if (x < band) {
+        command = side * lead(x, side * last_command_[i], std::abs(wanted), band, lag_alpha_[i]);
+      }
     }
     out.spool[i] = send(i, command);
   }
 }
 
-double ReferenceFollower::lead(double x, double last, double target, double band) const {
+double ReferenceFollower::lead(double x, double last, double target, double band,
+                               double alpha) const {
   // Sided coordinates: x the spool estimate, last the last command, target the wanted command.
   const double low = std::max(target, last - max_step_);
   // At most the wanted command plus the way to its band edge from neutral (the dead band's
@@ -132,11 +148,11 @@ double ReferenceFollower::lead(double x, double last, double target, double band
   if (!(high > low)) return std::max(low, std::min(target, high));
   // Where the estimate ends when the command c is sent now, then steps back to the target.
   auto peak = [&](double c) {
-    double e = x + lag_alpha_ * (c - x);
+    double e = x + alpha * (c - x);
     double top = e;
     for (int k = 0; k < kMaxLeadSteps && c > target; ++k) {
       c = std::max(c - max_step_, target);
-      e += lag_alpha_ * (c - e);
+      e += alpha * (c - e);
       top = std::max(top, e);
     }
     return top;

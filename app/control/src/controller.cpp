@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "craneassist/dynamics/cylinders.hpp"
+#include "craneassist/dynamics/valve_table.hpp"
 
 namespace craneassist::control {
 namespace {
@@ -42,8 +43,8 @@ Controller::Controller(const config::CraneConfig& config, const ControllerOption
   hold_error_m_ = config.control.activation_error_m;
   rest_timeout_cycles_ = std::lround(config.control.rest_timeout_s / period_s_);
   // At rest for the valves' lag: whatever was commanded before has arrived.
-  rest_confirm_cycles_ = std::max(
-      1L, std::lround((model_.valves.delay_s + model_.valves.time_constant_s) / period_s_));
+  rest_confirm_cycles_ =
+      std::max(1L, std::lround(dynamics::longest_valve_lag_s(model_) / period_s_));
   rest_arms_.setZero(n);
   chart_ = config.load_chart;
   known_payload_kg_ = dynamics::payload_mass_kg(model_);

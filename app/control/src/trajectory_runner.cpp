@@ -7,6 +7,7 @@
 #include "craneassist/control/log_row_builder.hpp"
 #include "craneassist/control/run_statistics.hpp"
 #include "craneassist/dynamics/kinematics.hpp"
+#include "craneassist/dynamics/valve_table.hpp"
 #include "craneassist/valves/reference_follower.hpp"
 
 namespace craneassist::control {
@@ -122,8 +123,7 @@ TrajectoryRunSummary run_trajectory(const config::CraneConfig& config,
                                 " joints, the crane " + std::to_string(n));
   }
   const double period = 1.0 / config.control.rate_hz;
-  const double preview_s =
-      options.preview ? model.valves.delay_s + model.valves.time_constant_s : 0.0;
+  const double preview_s = options.preview ? dynamics::longest_valve_lag_s(model) : 0.0;
   TrajectoryTask task(config, trajectory, preview_s);
   RunStatistics statistics(period);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <ostream>
 #include <stdexcept>
 #include <utility>
@@ -16,6 +17,11 @@
 
 namespace craneassist::offline {
 namespace {
+
+// The velocity, as a share of the section's top speed, at which a level counts as moving
+// (identify_valve_dynamics); a misfit of the onsets up to this is never refused.
+constexpr double kOnsetShare = 0.003;
+constexpr double kMinOnsetResidualS = 0.005;
 
 // The joint position of section i at the middle of its cylinder stroke (c(q) is monotone over the
 // joint range, config checks that).
@@ -85,7 +91,8 @@ class SweepTask final : public control::CycleTask {
     move_timeout_cycles_ = static_cast<long>(std::ceil(move.timeout_s / period_s_));
     spool_step_ = move.spool_rate_1_s * period_s_;
     spool_rate_1_s_ = move.spool_rate_1_s;
-    valve_lag_s_ = config.model.valves.delay_s + config.model.valves.time_constant_s;
+    valve_lag_s_ = dynamics::section_delay_s(config.model, section) +
+                   dynamics::section_time_constant_s(config.model, section);
     const int dof = config.model.dof();
     spool_.setZero(dof);
     target_.setZero(dof);
@@ -342,6 +349,22 @@ SectionCalibration fit_section(int section, std::vector<SweepPoint> points,
   return result;
 }
 
+// When a level's cylinder starts to move: the first time its velocity passes threshold_m_s the
+// level's way, interpolated between the cycles (NaN: never, or already at the level's start).
+double onset_time(const std::vector<const SweepLogRow*>& level, double threshold_m_s) {
+  const double side = level.front()->command > 0.0 ? 1.0 : -1.0;
+  for (std::size_t k = 1; k < level.size(); ++k) {
+    const double v0 = side * level[k - 1]->cylinder_velocity_m_s;
+    const double v1 = side * level[k]->cylinder_velocity_m_s;
+    if (v0 < threshold_m_s && v1 >= threshold_m_s) {
+      const double w = (threshold_m_s - v0) / (v1 - v0);
+      return level[k - 1]->t_s + w * (level[k]->t_s - level[k - 1]->t_s);
+    }
+    if (v0 >= threshold_m_s) break;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
 void check_section(const dynamics::CraneModel& model, int section) {
   if (section < 0 || section >= model.dof()) throw std::invalid_argument("no such section");
 }
@@ -358,6 +381,94 @@ std::string format_list(const std::vector<double>& values) {
 }
 
 }  // namespace
+
+ValveDynamics identify_valve_dynamics(const dynamics::ValveTable& table,
+                                      const std::vector<SweepLogRow>& rows, int section,
+                                      double max_residual) {
+  ValveDynamics out;
+  if (const std::string why = dynamics::check_valve_table(table); !why.empty()) {
+    out.why_not = "no usable table (" + why + ")";
+    return out;
+  }
+  const double top = std::max(-table.velocity_m_s.front(), table.velocity_m_s.back());
+  const double threshold = kOnsetShare * top;
+  // Each level's onset against ln(c / (c - x_on)), x_on the command at which the table passes
+  // the threshold: t_on = delay + time_constant * ln(c / (c - x_on)) for a spool that follows a
+  // step to c after the delay with a first-order lag.
+  std::vector<double> xs, ts;
+  std::vector<const SweepLogRow*> level;
+  auto close_level = [&] {
+    if (level.size() < 2) {
+      level.clear();
+      return;
+    }
+    const double c = level.front()->command;
+    const double side = c > 0.0 ? 1.0 : -1.0;
+    const double x_on = std::abs(dynamics::valve_table_command(table, side * threshold));
+    // Levels that move clearly (10 % of the top speed), with room between onset and level.
+    if (side * dynamics::valve_table_velocity(table, c) >= 0.1 * top && std::abs(c) > x_on) {
+      const double t_on = onset_time(level, threshold);
+      if (std::isfinite(t_on)) {
+        xs.push_back(std::log(std::abs(c) / (std::abs(c) - x_on)));
+        ts.push_back(t_on);
+      }
+    }
+    level.clear();
+  };
+  for (const auto& row : rows) {
+    if (row.section != section) continue;
+    if (row.t_s == 0.0) close_level();  // a level (or a level measured again) starts
+    level.push_back(&row);
+  }
+  close_level();
+  out.levels = static_cast<int>(xs.size());
+  if (xs.size() < 3) {
+    out.why_not =
+        "only " + std::to_string(xs.size()) +
+        " levels start moving clearly (3 needed: levels of 10 % of the top speed or more)";
+    return out;
+  }
+  // Least squares for t_on = delay + time_constant * x.
+  const double n = static_cast<double>(xs.size());
+  double sx = 0.0, st = 0.0, sxx = 0.0, sxt = 0.0;
+  for (std::size_t k = 0; k < xs.size(); ++k) {
+    sx += xs[k];
+    st += ts[k];
+    sxx += xs[k] * xs[k];
+    sxt += xs[k] * ts[k];
+  }
+  const double det = n * sxx - sx * sx;
+  char buf[200];
+  if (!(det > 1e-9 * n * n)) {
+    out.why_not = "the levels' onsets do not tell the delay from the lag (levels too alike)";
+    return out;
+  }
+  out.time_constant_s = (n * sxt - sx * st) / det;
+  out.delay_s = (st - out.time_constant_s * sx) / n;
+  double sum_sq = 0.0;
+  for (std::size_t k = 0; k < xs.size(); ++k) {
+    const double e = ts[k] - (out.delay_s + out.time_constant_s * xs[k]);
+    sum_sq += e * e;
+  }
+  out.residual_s = std::sqrt(sum_sq / n);
+  const double allowed = std::max(kMinOnsetResidualS, max_residual * out.time_constant_s);
+  if (!(out.time_constant_s > 0.0) || !(out.delay_s >= -kMinOnsetResidualS)) {
+    std::snprintf(buf, sizeof buf,
+                  "the onsets give no physical spool (delay %.3f s, time constant %.3f s)",
+                  out.delay_s, out.time_constant_s);
+    out.why_not = buf;
+  } else if (out.residual_s > allowed) {
+    std::snprintf(buf, sizeof buf,
+                  "the onsets do not fit a delayed first-order spool (rms misfit %.1f ms, at most "
+                  "%.1f ms)",
+                  1e3 * out.residual_s, 1e3 * allowed);
+    out.why_not = buf;
+  } else {
+    out.delay_s = std::max(out.delay_s, 0.0);
+    out.identified = true;
+  }
+  return out;
+}
 
 std::string check_levels(const std::vector<double>& levels) {
   if (levels.empty()) return "no level given";
@@ -396,10 +507,17 @@ SectionCalibration calibrate_section(const config::CraneConfig& config, int sect
   sim_backend::SimSettings settings = sim_settings(config);
   settings.q_initial[section] = mid_stroke_q(model, section);
 
+  // A simulated machine whose joint sensors are coarse, noisy or late is judged as a machine is.
+  CalibrationOptions placed = options;
+  if (!config.simulation.joints.exact())
+    placed.settled_tolerance = options.machine_settled_tolerance;
   std::vector<SweepPoint> points;
+  std::vector<SweepLogRow> own_log;  // the step responses, when the caller keeps no log
+  if (log == nullptr) log = &own_log;
+  const std::size_t first_row = log->size();
   for (double command : signed_commands(options.levels)) {
     sim_backend::SimBackend machine(model, settings);
-    SweepTask task(config, section, {command}, options, SweepTask::Mode::kPlaced, log);
+    SweepTask task(config, section, {command}, placed, SweepTask::Mode::kPlaced, log);
     control::LoopOptions loop;
     loop.period_s = period;
     loop.max_cycles = task.level_cycles() + 1;  // a bound: the task finishes after its level
@@ -407,7 +525,11 @@ SectionCalibration calibrate_section(const config::CraneConfig& config, int sect
     control::run_control_loop(task, machine, loop);
     points.insert(points.end(), task.points().begin(), task.points().end());
   }
-  return fit_section(section, std::move(points), options);
+  SectionCalibration result = fit_section(section, std::move(points), placed);
+  const std::vector<SweepLogRow> rows(log->begin() + static_cast<std::ptrdiff_t>(first_row),
+                                      log->end());
+  result.dynamics = identify_valve_dynamics(result.table, rows, section);
+  return result;
 }
 
 MachineSweep calibrate_section_on_machine(const config::CraneConfig& config,
@@ -418,6 +540,9 @@ MachineSweep calibrate_section_on_machine(const config::CraneConfig& config,
   check_section(config.model, section);
   const double rate = config.control.rate_hz;
   const std::vector<double> commands = signed_commands(options.levels);
+  std::vector<SweepLogRow> own_log;  // the step responses, when the caller keeps no log
+  if (log == nullptr) log = &own_log;
+  const std::size_t first_row = log->size();
   SweepTask task(config, section, commands, options, SweepTask::Mode::kMachine, log);
   control::LoopOptions loop;
   loop.period_s = 1.0 / rate;
@@ -456,6 +581,9 @@ MachineSweep calibrate_section_on_machine(const config::CraneConfig& config,
   }
   if (out.end == SweepEnd::kComplete) {
     out.section = fit_section(section, task.points(), options);
+    const std::vector<SweepLogRow> rows(log->begin() + static_cast<std::ptrdiff_t>(first_row),
+                                        log->end());
+    out.section.dynamics = identify_valve_dynamics(out.section.table, rows, section);
   } else {
     out.section.section = section;  // the points so far, unfitted
     out.section.points = task.points();
@@ -546,6 +674,12 @@ dynamics::ValveTable fit_valve_table(const std::vector<SweepPoint>& points, doub
   return t;
 }
 
+void apply_dynamics(const ValveDynamics& found, dynamics::ValveTable& table) {
+  if (!found.identified) return;
+  table.time_constant_s = kLeadTimeConstantShare * found.time_constant_s;
+  table.delay_s = found.delay_s;
+}
+
 std::string valve_tables_yaml(const dynamics::CraneModel& model,
                               const std::vector<SectionCalibration>& sections,
                               const std::string& comment) {
@@ -554,6 +688,19 @@ std::string valve_tables_yaml(const dynamics::CraneModel& model,
     out += "      " + model.joints[static_cast<std::size_t>(s.section)].name + ":\n";
     out += "        command: " + format_list(s.table.command) + ", measured\n";
     out += "        velocity: " + format_list(s.table.velocity_m_s) + " m/s, measured\n";
+    if (s.dynamics.identified) {
+      dynamics::ValveTable t;
+      apply_dynamics(s.dynamics, t);
+      char buf[320];
+      std::snprintf(
+          buf, sizeof buf,
+          "        # spool: delay %.4f s, time constant %.4f s measured (onsets' rms misfit "
+          "%.1f ms); the lead plans on %.0f %% of it\n"
+          "        time_constant: %.4f s, measured\n        delay: %.4f s, measured\n",
+          s.dynamics.delay_s, s.dynamics.time_constant_s, 1e3 * s.dynamics.residual_s,
+          100.0 * kLeadTimeConstantShare, t.time_constant_s, t.delay_s);
+      out += buf;
+    }
   }
   return out;
 }

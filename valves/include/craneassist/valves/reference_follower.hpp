@@ -12,12 +12,15 @@
 // correction changes side, instead of the small commands lagging behind the large ones and
 // bending the tip path; beyond the dead zone the wanted position passes unchanged. Every command,
 // neutral included, then moves at most period / hydraulics.valves.stroke_time from the last one
-// (the slew-rate limit of a valve driver's ramp). The lead is tuned to the model's spool lag: a
-// machine whose spools are much faster than hydraulics.valves.time_constant makes the lead
-// overshoot into flow (docs/valves.md). While a stop settles (hold()) there is no lead.
+// (the slew-rate limit of a valve driver's ramp). The lead is tuned to the section's spool lag:
+// its table's time constant and delay where craneassist calibrate measured them, else
+// hydraulics.valves'. A machine whose spools are much faster than that makes the lead overshoot
+// into flow and the feedback hunt (docs/valves.md#the-machine-it-meets): identify them first.
+// While a stop settles (hold()) there is no lead.
 // Preallocated history; update() allocates nothing.
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "craneassist/dynamics/model.hpp"
@@ -71,8 +74,9 @@ class ReferenceFollower {
   // update() and hold(): the wanted commands (DZI plus P), the lead, the slew-rate limit.
   void follow(const JointVector& q_ref, const JointVector& qdot_ref, const JointVector* q_meas,
               double hold_error_m, bool with_lead, ValveCommand& out);
-  // The dead-band lead in a section's sided coordinates (docs/valves.md).
-  double lead(double x, double last, double target, double band) const;
+  // The dead-band lead in a section's sided coordinates (docs/valves.md), planned with the
+  // lag factor alpha per period.
+  double lead(double x, double last, double target, double band, double alpha) const;
   // command moved at most max_step_ from section i's last command; the estimate follows.
   double send(int i, double command);
 
@@ -84,10 +88,13 @@ class ReferenceFollower {
   JointVector last_command_;  // what was sent last cycle
   JointVector zero_;
   double period_s_;
-  bool lead_ = true;       // every command reaches the valves: the dead-zone lead is safe
-  double lag_alpha_;       // share of the remaining spool travel the lag covers in one period
-  double max_step_ = 2.0;  // the slew-rate limit per update (2: none)
-  std::vector<JointVector> q_ref_history_;
+  bool lead_ = true;  // every command reaches the valves: the dead-zone lead is safe
+  // Per section: the share of the remaining spool travel the lag covers in one period, and the
+  // valve's delay plus lag in periods (the reference's age for the feedback).
+  JointVector lag_alpha_;
+  std::array<std::size_t, dynamics::kMaxJoints> lag_cycles_{};
+  double max_step_ = 2.0;                   // the slew-rate limit per update (2: none)
+  std::vector<JointVector> q_ref_history_;  // the longest lag's
   std::size_t head_ = 0;
 };
 

@@ -81,8 +81,25 @@ struct SweepLogRow {
   bool measuring = false;
 };
 
+// A section's spool dynamics identified from the sweep's step responses (every level starts
+// with a step from neutral): when the cylinder starts to move (its velocity passing 0.3 % of the
+// top speed) depends on the level c through the spool's travel across the dead band,
+// t_on = delay + time_constant * ln(c / (c - x_on)), x_on the command at which the fitted table
+// passes that speed; a line fitted through the levels' onsets (those moving at 10 % of the top
+// speed or more) gives both. The onset is set by the spool alone: the mass's acceleration, which
+// shapes the rise after it, does not enter.
+struct ValveDynamics {
+  bool identified = false;
+  double delay_s = 0.0;
+  double time_constant_s = 0.0;
+  double residual_s = 0.0;  // rms misfit of the onsets
+  int levels = 0;           // onsets fitted
+  std::string why_not;      // when not identified
+};
+
 struct SectionCalibration {
   int section = 0;
+  ValveDynamics dynamics;
   std::vector<SweepPoint> points;                          // ascending command, (0, 0) included
   dynamics::ValveTable table;                              // monotone fit
   double dead_band_retract = 0.0, dead_band_extend = 0.0;  // signed edges of the fitted table
@@ -133,7 +150,25 @@ MachineSweep calibrate_section_on_machine(const config::CraneConfig& config,
 // dynamics::check_valve_table when the points move both ways.
 dynamics::ValveTable fit_valve_table(const std::vector<SweepPoint>& points, double zero_speed_m_s);
 
-// The YAML block to paste under hydraulics.valves (indented for it).
+// Identifies section `section`'s spool delay and time constant from its rows of a sweep log
+// (each level's rows from its step, t since the level started) and its fitted table. Not
+// identified, with the reason, when the table is unusable, fewer than 3 levels start moving
+// clearly, the fit gives no physical spool, or its rms misfit exceeds max_residual times the
+// time constant (and 5 ms).
+ValveDynamics identify_valve_dynamics(const dynamics::ValveTable& table,
+                                      const std::vector<SweepLogRow>& rows, int section,
+                                      double max_residual = 0.2);
+
+// The identified dynamics as the controller is given them (the table's time_constant and delay):
+// the delay as measured, the time constant kLeadTimeConstantShare of the measured one. The
+// dead-band lead overshoots into flow on a spool faster than the one it plans for, and a few
+// per cent too slow a plan already makes it hunt (docs/valves.md#the-machine-it-meets), so the
+// plan errs on the fast side by more than the identification's error (3 % on the simulator).
+inline constexpr double kLeadTimeConstantShare = 0.95;
+void apply_dynamics(const ValveDynamics& found, dynamics::ValveTable& table);
+
+// The YAML block to paste under hydraulics.valves (indented for it): each section's table and,
+// where identified, its spool time constant and delay (apply_dynamics).
 std::string valve_tables_yaml(const dynamics::CraneModel& model,
                               const std::vector<SectionCalibration>& sections,
                               const std::string& comment);
