@@ -1,6 +1,7 @@
 // `craneassist suite MANIFEST`: run a scenario suite (examples/replays/suite.yaml) on the simulated
 // crane, print each run's operator-feel figures against its targets, and the pump energy over the
-// suite per resolution (docs/suite-format.md, docs/scaling.md#operator-feel).
+// suite per resolution (docs/suite-format.md, docs/scaling.md#operator-feel); with --variants the
+// whole suite on every machine variant and a robustness matrix (docs/valves.md).
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -14,6 +15,11 @@ struct SuiteArgs {
   std::string resolution;   // empty: the config's; a name, or "all"
   std::string log_dir;      // empty: no logs
   std::string only;         // run only the runs whose name contains this
+  std::string variants;     // machine variants file (empty: the config's machine only)
+  std::string matrix_csv;   // one row per variant, resolution and run (empty: none)
+  // Before each variant's runs, calibrate its valves on the simulated machine (the sweep of
+  // craneassist calibrate) and run with the tables and spool dynamics found.
+  bool calibrated = false;
 };
 
 CLI::App* add_suite_command(CLI::App& cli, SuiteArgs& args);

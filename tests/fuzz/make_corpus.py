@@ -80,6 +80,7 @@ for name, text in (("folded.txt", "lift=0 deg, tilt=-125 deg, extension=0.2 m"),
     write("fuzz_joint_pose", name, text)
 write("fuzz_suite_manifest", "suite.yaml", read("examples/replays/suite.yaml"))
 write("fuzz_suite_manifest", "loading.yaml", read("examples/replays/loading.yaml"))
+write("fuzz_suite_manifest", "variants.yaml", read("examples/machines/variants.yaml"))
 write("fuzz_suite_manifest", "baseline_fields.yaml",
       "format: craneassist-suite/1\nruns:\n  - replay: demo.csv\n    scaling: flow\n"
       "    sway_damping: false\n    wait_swing: 3 deg\n"

@@ -2,6 +2,7 @@
 // targets merged per run, and every mistake named by file, line and field.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "craneassist/config/crane_config.hpp"
@@ -165,4 +166,48 @@ TEST(ScenarioSuite, AWaitingRunMissesItsCycleTimeAndTimeoutTargets) {
   EXPECT_NE(out.missed[0].find("residual swing"), std::string::npos) << out.missed[0];
   EXPECT_NE(out.missed[1].find("cycle time"), std::string::npos) << out.missed[1];
   EXPECT_NE(out.missed[2].find("timed-out waits"), std::string::npos) << out.missed[2];
+}
+
+// Machine variants (docs/suite-format.md#machine-variants): the shipped file loads against the
+// K70M, its fields reach the simulated machine, its targets replace the suite's; mistakes are
+// named by file, line and field.
+TEST(ScenarioSuite, MachineVariantsLoadApplyAndNameTheirMistakes) {
+  const auto cfg = config::default_crane_config();
+  const auto variants = offline::load_variants(
+      std::filesystem::path(CRANEASSIST_SOURCE_DIR) / "examples/machines/variants.yaml", cfg);
+  ASSERT_GE(variants.size(), 10u);
+  EXPECT_EQ(variants.front().name, "model");
+  for (const auto& v : variants.front().valves) EXPECT_TRUE(std::isnan(v.time_constant_s));
+  ASSERT_TRUE(variants.front().targets.direction_error_p95_rad);
+  EXPECT_NEAR(*variants.front().targets.direction_error_p95_rad, 2.0 * M_PI / 180.0, 1e-12);
+
+  const auto parsed = offline::parse_variants(
+      "format: craneassist-variants/1\nvariants:\n  - name: fast\n    simulation:\n"
+      "      valves: {time_constant: 25 ms, lift: {gain: 0.8}}\n"
+      "      feedback: {jitter: 5 ms}\n    targets: {stop_timeouts: 0}\n",
+      "v.yaml", cfg);
+  ASSERT_EQ(parsed.size(), 1u);
+  const auto machine = parsed[0].apply(cfg);
+  EXPECT_DOUBLE_EQ(machine.simulation.valves[0].time_constant_s, 0.025);
+  EXPECT_DOUBLE_EQ(machine.simulation.valves[1].gain, 0.8);
+  EXPECT_DOUBLE_EQ(machine.simulation.valves[2].gain, 1.0);
+  EXPECT_DOUBLE_EQ(machine.simulation.joints.feedback_jitter_s, 0.005);
+  EXPECT_EQ(parsed[0].targets.stop_timeouts, 0);
+  EXPECT_TRUE(std::isnan(cfg.simulation.valves[0].time_constant_s)) << "the base untouched";
+
+  auto error = [&](const std::string& yaml) {
+    return test::thrown_error<config::ConfigError>(
+        [&] { offline::parse_variants(yaml, "v.yaml", cfg); }, "no error for:\n" + yaml);
+  };
+  const std::string head = "format: craneassist-variants/1\nvariants:\n";
+  auto e = error(head + "  - name: a\n    simulation: {valves: {boom: {gain: 2}}}\n");
+  EXPECT_EQ(e.file(), "v.yaml");
+  EXPECT_EQ(e.line(), 4);
+  EXPECT_EQ(e.field(), "variants[0].simulation.valves.boom");
+  EXPECT_EQ(error(head + "  - name: a\n    simulation: {step: 1 ms}\n").field(),
+            "variants[0].simulation.step");
+  EXPECT_EQ(error(head + "  - name: a\n  - name: a\n").field(), "variants[1].name");
+  EXPECT_EQ(error("format: craneassist-variants/2\nvariants:\n  - name: a\n").field(), "format");
+  EXPECT_EQ(error(head + "  - name: a\n    targets: {direction_error_p95: 2 m}\n").field(),
+            "variants[0].targets.direction_error_p95");
 }

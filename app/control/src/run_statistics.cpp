@@ -110,6 +110,10 @@ void RunStatistics::on_cycle(const CycleRecord& c) noexcept {
     s_.max_direction_error_deg = std::max(s_.max_direction_error_deg, err);
     sum_sq_direction_ += err * err;
     ++s_.direction_samples;
+    const int bin = err < 10.0
+                        ? static_cast<int>(err * 100.0)
+                        : kFineBins + std::min(static_cast<int>(err - 10.0), kCoarseBins - 1);
+    ++direction_bins_[static_cast<std::size_t>(std::clamp(bin, 0, kFineBins + kCoarseBins - 1))];
     // The displacement over the window lies within the steady command (window <= steady_after).
     const long now = tip_count_ - 1, then = now - window_;
     if (then >= 0 && tips_valid_[slot(now)] && tips_valid_[slot(then)]) {
@@ -240,6 +244,16 @@ RunSummary RunStatistics::summary(const LoopSummary& loop) const {
       s.direction_samples > 0
           ? std::sqrt(sum_sq_direction_ / static_cast<double>(s.direction_samples))
           : 0.0;
+  // The p95: the upper edge of the bin where the count passes 95 %.
+  long seen = 0;
+  for (int b = 0; b < kFineBins + kCoarseBins && s.direction_samples > 0; ++b) {
+    seen += direction_bins_[static_cast<std::size_t>(b)];
+    if (20 * seen >= 19 * s.direction_samples) {
+      s.p95_direction_error_deg = std::min(
+          b < kFineBins ? 0.01 * (b + 1) : 10.0 + (b - kFineBins + 1), s.max_direction_error_deg);
+      break;
+    }
+  }
   s.rms_position_direction_error_deg =
       position_samples_ > 0
           ? std::sqrt(sum_sq_position_direction_ / static_cast<double>(position_samples_))

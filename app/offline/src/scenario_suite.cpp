@@ -45,10 +45,16 @@ class SuiteReader : public config::YamlReader {
   }
 
   void targets(const YAML::Node& node, const std::string& path, SuiteTargets& t) const {
-    check_keys(node, path,
-               {"stall_events", "lateral_speed", "peak_power", "direction_error", "residual_swing",
-                "cycle_time", "timed_out_waits", "overload_cycles"});
+    check_keys(
+        node, path,
+        {"stall_events", "lateral_speed", "peak_power", "direction_error", "direction_error_p95",
+         "stop_timeouts", "residual_swing", "cycle_time", "timed_out_waits", "overload_cycles"});
     if (auto v = count(node, "stall_events", path)) t.stall_events = v;
+    if (auto v = count(node, "stop_timeouts", path)) t.stop_timeouts = v;
+    if (node["direction_error_p95"].IsDefined()) {
+      t.direction_error_p95_rad =
+          quantity(node, "direction_error_p95", path, config::Dimension::kAngle, 0.0, M_PI);
+    }
     if (auto v = count(node, "timed_out_waits", path)) t.timed_out_waits = v;
     if (auto v = count(node, "overload_cycles", path)) t.overload_cycles = v;
     if (node["residual_swing"].IsDefined()) {
@@ -78,6 +84,8 @@ void merge(const SuiteTargets& over, SuiteTargets& t) {
   if (over.lateral_speed_m_s) t.lateral_speed_m_s = over.lateral_speed_m_s;
   if (over.peak_power_share) t.peak_power_share = over.peak_power_share;
   if (over.direction_error_rad) t.direction_error_rad = over.direction_error_rad;
+  if (over.direction_error_p95_rad) t.direction_error_p95_rad = over.direction_error_p95_rad;
+  if (over.stop_timeouts) t.stop_timeouts = over.stop_timeouts;
   if (over.residual_swing_rad) t.residual_swing_rad = over.residual_swing_rad;
   if (over.cycle_time_s) t.cycle_time_s = over.cycle_time_s;
   if (over.timed_out_waits) t.timed_out_waits = over.timed_out_waits;
@@ -228,8 +236,73 @@ Suite load_suite(const std::filesystem::path& path) {
                      path.parent_path());
 }
 
+config::CraneConfig SuiteVariant::apply(const config::CraneConfig& cfg) const {
+  config::CraneConfig out = cfg;
+  out.simulation.valves = valves;
+  out.simulation.joints = joints;
+  return out;
+}
+
+std::vector<SuiteVariant> parse_variants(std::string_view yaml_text, std::string_view source_name,
+                                         const config::CraneConfig& cfg) {
+  return config::read_yaml(yaml_text, source_name, [&](const YAML::Node& root) {
+    constexpr const char* kVariantsFormat = "craneassist-variants/1";
+    const SuiteReader r{std::string(source_name)};
+    r.check_keys(root, "", {"format", "targets", "variants"});
+    const std::string format = r.text(root, "format", "");
+    if (format != kVariantsFormat) {
+      r.fail(root["format"], "format",
+             "unsupported format '" + format + "' (expected " + kVariantsFormat + ")");
+    }
+    SuiteTargets defaults;
+    if (root["targets"].IsDefined()) r.targets(root["targets"], "targets", defaults);
+    const YAML::Node list = r.child(root, "variants", "");
+    if (!list.IsSequence() || list.size() == 0) {
+      r.fail(list, "variants", "expected a list of variants");
+    }
+    std::vector<SuiteVariant> out;
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const YAML::Node node = list[k];
+      const std::string path = "variants[" + std::to_string(k) + "]";
+      r.check_keys(node, path, {"name", "simulation", "targets"});
+      SuiteVariant v;
+      v.line = node.Mark().line + 1;
+      v.name = r.text(node, "name", path);
+      for (const auto& other : out) {
+        if (other.name == v.name) r.fail(node["name"], path + ".name", "a second '" + v.name + "'");
+      }
+      config::CraneConfig machine = cfg;
+      if (node["simulation"].IsDefined()) {
+        config::apply_simulated_machine(node["simulation"], std::string(source_name),
+                                        path + ".simulation", machine);
+      }
+      v.valves = machine.simulation.valves;
+      v.joints = machine.simulation.joints;
+      v.targets = defaults;
+      if (node["targets"].IsDefined()) {
+        SuiteTargets own;
+        r.targets(node["targets"], path + ".targets", own);
+        merge(own, v.targets);
+      }
+      out.push_back(std::move(v));
+    }
+    return out;
+  });
+}
+
+std::vector<SuiteVariant> load_variants(const std::filesystem::path& path,
+                                        const config::CraneConfig& cfg) {
+  return parse_variants(config::read_yaml_file(path, "variants file"), path.string(), cfg);
+}
+
 SuiteOutcome run_suite_run(const config::CraneConfig& base, const SuiteRun& run,
                            const std::string& resolution, const std::filesystem::path& log_file) {
+  return run_suite_run(base, run, SuiteTargets{}, resolution, log_file);
+}
+
+SuiteOutcome run_suite_run(const config::CraneConfig& base, const SuiteRun& run,
+                           const SuiteTargets& over, const std::string& resolution,
+                           const std::filesystem::path& log_file) {
   config::CraneConfig cfg = base;
   config::set_payload_mass(cfg.model, run.payload_kg);
   if (!run.pose_text.empty()) {
@@ -251,7 +324,8 @@ SuiteOutcome run_suite_run(const config::CraneConfig& base, const SuiteRun& run,
   out.p_max_w = cfg.model.pump.prime_mover_power_w;
 
   const auto& s = out.summary;
-  const auto& t = run.targets;
+  SuiteTargets t = run.targets;
+  merge(over, t);
   if (t.stall_events && s.feel.stall_events > *t.stall_events) {
     out.missed.push_back("stall events " + std::to_string(s.feel.stall_events) + " > " +
                          std::to_string(*t.stall_events));
@@ -267,6 +341,15 @@ SuiteOutcome run_suite_run(const config::CraneConfig& base, const SuiteRun& run,
   if (t.direction_error_rad && s.max_direction_error_deg * M_PI / 180.0 > *t.direction_error_rad) {
     out.missed.push_back(figure("direction error %.2f deg", s.max_direction_error_deg) +
                          figure(" > %.2f", *t.direction_error_rad * 180.0 / M_PI));
+  }
+  if (t.direction_error_p95_rad &&
+      s.p95_direction_error_deg * M_PI / 180.0 > *t.direction_error_p95_rad) {
+    out.missed.push_back(figure("direction error p95 %.2f deg", s.p95_direction_error_deg) +
+                         figure(" > %.2f", *t.direction_error_p95_rad * 180.0 / M_PI));
+  }
+  if (t.stop_timeouts && s.stop.timeouts > *t.stop_timeouts) {
+    out.missed.push_back("stops still moving at neutral " + std::to_string(s.stop.timeouts) +
+                         " > " + std::to_string(*t.stop_timeouts));
   }
   const double residual = s.waits.residual_swing_deg;
   if (t.residual_swing_rad && std::isfinite(residual) &&

@@ -109,6 +109,8 @@ struct RunSummary {
   // Angle between commanded and measured tip velocity (steady cycles, see RunStatisticsOptions).
   double max_direction_error_deg = 0.0;
   double rms_direction_error_deg = 0.0;
+  // The 95th percentile of the same cycles (within 0.01 deg below 10 deg, 1 deg above).
+  double p95_direction_error_deg = 0.0;
   long direction_samples = 0;
   // The same cycles, the angle between the command and the tip's displacement over the last
   // position_window_s (what the tip did, free of the velocity estimate's noise).
@@ -159,6 +161,9 @@ class RunStatistics final : public CycleObserver {
   RunSummary s_;
   MotionQuality quality_;
   double sum_sq_direction_ = 0.0;
+  // Direction errors counted by bin (the p95): 0.01 deg bins up to 10 deg, then 1 deg bins.
+  static constexpr int kFineBins = 1000, kCoarseBins = 171;
+  std::array<long, kFineBins + kCoarseBins> direction_bins_{};
   Eigen::Vector3d last_cmd_ = Eigen::Vector3d::Zero();
   double cmd_since_s_ = 0.0;
   Eigen::Vector3d last_tip_ = Eigen::Vector3d::Zero();

@@ -18,10 +18,12 @@
 namespace craneassist::offline {
 
 struct SuiteTargets {
-  std::optional<int> stall_events;            // at most this many
-  std::optional<double> lateral_speed_m_s;    // one-line replays only, over 50 ms
-  std::optional<double> peak_power_share;     // measured pump power over P_max
-  std::optional<double> direction_error_rad;  // commanded vs measured, steady cycles
+  std::optional<int> stall_events;                // at most this many
+  std::optional<double> lateral_speed_m_s;        // one-line replays only, over 50 ms
+  std::optional<double> peak_power_share;         // measured pump power over P_max
+  std::optional<double> direction_error_rad;      // commanded vs measured, steady cycles: the max
+  std::optional<double> direction_error_p95_rad;  // the same cycles' 95th percentile
+  std::optional<int> stop_timeouts;  // stops that reached neutral still moving (rest_timeout)
   // Replays with wait rows (docs/replay-format.md#waits): the residual swing (the largest from
   // 1 s into a wait), the cycle time (the last row's time plus the waits), waits that timed out.
   std::optional<double> residual_swing_rad;
@@ -75,11 +77,36 @@ struct SuiteOutcome {
   bool ok() const { return missed.empty(); }
 };
 
+// A machine the suite runs on besides the config's own (`craneassist suite --variants FILE`,
+// format craneassist-variants/1, docs/suite-format.md#machine-variants): the simulated machine's
+// valves, joint sensors and feedback where they differ from the controller's model, and targets
+// that replace the suite's for its runs.
+struct SuiteVariant {
+  std::string name;
+  int line = 0;
+  dynamics::ValveDeviations valves{};
+  dynamics::JointSensing joints{};
+  SuiteTargets targets;  // over each run's own
+  // cfg with this machine (cfg.simulation.valves and joints replaced).
+  config::CraneConfig apply(const config::CraneConfig& cfg) const;
+};
+
+// Read and validate a variants file against the crane that runs them (joint names); throw
+// config::ConfigError naming the file, line and field.
+std::vector<SuiteVariant> load_variants(const std::filesystem::path& path,
+                                        const config::CraneConfig& cfg);
+std::vector<SuiteVariant> parse_variants(std::string_view yaml_text, std::string_view source_name,
+                                         const config::CraneConfig& cfg);
+
 // Runs one entry on the simulated crane described by base (its payload and start pose applied)
 // with the given resolution (a name config::set_resolution takes; empty: base's). log_file empty:
 // no log. Throws what loading the replay or the pose throws (the manifest was checked, so only
 // for files changed since).
 SuiteOutcome run_suite_run(const config::CraneConfig& base, const SuiteRun& run,
                            const std::string& resolution, const std::filesystem::path& log_file);
+// The same with the variant's targets over the run's.
+SuiteOutcome run_suite_run(const config::CraneConfig& base, const SuiteRun& run,
+                           const SuiteTargets& over, const std::string& resolution,
+                           const std::filesystem::path& log_file);
 
 }  // namespace craneassist::offline
