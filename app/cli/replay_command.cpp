@@ -214,11 +214,11 @@ void print_summary(const control::RunSummary& s, const config::CraneConfig& cfg,
   std::printf("  tip: path %.2f m, peak speed %.2f m/s\n", s.tip_path_m, s.peak_tip_speed_m_s);
   std::printf(
       "  tip direction error, commanded vs measured (steady, > 0.05 m/s): max %.2f deg, "
-      "p95 %.2f deg, rms %.2f deg over %ld cycles; from the tip's displacement over %.0f ms: "
-      "max %.2f deg, rms %.2f deg\n",
-      s.max_direction_error_deg, s.p95_direction_error_deg, s.rms_direction_error_deg,
-      s.direction_samples, s.position_window_s * 1e3, s.max_position_direction_error_deg,
-      s.rms_position_direction_error_deg);
+      "rms %.2f deg over %ld cycles; from the tip's displacement over %.0f ms: max %.2f deg, "
+      "rms %.2f deg; p95 (velocity) %.2f deg\n",
+      s.max_direction_error_deg, s.rms_direction_error_deg, s.direction_samples,
+      s.position_window_s * 1e3, s.max_position_direction_error_deg,
+      s.rms_position_direction_error_deg, s.p95_direction_error_deg);
   print_pump_line(s.energy_j, s.peak_power_w, s.peak_flow_m3_s, s.pump_saturated_cycles, cfg);
   if (s.stopped_cycles > 0) {
     std::printf(
