@@ -53,6 +53,10 @@ void CanBackend::start_claim(std::int64_t now_us) {
   const SendStatus st = m.transport.send(m.network_frame);
   m.claim_unsent = st != SendStatus::kOk;
   if (st == SendStatus::kOk) {
+    // J1939-81's 250 ms count from the claim on the bus, not from before it was sent: the
+    // claim's clock starts again once the frame is out (a frame stamped 20 us after now_us made
+    // the first command 249.98 ms after the claim under AddressSanitizer).
+    m.claimer->start(std::max(now_us, mono_us()), m.network_frame);
     m.counters.frames_sent.fetch_add(1, std::memory_order_relaxed);
     m.counters.claim_frames_sent.fetch_add(1, std::memory_order_relaxed);
     if (m.log_file != nullptr &&
