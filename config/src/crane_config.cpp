@@ -10,6 +10,7 @@
 #include <fstream>
 #include <initializer_list>
 #include <numbers>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 
@@ -103,6 +104,13 @@ class Reader : public YamlReader {
   double value_in(const YAML::Node& map, const std::string& key, const std::string& path,
                   Dimension dimension, const FieldRange& range) {
     return value_in(map, key, path, dimension, range.lo, range.hi, range.text);
+  }
+
+  // An optional value in [lo, hi]: out keeps its value when the key is absent.
+  void optional_value_in(const YAML::Node& map, const std::string& key, const std::string& path,
+                         Dimension dimension, double lo, double hi, const std::string& range_text,
+                         double& out) {
+    if (map[key].IsDefined()) out = value_in(map, key, path, dimension, lo, hi, range_text);
   }
 
   // `count` values, each in the range.
@@ -377,6 +385,14 @@ void read_bodies(Reader& r, const YAML::Node& root, dynamics::CraneModel& model)
   model.bodies.push_back(p);
 }
 
+// The index of the joint of that name, or model.joints.size() when there is none.
+std::size_t joint_index(const dynamics::CraneModel& model, const std::string& name) {
+  for (std::size_t i = 0; i < model.joints.size(); ++i) {
+    if (model.joints[i].name == name) return i;
+  }
+  return model.joints.size();
+}
+
 // hydraulics.valves.tables: the measured characteristic of some sections, by joint name
 // (craneassist calibrate writes this block); the others keep the straight line.
 void read_valve_tables(Reader& r, const YAML::Node& tables, const std::string& path,
@@ -386,24 +402,17 @@ void read_valve_tables(Reader& r, const YAML::Node& tables, const std::string& p
   for (const auto& kv : tables) {
     const std::string name = kv.first.Scalar();
     const std::string tp = path + "." + name;
-    std::size_t index = model.joints.size();
-    for (std::size_t i = 0; i < model.joints.size(); ++i) {
-      if (model.joints[i].name == name) index = i;
-    }
+    const std::size_t index = joint_index(model, name);
     if (index == model.joints.size()) r.fail(kv.first, tp, "no joint of that name");
     const YAML::Node entry = kv.second;
     r.check_keys(entry, tp, {"command", "velocity", "time_constant", "delay"});
     dynamics::ValveTable table;
     table.command = r.values(entry, "command", tp, Dimension::kDimensionless, 0);
     table.velocity_m_s = r.values(entry, "velocity", tp, Dimension::kVelocity, 0);
-    if (entry["time_constant"].IsDefined()) {
-      table.time_constant_s =
-          r.value_in(entry, "time_constant", tp, Dimension::kTime, 0.0, 5.0, "between 0 and 5 s");
-    }
-    if (entry["delay"].IsDefined()) {
-      table.delay_s =
-          r.value_in(entry, "delay", tp, Dimension::kTime, 0.0, 1.0, "between 0 and 1 s");
-    }
+    r.optional_value_in(entry, "time_constant", tp, Dimension::kTime, 0.0, 5.0, "between 0 and 5 s",
+                        table.time_constant_s);
+    r.optional_value_in(entry, "delay", tp, Dimension::kTime, 0.0, 1.0, "between 0 and 1 s",
+                        table.delay_s);
     if (const std::string why = dynamics::check_valve_table(table); !why.empty()) {
       const bool about_command = why.rfind("command", 0) == 0;  // else about the velocities
       r.fail(entry[about_command ? "command" : "velocity"],
@@ -571,20 +580,23 @@ void read_simulated_grapple(Reader& r, const YAML::Node& sim, CraneConfig& cfg) 
   cfg.simulation.grapple = g;
 }
 
-// One valve section's deviation fields (simulation.valves and its per-joint entries): the ones
-// present replace those in v.
+// The valve deviation fields present in node (simulation.valves, or a joint's entry in it), each
+// read once and given to every section in `sections`.
 void read_valve_deviation(Reader& r, const YAML::Node& node, const std::string& path,
-                          dynamics::ValveDeviation& v) {
-  auto opt = [&](const char* key, Dimension dim, double lo, double hi, const char* range,
-                 double& out) {
-    if (node[key].IsDefined()) out = r.value_in(node, key, path, dim, lo, hi, range);
+                          std::span<dynamics::ValveDeviation> sections) {
+  using D = dynamics::ValveDeviation;
+  auto field = [&](const char* key, Dimension dim, double lo, double hi, const char* range,
+                   double D::*member) {
+    if (!node[key].IsDefined()) return;
+    const double v = r.value_in(node, key, path, dim, lo, hi, range);
+    for (auto& section : sections) section.*member = v;
   };
-  opt("time_constant", Dimension::kTime, 0.0, 5.0, "between 0 and 5 s", v.time_constant_s);
-  opt("delay", Dimension::kTime, 0.0, 1.0, "between 0 and 1 s", v.delay_s);
-  opt("dead_zone", Dimension::kDimensionless, 0.0, 0.95, "between 0 and 0.95", v.dead_zone);
-  opt("gain", Dimension::kDimensionless, 0.1, 10.0, "between 0.1 and 10", v.gain);
-  opt("shape", Dimension::kDimensionless, 0.2, 5.0, "between 0.2 and 5", v.shape);
-  opt("hysteresis", Dimension::kDimensionless, 0.0, 0.5, "between 0 and 0.5", v.hysteresis);
+  field("time_constant", Dimension::kTime, 0.0, 5.0, "between 0 and 5 s", &D::time_constant_s);
+  field("delay", Dimension::kTime, 0.0, 1.0, "between 0 and 1 s", &D::delay_s);
+  field("dead_zone", Dimension::kDimensionless, 0.0, 0.95, "between 0 and 0.95", &D::dead_zone);
+  field("gain", Dimension::kDimensionless, 0.1, 10.0, "between 0.1 and 10", &D::gain);
+  field("shape", Dimension::kDimensionless, 0.2, 5.0, "between 0.2 and 5", &D::shape);
+  field("hysteresis", Dimension::kDimensionless, 0.0, 0.5, "between 0 and 0.5", &D::hysteresis);
 }
 
 // simulation.valves, simulation.joint_sensors, simulation.feedback: where the simulated machine
@@ -603,23 +615,11 @@ void read_simulated_machine(Reader& r, const YAML::Node& sim, const std::string&
     static constexpr std::array kFields{"time_constant", "delay", "dead_zone",
                                         "gain",          "shape", "hysteresis"};
     // The fields for every section first, then each joint's own.
-    dynamics::ValveDeviation all;
-    read_valve_deviation(r, valves, vp, all);
-    for (auto& v : cfg.simulation.valves) {
-      if (valves["time_constant"].IsDefined()) v.time_constant_s = all.time_constant_s;
-      if (valves["delay"].IsDefined()) v.delay_s = all.delay_s;
-      if (valves["dead_zone"].IsDefined()) v.dead_zone = all.dead_zone;
-      if (valves["gain"].IsDefined()) v.gain = all.gain;
-      if (valves["shape"].IsDefined()) v.shape = all.shape;
-      if (valves["hysteresis"].IsDefined()) v.hysteresis = all.hysteresis;
-    }
+    read_valve_deviation(r, valves, vp, cfg.simulation.valves);
     for (const auto& kv : valves) {
       const std::string key = kv.first.Scalar();
       if (std::find(kFields.begin(), kFields.end(), key) != kFields.end()) continue;
-      std::size_t index = joints.size();
-      for (std::size_t i = 0; i < joints.size(); ++i) {
-        if (joints[i].name == key) index = i;
-      }
+      const std::size_t index = joint_index(cfg.model, key);
       if (index == joints.size()) {
         std::string list;
         for (const char* f : kFields) list += std::string(f) + ", ";
@@ -629,7 +629,7 @@ void read_simulated_machine(Reader& r, const YAML::Node& sim, const std::string&
       const std::string jp = vp + "." + key;
       r.check_keys(kv.second, jp,
                    {"time_constant", "delay", "dead_zone", "gain", "shape", "hysteresis"});
-      read_valve_deviation(r, kv.second, jp, cfg.simulation.valves[index]);
+      read_valve_deviation(r, kv.second, jp, std::span(&cfg.simulation.valves[index], 1));
     }
   }
   auto& js = cfg.simulation.joints;
@@ -638,28 +638,24 @@ void read_simulated_machine(Reader& r, const YAML::Node& sim, const std::string&
           {"angle_noise", "angle_resolution", "length_noise", "length_resolution", "delay"})) {
     const YAML::Node& n = *sensors;
     const std::string p = prefix + ".joint_sensors";
-    auto opt = [&](const char* key, Dimension dim, double hi, const char* range, double& out) {
-      if (n[key].IsDefined()) out = r.value_in(n, key, p, dim, 0.0, hi, range);
-    };
-    opt("angle_noise", Dimension::kAngle, 0.1, "between 0 and 5.7 deg", js.angle_noise_rad);
-    opt("angle_resolution", Dimension::kAngle, 0.1, "between 0 and 5.7 deg",
-        js.angle_resolution_rad);
-    opt("length_noise", Dimension::kLength, 0.1, "between 0 and 0.1 m", js.length_noise_m);
-    opt("length_resolution", Dimension::kLength, 0.1, "between 0 and 0.1 m",
-        js.length_resolution_m);
-    opt("delay", Dimension::kTime, 1.0, "between 0 and 1 s", js.delay_s);
+    const std::string angle = "between 0 and 5.7 deg", length = "between 0 and 0.1 m";
+    r.optional_value_in(n, "angle_noise", p, Dimension::kAngle, 0.0, 0.1, angle,
+                        js.angle_noise_rad);
+    r.optional_value_in(n, "angle_resolution", p, Dimension::kAngle, 0.0, 0.1, angle,
+                        js.angle_resolution_rad);
+    r.optional_value_in(n, "length_noise", p, Dimension::kLength, 0.0, 0.1, length,
+                        js.length_noise_m);
+    r.optional_value_in(n, "length_resolution", p, Dimension::kLength, 0.0, 0.1, length,
+                        js.length_resolution_m);
+    r.optional_value_in(n, "delay", p, Dimension::kTime, 0.0, 1.0, "between 0 and 1 s", js.delay_s);
   }
   if (const auto fb = r.optional_section(sim, "feedback", prefix, {"delay", "jitter"})) {
     const YAML::Node& n = *fb;
     const std::string p = prefix + ".feedback";
-    if (n["delay"].IsDefined()) {
-      js.feedback_delay_s =
-          r.value_in(n, "delay", p, Dimension::kTime, 0.0, 1.0, "between 0 and 1 s");
-    }
-    if (n["jitter"].IsDefined()) {
-      js.feedback_jitter_s =
-          r.value_in(n, "jitter", p, Dimension::kTime, 0.0, 1.0, "between 0 and 1 s");
-    }
+    r.optional_value_in(n, "delay", p, Dimension::kTime, 0.0, 1.0, "between 0 and 1 s",
+                        js.feedback_delay_s);
+    r.optional_value_in(n, "jitter", p, Dimension::kTime, 0.0, 1.0, "between 0 and 1 s",
+                        js.feedback_jitter_s);
   }
 }
 

@@ -419,7 +419,7 @@ struct SimBackend::Impl {
     pump.solve(demand, load_pressure, pump_result);
     step_physics(false);
     update_loads(load_alpha);
-    record_joints();
+    if (!settings.joints.exact()) record_joints();  // exact readings need no history
     t_s += settings.step_s;
     energy_j += pump_result.power_w * settings.step_s;
   }

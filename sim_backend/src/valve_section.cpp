@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "craneassist/valves/proportional_valves.hpp"
+
 namespace craneassist::sim_backend {
 
 ValveSection::ValveSection(const dynamics::ValveSections& params,
@@ -18,8 +20,9 @@ ValveSection::ValveSection(const dynamics::ValveSections& params,
       delay_line_(static_cast<std::size_t>(std::lround(params_.delay_s / step_s)) + 1, 0.0) {}
 
 double ValveSection::velocity_at(double spool) const {
-  const double d = params_.dead_zone;
-  const double open = std::clamp((std::abs(spool) - d) / (1.0 - d), 0.0, 1.0);
+  // The straight line's opening (the model's characteristic), shaped and scaled by the gain.
+  const double open =
+      std::abs(valves::ProportionalValves::velocity_from_spool(spool, params_.dead_zone, 1.0));
   const double shaped = shape_ == 1.0 ? open : std::pow(open, shape_);
   return std::copysign(gain_ * shaped * v_max_m_s_, spool);
 }

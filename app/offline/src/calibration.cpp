@@ -383,7 +383,7 @@ std::string format_list(const std::vector<double>& values) {
 }  // namespace
 
 ValveDynamics identify_valve_dynamics(const dynamics::ValveTable& table,
-                                      const std::vector<SweepLogRow>& rows, int section,
+                                      std::span<const SweepLogRow> rows, int section,
                                       double max_residual) {
   ValveDynamics out;
   if (const std::string why = dynamics::check_valve_table(table); !why.empty()) {
@@ -526,9 +526,8 @@ SectionCalibration calibrate_section(const config::CraneConfig& config, int sect
     points.insert(points.end(), task.points().begin(), task.points().end());
   }
   SectionCalibration result = fit_section(section, std::move(points), placed);
-  const std::vector<SweepLogRow> rows(log->begin() + static_cast<std::ptrdiff_t>(first_row),
-                                      log->end());
-  result.dynamics = identify_valve_dynamics(result.table, rows, section);
+  result.dynamics =
+      identify_valve_dynamics(result.table, std::span(*log).subspan(first_row), section);
   return result;
 }
 
@@ -581,9 +580,8 @@ MachineSweep calibrate_section_on_machine(const config::CraneConfig& config,
   }
   if (out.end == SweepEnd::kComplete) {
     out.section = fit_section(section, task.points(), options);
-    const std::vector<SweepLogRow> rows(log->begin() + static_cast<std::ptrdiff_t>(first_row),
-                                        log->end());
-    out.section.dynamics = identify_valve_dynamics(out.section.table, rows, section);
+    out.section.dynamics =
+        identify_valve_dynamics(out.section.table, std::span(*log).subspan(first_row), section);
   } else {
     out.section.section = section;  // the points so far, unfitted
     out.section.points = task.points();

@@ -9,6 +9,7 @@
 
 #include <atomic>
 #include <iosfwd>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -156,7 +157,7 @@ dynamics::ValveTable fit_valve_table(const std::vector<SweepPoint>& points, doub
 // clearly, the fit gives no physical spool, or its rms misfit exceeds max_residual times the
 // time constant (and 5 ms).
 ValveDynamics identify_valve_dynamics(const dynamics::ValveTable& table,
-                                      const std::vector<SweepLogRow>& rows, int section,
+                                      std::span<const SweepLogRow> rows, int section,
                                       double max_residual = 0.2);
 
 // The identified dynamics as the controller is given them (the table's time_constant and delay):
