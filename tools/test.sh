@@ -52,9 +52,11 @@ ctest --test-dir build --output-on-failure -j"$jobs" -LE can_vm
 # unoptimised) compiles beside them at the lowest priority, in the cores they leave idle.
 echo "== the SocketCAN VM tests; beside them, the build without DDS and the web view"
 stage "release: the SocketCAN VM tests (can_vm), the no-DDS build beside"
-# Its own process group (setsid), so a failure here ends the whole build, not only its shell.
+# Its own process group (setsid), so a failure here ends the whole build, not only its shell; a
+# session of its own is also a scheduling group of its own (sched_autogroup_enabled), which gets
+# the lowest priority as its processes do.
 mkdir -p build-nodds
-setsid bash -c 'cmake -S . -B build-nodds -DCMAKE_BUILD_TYPE=Debug -DCRANEASSIST_DDS=OFF \
+setsid bash -c 'echo 19 >/proc/self/autogroup 2>/dev/null; cmake -S . -B build-nodds -DCMAKE_BUILD_TYPE=Debug -DCRANEASSIST_DDS=OFF \
   -DCRANEASSIST_BUILD_BENCH=OFF -DCRANEASSIST_CAN_VM_TESTS=OFF -DCRANEASSIST_WEB=OFF >/dev/null &&
   nice -n 19 cmake --build build-nodds -j"$1" --target craneassist' _ "$jobs" >build-nodds/build.log 2>&1 &
 nodds_pid=$!

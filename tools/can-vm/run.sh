@@ -205,10 +205,15 @@ cpus="${CRANEASSIST_CAN_VM_CPUS:-$(($(nproc) >= 2 ? 2 : 1))}"
 # starve them: where it may (as root, as CI runs), qemu runs at nice -15, a scheduler share about
 # 28 times a normal process's, so a busy host (a build beside it, `stress-ng --cpu 2`) slows it
 # little. Not SCHED_FIFO: the emulated CPUs may spin, and would then starve the host.
+# A nice value weighs only against the processes of the same session where the kernel groups
+# sessions (sched_autogroup_enabled, Debian's default): a build or stress-ng started in another
+# session (a terminal, `setsid`) gets as much of the CPUs as all of this session together, so
+# qemu runs in a session of its own whose group gets the same nice value (/proc/self/autogroup).
 # CRANEASSIST_CAN_VM_NICE overrides (0: as the caller).
 nice_level="${CRANEASSIST_CAN_VM_NICE:-$([ "$(id -u)" -eq 0 ] && echo -15 || echo 0)}"
 set +e
-timeout --kill-after=10 "$timeout_s" nice -n "$nice_level" qemu-system-x86_64 -accel tcg,thread=multi -m "$memory" -smp "$cpus" \
+setsid --wait sh -c 'echo "$1" >/proc/self/autogroup 2>/dev/null; shift; exec "$@"' _ "$nice_level" \
+  timeout --kill-after=10 "$timeout_s" nice -n "$nice_level" qemu-system-x86_64 -accel tcg,thread=multi -m "$memory" -smp "$cpus" \
   -nodefaults -no-user-config -no-reboot -display none -serial stdio -nic none \
   -kernel "$kernel" -initrd "$work/initramfs.cpio" \
   -append "console=ttyS0 quiet loglevel=3 panic=-1 rdinit=/init ${CRANEASSIST_CAN_VM_APPEND:-}" \
