@@ -22,8 +22,9 @@ void add_foxglove_options(CLI::App& command, FoxgloveArgs& args) {
   add_foxglove_server_option(command, args.foxglove);
   command
       .add_option("--foxglove-wait", args.foxglove_wait_s,
-                  "Hold the run's start until a Foxglove client has subscribed, at most this many "
-                  "seconds (then start anyway)")
+                  "Hold the run's start until a Foxglove client has subscribed (and its "
+                  "subscriptions have settled: 0.2 s without a new one), at most this many seconds "
+                  "(then start anyway)")
       ->check(CLI::Range(0.0, 3600.0))
       ->needs("--foxglove");
 }

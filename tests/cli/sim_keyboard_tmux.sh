@@ -54,11 +54,16 @@ awk -F, -v out="$work/moves.txt" '
   }' "$work/kb.csv"
 [ "$(cat "$work/moves.txt")" = 1 ] || { echo "the crane did not move as commanded"; exit 1; }
 
-# SIGTERM while the deadman is on: stops, restores the terminal.
+# SIGTERM while the deadman is on: stops, restores the terminal. The screen cleared first, so
+# the waits below see the second run's lines, not the first's (on a busy machine the second run
+# starts later than its keys are sent).
+keys "clear" Enter
+wait_for_gone "keys: space deadman" 10
 keys "stty -g > $work/before2.stty; sh -c 'echo \$\$ > $work/pid; exec $bin sim --input keyboard'; stty -g > $work/after2.stty; echo SESSION2-\$((40 + 2))" Enter
 wait_for "keys: space deadman" 10
 keys Space
 wait_for "deadman ON" 3
+[ -s "$work/pid" ] || fail "no pid file from the second run"
 kill -TERM "$(cat "$work/pid")"
 wait_for SESSION2-42 10
 cmp "$work/before2.stty" "$work/after2.stty" || { echo "terminal settings not restored after SIGTERM"; exit 1; }

@@ -7,6 +7,7 @@
 #   keys KEYS...         tmux send-keys to the session
 #   fail MESSAGE         say it with the pane and exit 1
 #   wait_for TEXT SECS   until the pane shows TEXT (a fixed string), else fail
+#   wait_for_gone TEXT SECS  until the pane no longer shows TEXT, else fail
 command -v tmux >/dev/null || { echo "tmux is not installed (tools/install-deps.sh)"; exit 1; }
 work=$(mktemp -d)
 sock="$work/tmux.sock"
@@ -26,6 +27,14 @@ wait_for() {
   while ! pane | grep -q -F -- "$1"; do
     i=$((i + 1))
     [ $i -le $(($2 * 10)) ] || fail "timed out waiting for '$1'"
+    sleep 0.1
+  done
+}
+wait_for_gone() {
+  i=0
+  while pane | grep -q -F -- "$1"; do
+    i=$((i + 1))
+    [ $i -le $(($2 * 10)) ] || fail "timed out waiting for '$1' to leave the screen"
     sleep 0.1
   done
 }

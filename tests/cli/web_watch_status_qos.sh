@@ -10,14 +10,23 @@ sed '/^  status:/,/depth/{s/reliability: reliable/reliability: best_effort/;s/du
   "$(dirname "$0")/../../config/telemetry/default.yaml" >"$work/best_effort.yaml"
 grep -q "reliability: best_effort" "$work/best_effort.yaml" || fail "sed did not edit the status topic"
 
-watch_case() {  # NAME [web options...]: web watches one replay with best-effort status
+# watch_case NAME [web options...]: web watches one replay with best-effort status, until the
+# replay has ended and web has said so (or 10 s more: on a busy machine the run starts and ends
+# later than on an idle one, and a fixed --duration cut it short), then is stopped with SIGINT.
+watch_case() {
   name=$1
   shift
-  "$craneassist" web --web-listen 127.0.0.1:0 --domain "$domain" --duration 8 "$@" >"$work/$name.txt" 2>&1 &
+  "$craneassist" web --web-listen 127.0.0.1:0 --domain "$domain" --duration 120 "$@" >"$work/$name.txt" 2>&1 &
   bg_pid=$!
   sleep 1
   "$craneassist" replay "$replay" --realtime --telemetry --telemetry-config "$work/best_effort.yaml" \
     --domain "$domain" --no-log >"$work/$name-replay.txt" 2>&1 || fail "replay failed"
+  i=0
+  while [ $i -lt 100 ] && ! grep -q "the watched run stopped\|before it said it stopped" "$work/$name.txt"; do
+    sleep 0.1
+    i=$((i + 1))
+  done
+  kill -INT "$bg_pid"
   wait "$bg_pid" || { cat "$work/$name.txt"; fail "web failed"; }
   bg_pid=
 }

@@ -37,6 +37,8 @@ namespace {
 constexpr int kTelemetryTopics = 6;
 constexpr int kBaseTopic = 4;
 constexpr int kFieldsTopic = 5;
+// How long the writers stay after the run's last samples when a best-effort topic has readers.
+constexpr auto kBestEffortLinger = std::chrono::milliseconds(200);
 
 template <typename Header>
 void fill_header(Header& h, const TelemetryFrame& f) {
@@ -149,6 +151,17 @@ struct TelemetryPublisher::Impl {
           // matched readers have it before the writers go, for at most half a second (a reader
           // that died cannot hold the exit up).
           const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
+          bool best_effort_matched = false;
+          for (auto* w : writers) {
+            if (w != nullptr &&
+                w->get_qos().reliability().kind == fdds::BEST_EFFORT_RELIABILITY_QOS) {
+              fdds::PublicationMatchedStatus matched;
+              best_effort_matched =
+                  best_effort_matched ||
+                  (w->get_publication_matched_status(matched) == ReturnCode_t::RETCODE_OK &&
+                   matched.current_count > 0);
+            }
+          }
           for (auto* w : writers) {
             const auto left_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
                                      until - std::chrono::steady_clock::now())
@@ -160,6 +173,13 @@ struct TelemetryPublisher::Impl {
                                     ReturnCode_t::RETCODE_OK) {
               end_unacknowledged.fetch_add(1, std::memory_order_relaxed);
             }
+          }
+          // A best-effort topic is never acknowledged, and a reader that has not yet taken its
+          // last sample loses it when the writer goes (over shared memory, the sample's buffer
+          // goes with the writer): its readers get a moment (kBestEffortLinger) to take it.
+          if (best_effort_matched) {
+            std::this_thread::sleep_until(
+                std::min(until, std::chrono::steady_clock::now() + kBestEffortLinger));
           }
         }
         return;

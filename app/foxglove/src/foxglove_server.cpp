@@ -539,10 +539,25 @@ void FoxgloveServer::stop(double drain_s) {
 }
 
 bool FoxgloveServer::wait_for_subscriber(double timeout_s) const {
-  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  using clock = std::chrono::steady_clock;
+  const auto until = clock::now() + std::chrono::duration<double>(timeout_s);
   while (impl_->subscriptions_made.load() == 0) {
-    if (std::chrono::steady_clock::now() >= until) return false;
+    if (clock::now() >= until) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  // A client subscribes channel by channel (a viewer: a message per panel's topic, clients
+  // connecting together each their own): the run starts once the subscriptions have settled,
+  // kSubscriptionsSettle after the last one (within the timeout), so that its first cycle reaches
+  // every channel asked for, on a busy machine too.
+  constexpr auto kSubscriptionsSettle = std::chrono::milliseconds(200);
+  std::uint64_t seen = impl_->subscriptions_made.load();
+  auto last = clock::now();
+  while (clock::now() - last < kSubscriptionsSettle && clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (const std::uint64_t now_made = impl_->subscriptions_made.load(); now_made != seen) {
+      seen = now_made;
+      last = clock::now();
+    }
   }
   return true;
 }

@@ -76,7 +76,8 @@ class FoxgloveServer {
   unsigned short port() const;
   std::string url() const;  // ws://HOST:PORT
   control::CycleObserver& observer();
-  // Waits until a client has subscribed to a channel, at most timeout_s; false when none did.
+  // Waits until a client has subscribed to a channel and its subscriptions have settled (0.2 s
+  // without a new one), at most timeout_s; false when none subscribed.
   // Before the run (not on the loop's thread).
   bool wait_for_subscriber(double timeout_s) const;
   // Sends what the loop handed over, then closes every connection (at most `drain_s`).
