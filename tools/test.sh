@@ -62,6 +62,9 @@ setsid bash -c 'echo 19 >/proc/self/autogroup 2>/dev/null; cmake -S . -B build-n
 nodds_pid=$!
 ctest --test-dir build --output-on-failure -j"$jobs" -L can_vm
 stage "no DDS, no web view: the rest of its build, its CLI checks"
+# The VM tests are done: the rest of the build at a normal share (at nice 19 its group would get
+# nothing beside other work on the machine, e.g. stress-ng).
+echo 0 >"/proc/$nodds_pid/autogroup" 2>/dev/null || true
 wait "$nodds_pid" || { cat build-nodds/build.log; echo "the build without DDS failed" >&2; exit 1; }
 nodds_pid=""
 ctest --test-dir build-nodds --output-on-failure -R 'cli_sim_without_dds|cli_sim_without_web|cli_replay_initial|cli_sim_bad_input'
