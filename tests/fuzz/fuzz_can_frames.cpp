@@ -4,6 +4,8 @@
 //    decomposed identifier's PGN gives that PGN back;
 //  - the ISO 11783-7 auxiliary valve codec (can/iso11783_valve.hpp): the command, measured flow
 //    and estimated flow decoders; a decoded command encodes to a frame that decodes the same;
+//  - the J1939-71 joystick messages (can/j1939_joystick.hpp): every axis a position in -1..1 only
+//    when it is valid, 0 otherwise; a decoded message encodes to a frame that decodes the same;
 //  - J1939 network management and diagnostics (can/address_claim.hpp, can/dm1.hpp): Address
 //    Claimed, Request, DM1 and its TP.CM announcement decode to what encodes the same frame; an
 //    AddressClaimer fed every frame only ever sends claims of its address or Cannot Claim;
@@ -27,6 +29,7 @@
 #include "craneassist/can/heartbeat.hpp"
 #include "craneassist/can/iso11783_valve.hpp"
 #include "craneassist/can/j1939.hpp"
+#include "craneassist/can/j1939_joystick.hpp"
 #include "craneassist/can/mapping_config.hpp"
 #include "craneassist/can/signal_map.hpp"
 #include "craneassist/can/valve_frames.hpp"
@@ -60,6 +63,31 @@ void check_j1939(const can::CanFrame& frame) {
 
 bool same_value(double a, double b) {
   return (std::isnan(a) && std::isnan(b)) || a == b;
+}
+
+void check_joystick(const can::CanFrame& frame) {
+  namespace js = craneassist::can::j1939_joystick;
+  js::JoystickMessage m;
+  const js::DecodeStatus status = js::decode(frame, m);
+  (void)js::to_string(status);
+  if (status != js::DecodeStatus::kOk) return;
+  for (const js::Axis& a : m.axes) {
+    (void)js::to_string(a.status);
+    FUZZ_CHECK(std::isfinite(a.value) && a.value >= -1.0 && a.value <= 1.0, "an axis in -1..1");
+    FUZZ_CHECK(a.status == js::AxisStatus::kOk || a.value == 0.0, "no position unless valid");
+    FUZZ_CHECK(!a.neutral || (a.status == js::AxisStatus::kOk && a.value == 0.0),
+               "neutral only at 0");
+  }
+  can::CanFrame again;
+  js::encode(m, j1939::decompose(frame.id).source_address, again,
+             j1939::decompose(frame.id).priority);
+  js::JoystickMessage back;
+  FUZZ_CHECK(js::decode(again, back) == js::DecodeStatus::kOk, "an encoded message decodes");
+  for (std::size_t i = 0; i < m.axes.size(); ++i) {
+    FUZZ_CHECK(back.axes[i].status == m.axes[i].status && back.axes[i].value == m.axes[i].value,
+               "an axis decodes the same after encoding");
+  }
+  FUZZ_CHECK(back.buttons == m.buttons && back.x_detent == m.x_detent, "buttons the same");
 }
 
 void check_iso11783(const can::CanFrame& frame) {
@@ -246,6 +274,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     t_s += 0.001;
 
     check_j1939(frame);
+    check_joystick(frame);
     check_iso11783(frame);
     check_network(frame, t_s);
     for (Machine& m : machines) {
