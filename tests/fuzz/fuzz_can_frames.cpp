@@ -79,8 +79,8 @@ void check_joystick(const can::CanFrame& frame) {
                "neutral only at 0");
   }
   can::CanFrame again;
-  js::encode(m, j1939::decompose(frame.id).source_address, again,
-             j1939::decompose(frame.id).priority);
+  const j1939::Identifier id = j1939::decompose(frame.id);
+  js::encode(m, id.source_address, again, id.priority);
   js::JoystickMessage back;
   FUZZ_CHECK(js::decode(again, back) == js::DecodeStatus::kOk, "an encoded message decodes");
   for (std::size_t i = 0; i < m.axes.size(); ++i) {

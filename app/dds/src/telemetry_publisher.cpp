@@ -153,20 +153,17 @@ struct TelemetryPublisher::Impl {
           const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
           bool best_effort_matched = false;
           for (auto* w : writers) {
-            if (w != nullptr &&
-                w->get_qos().reliability().kind == fdds::BEST_EFFORT_RELIABILITY_QOS) {
+            const auto left_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                     until - std::chrono::steady_clock::now())
+                                     .count();
+            if (w == nullptr) continue;
+            if (w->get_qos().reliability().kind == fdds::BEST_EFFORT_RELIABILITY_QOS) {
               fdds::PublicationMatchedStatus matched;
               best_effort_matched =
                   best_effort_matched ||
                   (w->get_publication_matched_status(matched) == ReturnCode_t::RETCODE_OK &&
                    matched.current_count > 0);
             }
-          }
-          for (auto* w : writers) {
-            const auto left_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                     until - std::chrono::steady_clock::now())
-                                     .count();
-            if (w == nullptr) continue;
             if (left_ns <= 0 || w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(
                                     static_cast<std::int32_t>(left_ns / 1000000000),
                                     static_cast<std::uint32_t>(left_ns % 1000000000))) !=

@@ -19,6 +19,17 @@ std::uint16_t le16(const CanFrame& f, int byte) {
   return static_cast<std::uint16_t>(f.data[static_cast<std::size_t>(byte)] |
                                     (f.data[static_cast<std::size_t>(byte) + 1] << 8));
 }
+// Where button b (0: button 1) sits: byte 6 holds buttons 4..1, byte 7 buttons 8..5, byte 8
+// buttons 12..9 (1-based J1939 bytes), each byte's highest pair being the lowest-numbered button
+// of its four. The data byte's index and the pair's shift.
+struct ButtonSlot {
+  std::size_t byte;
+  unsigned shift;
+};
+ButtonSlot button_slot(int b) {
+  return {static_cast<std::size_t>(5 + b / 4), 2u * static_cast<unsigned>(3 - b % 4)};
+}
+
 void put_le16(CanFrame& f, int byte, std::uint16_t v) {
   f.data[static_cast<std::size_t>(byte)] = static_cast<std::uint8_t>(v & 0xFFu);
   f.data[static_cast<std::size_t>(byte) + 1] = static_cast<std::uint8_t>(v >> 8);
@@ -68,8 +79,8 @@ Axis decode_axis(std::uint16_t bits) {
   }
   a.status = AxisStatus::kOk;
   a.neutral = neutral;
-  a.value = (negative ? -1.0 : 1.0) * a.magnitude / static_cast<double>(kMaxMagnitude);
-  if (neutral) a.value = 0.0;
+  a.value =
+      (negative ? -1.0 : 1.0) * a.magnitude / static_cast<double>(kMaxMagnitude);  // 0 in neutral
   return a;
 }
 
@@ -115,11 +126,8 @@ DecodeStatus decode(const CanFrame& frame, JoystickMessage& out) {
   out.y_detent = switch_at(frame.data[4] >> 4);
   out.x_detent = switch_at(frame.data[4] >> 6);
   for (int b = 0; b < kButtons; ++b) {
-    // Byte 6 holds buttons 4..1, byte 7 buttons 8..5, byte 8 buttons 12..9, each byte's highest
-    // pair being the lowest-numbered button of its four.
-    const int byte = 5 + b / 4, pair = 3 - b % 4;
-    out.buttons[static_cast<std::size_t>(b)] =
-        switch_at(frame.data[static_cast<std::size_t>(byte)] >> (2 * pair));
+    const ButtonSlot slot = button_slot(b);
+    out.buttons[static_cast<std::size_t>(b)] = switch_at(frame.data[slot.byte] >> slot.shift);
   }
   return DecodeStatus::kOk;
 }
@@ -144,9 +152,9 @@ void encode(const JoystickMessage& message, std::uint8_t source, CanFrame& out,
                                           (bits_of(message.x_detent) << 6));
   for (int byte = 5; byte < 8; ++byte) out.data[static_cast<std::size_t>(byte)] = 0;
   for (int b = 0; b < kButtons; ++b) {
-    const int byte = 5 + b / 4, pair = 3 - b % 4;
-    out.data[static_cast<std::size_t>(byte)] |= static_cast<std::uint8_t>(
-        bits_of(message.buttons[static_cast<std::size_t>(b)]) << (2 * pair));
+    const ButtonSlot slot = button_slot(b);
+    out.data[slot.byte] |= static_cast<std::uint8_t>(
+        bits_of(message.buttons[static_cast<std::size_t>(b)]) << slot.shift);
   }
 }
 
